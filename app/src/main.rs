@@ -1,0 +1,5 @@
+//! The photomontage studio.
+
+fn main() -> anyhow::Result<()> {
+    Ok(())
+}

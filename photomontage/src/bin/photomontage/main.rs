@@ -1,0 +1,22 @@
+//! The `photomontage` command-line tool.
+
+use clap::{Parser, Subcommand};
+
+/// Photogrammetric photomontage: solve site cameras, model daylight, render planned buildings.
+///
+/// Pixel convention everywhere: (0,0) is the centre of the top-left pixel of the photo as
+/// displayed (EXIF orientation applied); x runs right, y runs down.
+#[derive(Parser)]
+#[command(name = "photomontage", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {}
+}

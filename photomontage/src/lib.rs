@@ -1,0 +1,11 @@
+//! photomontage: put planned buildings into site photographs accurately enough for
+//! planning-permission visual impact studies ("verified views").
+//!
+//! The method follows Durisch, *Photogrammetry and computer graphics for visual impact analysis in
+//! architecture* (ISPRS 1992): a photogrammetric camera model and its inversions, daylight and
+//! atmosphere models fitted to the photos, and a differential ray tracer.
+//!
+//! Frames and units are part of every name: `world_from_camera` maps camera coordinates to world
+//! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
+
+pub mod camera;
