@@ -1,0 +1,214 @@
+//! The site file: the project a user saves (TOML, versioned schema). Every field is documented
+//! in `docs/site-format.md`; this module is the schema, its validation and atomic saving.
+//!
+//! A site holds the photos (file, interior orientation, exterior orientation once solved), the
+//! surveyed control points, the pixel observations of points in photos, the scene polygons
+//! (Durisch 1992 §4.1: vertices, material attribute, image attribute), lighting and atmosphere
+//! parameters, CAD models with their placement and the render settings. Paths are relative to the
+//! site file.
+//!
+//! # Known limitations
+//! Line numbers of semantic errors (a duplicate id, an unknown photo) are found by locating the
+//! `[[table]]` header and key in the text, which works for the array-of-tables layout that
+//! [`Site::save`] writes; for hand-written inline tables the error names the field but may give
+//! the line of the enclosing table.
+
+mod locate;
+mod schema;
+mod validate;
+
+pub use schema::*;
+pub use validate::SiteIssue;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The schema version this build reads and writes.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// What can go wrong loading or saving a site file.
+#[derive(Debug, thiserror::Error)]
+pub enum SiteError {
+    #[error("cannot read site file {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}:{column}: {message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("{path}:{line}: field `{field}`: {message}")]
+    Invalid {
+        path: PathBuf,
+        line: usize,
+        field: String,
+        message: String,
+    },
+    #[error(
+        "{path}: schema_version {found} is not supported (this build reads version {supported})"
+    )]
+    UnsupportedVersion {
+        path: PathBuf,
+        found: u32,
+        supported: u32,
+    },
+    #[error("cannot serialise site: {0}")]
+    Serialise(String),
+    #[error("cannot write site file {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// A site file loaded from disk, with the folder its relative paths are resolved against.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SiteDocument {
+    /// The site file's own path.
+    pub path: PathBuf,
+    /// The schema content.
+    pub site: Site,
+}
+
+impl SiteDocument {
+    /// Reads, parses and validates a site file.
+    ///
+    /// # Errors
+    /// [`SiteError`] naming the file, line and field of the first problem.
+    pub fn load(path: &Path) -> Result<Self, SiteError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SiteError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let site = Site::from_toml(&text, path)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            site,
+        })
+    }
+
+    /// The folder relative paths in the site are resolved against.
+    #[must_use]
+    pub fn base_dir(&self) -> &Path {
+        self.path.parent().unwrap_or_else(|| Path::new("."))
+    }
+
+    /// Resolves a path written in the site file (relative to the site file) to a usable path.
+    #[must_use]
+    pub fn resolve(&self, relative: &str) -> PathBuf {
+        self.base_dir().join(relative)
+    }
+
+    /// Saves atomically to the document's own path.
+    ///
+    /// # Errors
+    /// [`SiteError::Write`] or [`SiteError::Serialise`]; the file on disk is then unchanged.
+    pub fn save(&self) -> Result<(), SiteError> {
+        self.site.save(&self.path)
+    }
+}
+
+impl Site {
+    /// Parses and validates site TOML text. `path` is only used in error messages.
+    ///
+    /// # Errors
+    /// [`SiteError::Syntax`] for TOML or type errors, [`SiteError::Invalid`] for semantic errors,
+    /// [`SiteError::UnsupportedVersion`] for another schema version.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self, SiteError> {
+        // The version is checked first so that a newer file gets a version message, not a
+        // confusing unknown-field one.
+        if let Ok(probe) = toml::from_str::<VersionProbe>(text)
+            && probe.schema_version != SCHEMA_VERSION
+        {
+            return Err(SiteError::UnsupportedVersion {
+                path: path.to_path_buf(),
+                found: probe.schema_version,
+                supported: SCHEMA_VERSION,
+            });
+        }
+        let site: Self = toml::from_str(text).map_err(|e| {
+            let (line, column) = e
+                .span()
+                .map_or((0, 0), |span| locate::line_column(text, span.start));
+            SiteError::Syntax {
+                path: path.to_path_buf(),
+                line,
+                column,
+                message: e.message().to_string(),
+            }
+        })?;
+        if let Some(issue) = site.validate().into_iter().next() {
+            return Err(SiteError::Invalid {
+                path: path.to_path_buf(),
+                line: locate::field_line(text, &issue.field),
+                field: issue.field,
+                message: issue.message,
+            });
+        }
+        Ok(site)
+    }
+
+    /// The site as TOML text, in the layout `load` reads back to an equal value.
+    ///
+    /// # Errors
+    /// [`SiteError::Serialise`] if a value cannot be represented (e.g. a non-finite float).
+    pub fn to_toml(&self) -> Result<String, SiteError> {
+        toml::to_string_pretty(self).map_err(|e| SiteError::Serialise(e.to_string()))
+    }
+
+    /// Saves atomically: writes a temporary file beside `path`, flushes it to disk, then renames it
+    /// over `path`, so a crash leaves either the old or the new file, never a torn one.
+    ///
+    /// # Errors
+    /// [`SiteError::Write`] or [`SiteError::Serialise`].
+    pub fn save(&self, path: &Path) -> Result<(), SiteError> {
+        let text = self.to_toml()?;
+        write_atomically(path, text.as_bytes()).map_err(|source| SiteError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
+    }
+}
+
+/// Writes `bytes` to `path` atomically (temporary file beside it, fsync, rename, fsync folder).
+///
+/// # Errors
+/// Any I/O error; the temporary file is removed on failure.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let file_name = path
+        .file_name()
+        .map_or_else(|| "site".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)?;
+        // Make the rename itself durable.
+        if let Ok(d) = std::fs::File::open(&dir) {
+            let _ = d.sync_all();
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[derive(serde::Deserialize)]
+struct VersionProbe {
+    schema_version: u32,
+}
+
+#[cfg(test)]
+mod tests;

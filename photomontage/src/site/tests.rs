@@ -1,0 +1,234 @@
+use super::*;
+
+const EXAMPLE: &str = r#"schema_version = 1
+name = "Test court"
+
+[location]
+latitude_deg = 47.37
+longitude_deg = 8.54
+elevation_m = 410.0
+crs = "EPSG:2056"
+
+[[photos]]
+id = "P1"
+file = "photos/p1.jpg"
+taken_at = "2024-06-21T14:00:00+02:00"
+
+[photos.interior]
+focal_px = 3000.0
+image_size_px = [4000, 3000]
+
+[[photos]]
+id = "P2"
+file = "photos/p2.jpg"
+
+[[control_points]]
+id = "C1"
+xyz = [2683000.125, 1247000.5, 410.25]
+sigma_m = [0.005, 0.005, 0.01]
+
+[[control_points]]
+id = "C2"
+xyz = [2683010.0, 1247000.5, 410.25]
+
+[[observations]]
+photo = "P1"
+point = "C1"
+x_px = 1234.5
+y_px = 987.25
+
+[[observations]]
+photo = "P2"
+point = "C2"
+x_px = 10.0
+y_px = 20.0
+sigma_px = 1.0
+enabled = false
+
+[[polygons]]
+id = "ground"
+vertices = ["C1", "C2", "T1"]
+material = "asphalt"
+image = "P1"
+
+[[observations]]
+photo = "P2"
+point = "T1"
+x_px = 11.0
+y_px = 21.0
+"#;
+
+fn parse(text: &str) -> Result<Site, SiteError> {
+    Site::from_toml(text, Path::new("test.toml"))
+}
+
+#[test]
+fn example_parses_with_defaults() {
+    let site = parse(EXAMPLE).unwrap();
+    assert_eq!(site.photos.len(), 2);
+    assert_eq!(site.control_points[1].sigma_m, [0.01, 0.01, 0.01]);
+    assert!(site.observations[0].enabled);
+    assert!((site.observations[0].sigma_px - 0.5).abs() < f64::EPSILON);
+    assert!(!site.observations[1].enabled);
+    assert_eq!(site.solve, SolveSettings::default());
+}
+
+#[test]
+fn round_trip_is_lossless_and_stable() {
+    let site = parse(EXAMPLE).unwrap();
+    let text = site.to_toml().unwrap();
+    let again = parse(&text).unwrap();
+    assert_eq!(site, again);
+    // A second save writes exactly the same bytes.
+    assert_eq!(text, again.to_toml().unwrap());
+}
+
+#[test]
+fn round_trip_keeps_every_float_bit() {
+    let mut site = parse(EXAMPLE).unwrap();
+    site.control_points[0].xyz = [0.1 + 0.2, 1.0 / 3.0, 612_345.678_901_234_5];
+    site.observations[0].x_px = std::f64::consts::PI * 1000.0;
+    let again = parse(&site.to_toml().unwrap()).unwrap();
+    for (a, b) in site.control_points[0]
+        .xyz
+        .iter()
+        .zip(again.control_points[0].xyz)
+    {
+        assert_eq!(a.to_bits(), b.to_bits());
+    }
+    assert_eq!(
+        site.observations[0].x_px.to_bits(),
+        again.observations[0].x_px.to_bits()
+    );
+}
+
+#[test]
+fn syntax_error_names_line_and_column() {
+    let text = EXAMPLE.replace("x_px = 1234.5", "x_px = 12 34.5");
+    let err = parse(&text).unwrap_err();
+    let SiteError::Syntax { line, .. } = err else {
+        panic!("expected a syntax error, got {err}");
+    };
+    let expected = EXAMPLE.lines().position(|l| l == "x_px = 1234.5").unwrap() + 1;
+    assert_eq!(line, expected);
+}
+
+#[test]
+fn type_error_names_line_and_field() {
+    let text = EXAMPLE.replace("focal_px = 3000.0", "focal_px = \"long\"");
+    let err = parse(&text).unwrap_err();
+    let msg = err.to_string();
+    let expected = EXAMPLE
+        .lines()
+        .position(|l| l == "focal_px = 3000.0")
+        .unwrap()
+        + 1;
+    assert!(msg.contains(&format!("test.toml:{expected}:")), "{msg}");
+}
+
+#[test]
+fn unknown_field_is_refused() {
+    let text = EXAMPLE.replace("enabled = false", "enabld = false");
+    let msg = parse(&text).unwrap_err().to_string();
+    assert!(msg.contains("enabld"), "{msg}");
+}
+
+#[test]
+fn unknown_photo_reference_gives_field_and_line() {
+    let text = EXAMPLE.replace(
+        "photo = \"P2\"\npoint = \"C2\"",
+        "photo = \"P9\"\npoint = \"C2\"",
+    );
+    let err = parse(&text).unwrap_err();
+    let SiteError::Invalid {
+        line,
+        field,
+        message,
+        ..
+    } = err
+    else {
+        panic!("expected a validation error, got {err}");
+    };
+    assert_eq!(field, "observations[1].photo");
+    assert!(message.contains("P9"));
+    let expected = text.lines().position(|l| l == "photo = \"P9\"").unwrap() + 1;
+    assert_eq!(line, expected);
+}
+
+#[test]
+fn duplicate_point_id_is_refused() {
+    let text = EXAMPLE.replace("id = \"C2\"", "id = \"C1\"");
+    let err = parse(&text).unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "control_points[1].id"),
+        "{err}"
+    );
+}
+
+#[test]
+fn nan_coordinate_is_refused() {
+    let text = EXAMPLE.replace(
+        "xyz = [2683010.0, 1247000.5, 410.25]",
+        "xyz = [nan, 1247000.5, 410.25]",
+    );
+    let err = parse(&text).unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "control_points[1].xyz"),
+        "{err}"
+    );
+}
+
+#[test]
+fn newer_schema_version_is_named() {
+    let text = EXAMPLE.replace("schema_version = 1", "schema_version = 7");
+    let err = parse(&text).unwrap_err();
+    assert!(matches!(
+        err,
+        SiteError::UnsupportedVersion {
+            found: 7,
+            supported: 1,
+            ..
+        }
+    ));
+}
+
+#[test]
+fn polygon_needs_known_vertices() {
+    let text = EXAMPLE.replace(
+        "vertices = [\"C1\", \"C2\", \"T1\"]",
+        "vertices = [\"C1\", \"C2\", \"Q7\"]",
+    );
+    let msg = parse(&text).unwrap_err().to_string();
+    assert!(
+        msg.contains("Q7") && msg.contains("polygons[0].vertices"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn atomic_save_replaces_and_leaves_no_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("site.toml");
+    std::fs::write(&path, "old").unwrap();
+    let site = parse(EXAMPLE).unwrap();
+    site.save(&path).unwrap();
+    let doc = SiteDocument::load(&path).unwrap();
+    assert_eq!(doc.site, site);
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "left behind: {names:?}");
+}
+
+#[test]
+fn failed_save_keeps_the_old_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("site.toml");
+    std::fs::write(&path, EXAMPLE).unwrap();
+    let site = parse(EXAMPLE).unwrap();
+    // A missing folder makes the write fail before anything is renamed.
+    let bad = dir.path().join("missing").join("site.toml");
+    assert!(site.save(&bad).is_err());
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), EXAMPLE);
+}

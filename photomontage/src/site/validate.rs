@@ -1,0 +1,297 @@
+//! Semantic checks of a parsed site: unique ids, references that resolve, finite numbers,
+//! positive standard deviations.
+
+use super::Site;
+use std::collections::HashSet;
+
+/// One problem found in a site, with the field path it concerns (e.g. `observations[3].photo`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SiteIssue {
+    pub field: String,
+    pub message: String,
+}
+
+fn issue(field: String, message: impl Into<String>) -> SiteIssue {
+    SiteIssue {
+        field,
+        message: message.into(),
+    }
+}
+
+fn check_finite(issues: &mut Vec<SiteIssue>, field: String, values: &[f64]) {
+    if values.iter().any(|v| !v.is_finite()) {
+        issues.push(issue(
+            field,
+            "must be a finite number (not NaN or infinite)",
+        ));
+    }
+}
+
+impl Site {
+    /// Every semantic problem in the site, in file order. Empty when the site is valid.
+    #[must_use]
+    pub fn validate(&self) -> Vec<SiteIssue> {
+        let mut issues = Vec::new();
+        let mut photo_ids = HashSet::new();
+        for (i, photo) in self.photos.iter().enumerate() {
+            if photo.id.trim().is_empty() {
+                issues.push(issue(format!("photos[{i}].id"), "must not be empty"));
+            }
+            if !photo_ids.insert(photo.id.as_str()) {
+                issues.push(issue(
+                    format!("photos[{i}].id"),
+                    format!("duplicate photo id `{}`", photo.id),
+                ));
+            }
+            if photo.file.trim().is_empty() {
+                issues.push(issue(format!("photos[{i}].file"), "must not be empty"));
+            }
+            if let Some(t) = &photo.taken_at
+                && chrono::DateTime::parse_from_rfc3339(t).is_err()
+            {
+                issues.push(issue(
+                    format!("photos[{i}].taken_at"),
+                    format!("`{t}` is not an RFC 3339 time with offset"),
+                ));
+            }
+            if let Some(interior) = &photo.interior {
+                if !(interior.focal_px.is_finite() && interior.focal_px > 0.0) {
+                    issues.push(issue(
+                        format!("photos[{i}].interior.focal_px"),
+                        "must be a positive number",
+                    ));
+                }
+                if let Some(pp) = interior.principal_point_px {
+                    check_finite(
+                        &mut issues,
+                        format!("photos[{i}].interior.principal_point_px"),
+                        &pp,
+                    );
+                }
+                let d = interior.distortion;
+                check_finite(
+                    &mut issues,
+                    format!("photos[{i}].interior.distortion"),
+                    &[d.k1, d.k2, d.k3, d.p1, d.p2],
+                );
+                if let Some([w, h]) = interior.image_size_px
+                    && (w == 0 || h == 0)
+                {
+                    issues.push(issue(
+                        format!("photos[{i}].interior.image_size_px"),
+                        "width and height must be positive",
+                    ));
+                }
+            }
+            if let Some(ext) = &photo.exterior {
+                check_finite(
+                    &mut issues,
+                    format!("photos[{i}].exterior.camera_center"),
+                    &ext.camera_center,
+                );
+                check_finite(
+                    &mut issues,
+                    format!("photos[{i}].exterior.rotation_world_from_camera"),
+                    &ext.rotation_world_from_camera.concat(),
+                );
+            }
+        }
+
+        let mut point_ids = HashSet::new();
+        for (i, cp) in self.control_points.iter().enumerate() {
+            let field = format!("control_points[{i}]");
+            if cp.id.trim().is_empty() {
+                issues.push(issue(format!("{field}.id"), "must not be empty"));
+            }
+            if !point_ids.insert(cp.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!("duplicate point id `{}`", cp.id),
+                ));
+            }
+            check_finite(&mut issues, format!("{field}.xyz"), &cp.xyz);
+            if cp.sigma_m.iter().any(|s| !s.is_finite() || *s < 0.0) {
+                issues.push(issue(
+                    format!("{field}.sigma_m"),
+                    "standard deviations must be finite and ≥ 0 (0 holds the axis fixed)",
+                ));
+            }
+        }
+        for (i, tp) in self.tie_points.iter().enumerate() {
+            let field = format!("tie_points[{i}]");
+            if !point_ids.insert(tp.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!(
+                        "duplicate point id `{}` (also a control or tie point)",
+                        tp.id
+                    ),
+                ));
+            }
+            check_finite(&mut issues, format!("{field}.xyz"), &tp.xyz);
+        }
+
+        let mut seen_obs = HashSet::new();
+        for (i, obs) in self.observations.iter().enumerate() {
+            let field = format!("observations[{i}]");
+            if !photo_ids.contains(obs.photo.as_str()) {
+                issues.push(issue(
+                    format!("{field}.photo"),
+                    format!("no photo has id `{}`", obs.photo),
+                ));
+            }
+            if obs.point.trim().is_empty() {
+                issues.push(issue(format!("{field}.point"), "must not be empty"));
+            }
+            if !seen_obs.insert((obs.photo.as_str(), obs.point.as_str())) {
+                issues.push(issue(
+                    format!("{field}.point"),
+                    format!(
+                        "point `{}` is observed twice in photo `{}`",
+                        obs.point, obs.photo
+                    ),
+                ));
+            }
+            check_finite(&mut issues, format!("{field}.x_px"), &[obs.x_px]);
+            check_finite(&mut issues, format!("{field}.y_px"), &[obs.y_px]);
+            if !(obs.sigma_px.is_finite() && obs.sigma_px > 0.0) {
+                issues.push(issue(
+                    format!("{field}.sigma_px"),
+                    "must be a positive number",
+                ));
+            }
+        }
+
+        let observed: HashSet<&str> = self.observations.iter().map(|o| o.point.as_str()).collect();
+        let mut polygon_ids = HashSet::new();
+        for (i, poly) in self.polygons.iter().enumerate() {
+            let field = format!("polygons[{i}]");
+            if !polygon_ids.insert(poly.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!("duplicate polygon id `{}`", poly.id),
+                ));
+            }
+            if poly.vertices.len() < 3 {
+                issues.push(issue(
+                    format!("{field}.vertices"),
+                    format!(
+                        "a polygon needs at least 3 vertices, found {}",
+                        poly.vertices.len()
+                    ),
+                ));
+            }
+            for v in &poly.vertices {
+                if !point_ids.contains(v.as_str()) && !observed.contains(v.as_str()) {
+                    issues.push(issue(
+                        format!("{field}.vertices"),
+                        format!("vertex `{v}` is neither a control point nor an observed point"),
+                    ));
+                }
+            }
+            if let Some(img) = &poly.image
+                && !photo_ids.contains(img.as_str())
+            {
+                issues.push(issue(
+                    format!("{field}.image"),
+                    format!("image attribute `{img}` is not a photo id"),
+                ));
+            }
+        }
+
+        let mut model_ids = HashSet::new();
+        for (i, model) in self.models.iter().enumerate() {
+            let field = format!("models[{i}]");
+            if !model_ids.insert(model.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!("duplicate model id `{}`", model.id),
+                ));
+            }
+            if !["m", "cm", "mm", "in", "ft"].contains(&model.units.as_str()) {
+                issues.push(issue(
+                    format!("{field}.units"),
+                    format!("`{}` is not one of m, cm, mm, in, ft", model.units),
+                ));
+            }
+            if !["z", "y"].contains(&model.up_axis.as_str()) {
+                issues.push(issue(
+                    format!("{field}.up_axis"),
+                    format!("`{}` is not `z` or `y`", model.up_axis),
+                ));
+            }
+            let p = &model.placement;
+            check_finite(
+                &mut issues,
+                format!("{field}.placement"),
+                &[
+                    p.translation[0],
+                    p.translation[1],
+                    p.translation[2],
+                    p.rotation_z_deg,
+                    p.scale,
+                ],
+            );
+            if p.scale <= 0.0 {
+                issues.push(issue(
+                    format!("{field}.placement.scale"),
+                    "must be positive",
+                ));
+            }
+        }
+
+        let lighting = &self.lighting;
+        if !valid_sky_model(&lighting.sky_model) {
+            issues.push(issue(
+                "lighting.sky_model".into(),
+                format!(
+                    "`{}` is not `uniform`, `cie_overcast` or `cie_general:N` (N = 1–15)",
+                    lighting.sky_model
+                ),
+            ));
+        }
+        if let Some(t) = &lighting.time
+            && chrono::DateTime::parse_from_rfc3339(t).is_err()
+        {
+            issues.push(issue(
+                "lighting.time".into(),
+                format!("`{t}` is not an RFC 3339 time with offset"),
+            ));
+        }
+        let r = &self.render;
+        if r.spp_min == 0 || r.spp_max < r.spp_min {
+            issues.push(issue(
+                "render.spp_max".into(),
+                format!(
+                    "need 1 ≤ spp_min ≤ spp_max, found spp_min = {}, spp_max = {}",
+                    r.spp_min, r.spp_max
+                ),
+            ));
+        }
+        if let Some(loc) = &self.location {
+            if !(-90.0..=90.0).contains(&loc.latitude_deg) {
+                issues.push(issue(
+                    "location.latitude_deg".into(),
+                    format!("{} is outside −90…90", loc.latitude_deg),
+                ));
+            }
+            if !(-180.0..=180.0).contains(&loc.longitude_deg) {
+                issues.push(issue(
+                    "location.longitude_deg".into(),
+                    format!("{} is outside −180…180", loc.longitude_deg),
+                ));
+            }
+        }
+        issues
+    }
+}
+
+fn valid_sky_model(name: &str) -> bool {
+    match name {
+        "uniform" | "cie_overcast" => true,
+        other => other
+            .strip_prefix("cie_general:")
+            .and_then(|n| n.parse::<u8>().ok())
+            .is_some_and(|n| (1..=15).contains(&n)),
+    }
+}
