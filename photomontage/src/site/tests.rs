@@ -222,13 +222,19 @@ fn atomic_save_replaces_and_leaves_no_temporary() {
 }
 
 #[test]
-fn failed_save_keeps_the_old_file() {
+fn failed_save_cleans_up_and_reports() {
     let dir = tempfile::tempdir().unwrap();
+    // The target is a non-empty folder, so the final rename must fail.
     let path = dir.path().join("site.toml");
-    std::fs::write(&path, EXAMPLE).unwrap();
+    std::fs::create_dir(&path).unwrap();
+    std::fs::write(path.join("keep"), "x").unwrap();
     let site = parse(EXAMPLE).unwrap();
-    // A missing folder makes the write fail before anything is renamed.
-    let bad = dir.path().join("missing").join("site.toml");
-    assert!(site.save(&bad).is_err());
-    assert_eq!(std::fs::read_to_string(&path).unwrap(), EXAMPLE);
+    let err = site.save(&path).unwrap_err();
+    assert!(matches!(err, SiteError::Write { .. }), "{err}");
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("site.toml")]);
+    assert_eq!(std::fs::read_to_string(path.join("keep")).unwrap(), "x");
 }
