@@ -9,4 +9,5 @@
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
 pub mod camera;
+pub mod photo;
 pub mod site;

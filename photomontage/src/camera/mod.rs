@@ -19,6 +19,7 @@
 //! lenses beyond the range where the polynomial is monotonic are not modelled.
 
 pub mod brown_conrady;
+pub mod undistort;
 
 pub use brown_conrady::BrownConrady;
 

@@ -1,0 +1,305 @@
+//! EXIF metadata a photomontage needs (CIPA DC-008 "Exif 2.3"): camera make and model, focal
+//! length (actual and 35 mm equivalent), focal-plane resolution, the original date and time with
+//! its offset, GPS position and the orientation. Read with kamadak-exif.
+//!
+//! The initial focal length in pixels is taken, in order of trust, from
+//! 1. the focal-plane resolution (pixels per unit on the sensor), rescaled when the stored image
+//!    is smaller than the size EXIF describes;
+//! 2. a sensor-width table for known camera models;
+//! 3. the 35 mm equivalent focal length (diagonal of 43.27 mm).
+//!
+//! # Known limitations
+//! Maker notes are not read, so lenses that report no focal length give no estimate; the sensor
+//! table holds only a few common bodies.
+
+use exif::{In, Tag, Value};
+use serde::Serialize;
+use std::path::Path;
+
+use super::PhotoError;
+
+/// Diagonal of the 36 × 24 mm frame that "35 mm equivalent" focal lengths refer to.
+const FULL_FRAME_DIAGONAL_MM: f64 = 43.266_615_305_567_87;
+
+/// Sensor sizes (width × height, mm) of camera bodies whose EXIF lacks a usable focal-plane
+/// resolution. Sources: the manufacturers' specification sheets.
+const SENSOR_SIZES_MM: &[(&str, &str, f64, f64)] = &[
+    ("canon", "canon eos 450d", 22.2, 14.8),
+    ("canon", "canon eos 40d", 22.2, 14.8),
+    ("canon", "canon eos 5d mark ii", 36.0, 24.0),
+    ("nikon", "nikon d70", 23.7, 15.6),
+    ("nikon", "nikon d700", 36.0, 23.9),
+    ("pentax", "pentax k10d", 23.5, 15.7),
+    ("sony", "ilce-7m3", 35.6, 23.8),
+];
+
+/// GPS position from EXIF (WGS 84 unless `GPSMapDatum` says otherwise).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GpsPosition {
+    pub latitude_deg: f64,
+    pub longitude_deg: f64,
+    pub altitude_m: Option<f64>,
+}
+
+/// The EXIF fields the studio uses; every field is optional.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ExifInfo {
+    pub make: Option<String>,
+    pub model: Option<String>,
+    pub focal_length_mm: Option<f64>,
+    pub focal_length_35mm: Option<f64>,
+    /// Focal-plane resolution in pixels per millimetre (x, y).
+    pub focal_plane_px_per_mm: Option<[f64; 2]>,
+    /// Image size EXIF states (PixelXDimension × PixelYDimension), as stored (not rotated).
+    pub exif_image_size_px: Option<[u32; 2]>,
+    /// DateTimeOriginal as written (`YYYY:MM:DD HH:MM:SS`).
+    pub date_time_original: Option<String>,
+    /// OffsetTimeOriginal (`+HH:MM`), when present.
+    pub offset_time_original: Option<String>,
+    pub gps: Option<GpsPosition>,
+    /// Orientation tag 1–8 (1 when absent).
+    pub orientation: u16,
+}
+
+impl ExifInfo {
+    /// The original capture time as RFC 3339 when both the time and its offset are known.
+    #[must_use]
+    pub fn taken_at_rfc3339(&self) -> Option<String> {
+        let dt = self.date_time_original.as_ref()?;
+        let offset = self.offset_time_original.as_ref()?;
+        let naive = chrono::NaiveDateTime::parse_from_str(dt.trim(), "%Y:%m:%d %H:%M:%S").ok()?;
+        let text = format!("{}{}", naive.format("%Y-%m-%dT%H:%M:%S"), offset.trim());
+        chrono::DateTime::parse_from_rfc3339(&text)
+            .ok()
+            .map(|t| t.to_rfc3339())
+    }
+
+    /// `make model` for display.
+    #[must_use]
+    pub fn camera_name(&self) -> Option<String> {
+        match (&self.make, &self.model) {
+            (Some(make), Some(model)) if model.to_lowercase().starts_with(&make.to_lowercase()) => {
+                Some(model.clone())
+            }
+            (Some(make), Some(model)) => Some(format!("{make} {model}")),
+            (None, Some(model)) => Some(model.clone()),
+            (Some(make), None) => Some(make.clone()),
+            (None, None) => None,
+        }
+    }
+}
+
+fn ascii(exif: &exif::Exif, tag: Tag) -> Option<String> {
+    let field = exif.get_field(tag, In::PRIMARY)?;
+    match &field.value {
+        Value::Ascii(parts) => {
+            let bytes = parts.first()?;
+            let s = String::from_utf8_lossy(bytes)
+                .trim_matches(char::from(0))
+                .trim()
+                .to_string();
+            (!s.is_empty()).then_some(s)
+        }
+        _ => None,
+    }
+}
+
+fn number(exif: &exif::Exif, tag: Tag) -> Option<f64> {
+    let field = exif.get_field(tag, In::PRIMARY)?;
+    let v = match &field.value {
+        Value::Rational(r) => r.first().map(exif::Rational::to_f64),
+        Value::SRational(r) => r.first().map(exif::SRational::to_f64),
+        Value::Short(s) => s.first().map(|v| f64::from(*v)),
+        Value::Long(l) => l.first().map(|v| f64::from(*v)),
+        _ => None,
+    }?;
+    v.is_finite().then_some(v)
+}
+
+fn dms(exif: &exif::Exif, tag: Tag) -> Option<f64> {
+    let field = exif.get_field(tag, In::PRIMARY)?;
+    match &field.value {
+        Value::Rational(r) if r.len() == 3 => {
+            Some(r[0].to_f64() + r[1].to_f64() / 60.0 + r[2].to_f64() / 3600.0)
+        }
+        _ => None,
+    }
+}
+
+/// Reads the EXIF block of a photo.
+///
+/// # Errors
+/// [`PhotoError::Missing`] when the file does not exist, [`PhotoError::Exif`] when there is no
+/// readable EXIF (callers treat that as a warning, not a failure).
+pub fn read_exif(path: &Path) -> Result<ExifInfo, PhotoError> {
+    let file = std::fs::File::open(path).map_err(|_| PhotoError::Missing {
+        path: path.to_path_buf(),
+    })?;
+    let mut reader = std::io::BufReader::new(file);
+    let exif = exif::Reader::new()
+        .read_from_container(&mut reader)
+        .map_err(|e| PhotoError::Exif {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+
+    // Focal-plane resolution: unit 2 = inch, 3 = cm, 4 = mm (Exif 2.3 §4.6.5).
+    let unit_mm = match number(&exif, Tag::FocalPlaneResolutionUnit).map(|u| u as u32) {
+        Some(3) => 10.0,
+        Some(4) => 1.0,
+        Some(5) => 0.001,
+        _ => 25.4,
+    };
+    let focal_plane_px_per_mm = match (
+        number(&exif, Tag::FocalPlaneXResolution),
+        number(&exif, Tag::FocalPlaneYResolution),
+    ) {
+        (Some(x), Some(y)) if x > 0.0 && y > 0.0 => Some([x / unit_mm, y / unit_mm]),
+        (Some(x), None) if x > 0.0 => Some([x / unit_mm, x / unit_mm]),
+        _ => None,
+    };
+    let exif_image_size_px = match (
+        number(&exif, Tag::PixelXDimension),
+        number(&exif, Tag::PixelYDimension),
+    ) {
+        (Some(w), Some(h)) if w >= 1.0 && h >= 1.0 => Some([w as u32, h as u32]),
+        _ => None,
+    };
+    let gps = match (dms(&exif, Tag::GPSLatitude), dms(&exif, Tag::GPSLongitude)) {
+        (Some(lat), Some(lon)) => {
+            let south = ascii(&exif, Tag::GPSLatitudeRef).is_some_and(|r| r.starts_with('S'));
+            let west = ascii(&exif, Tag::GPSLongitudeRef).is_some_and(|r| r.starts_with('W'));
+            let below = exif
+                .get_field(Tag::GPSAltitudeRef, In::PRIMARY)
+                .and_then(|f| f.value.get_uint(0))
+                == Some(1);
+            Some(GpsPosition {
+                latitude_deg: if south { -lat } else { lat },
+                longitude_deg: if west { -lon } else { lon },
+                altitude_m: number(&exif, Tag::GPSAltitude).map(|a| if below { -a } else { a }),
+            })
+        }
+        _ => None,
+    };
+    Ok(ExifInfo {
+        make: ascii(&exif, Tag::Make),
+        model: ascii(&exif, Tag::Model),
+        focal_length_mm: number(&exif, Tag::FocalLength).filter(|f| *f > 0.0),
+        focal_length_35mm: number(&exif, Tag::FocalLengthIn35mmFilm).filter(|f| *f > 0.0),
+        focal_plane_px_per_mm,
+        exif_image_size_px,
+        date_time_original: ascii(&exif, Tag::DateTimeOriginal),
+        offset_time_original: ascii(&exif, Tag::OffsetTimeOriginal),
+        gps,
+        orientation: exif
+            .get_field(Tag::Orientation, In::PRIMARY)
+            .and_then(|f| f.value.get_uint(0))
+            .and_then(|o| u16::try_from(o).ok())
+            .filter(|o| (1..=8).contains(o))
+            .unwrap_or(1),
+    })
+}
+
+/// Where an initial focal length came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FocalSource {
+    FocalPlaneResolution,
+    SensorTable,
+    Equivalent35mm,
+}
+
+/// An initial focal length in pixels with its provenance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FocalEstimate {
+    pub focal_px: f64,
+    pub source: FocalSource,
+}
+
+/// The initial focal length in pixels for a photo of `image_size_px` (as displayed), or `None`
+/// when EXIF gives nothing to go on.
+#[must_use]
+pub fn initial_focal_px(exif: &ExifInfo, image_size_px: [u32; 2]) -> Option<FocalEstimate> {
+    let long_side = f64::from(image_size_px[0].max(image_size_px[1]));
+    let short_side = f64::from(image_size_px[0].min(image_size_px[1]));
+    if let (Some(f_mm), Some(res)) = (exif.focal_length_mm, exif.focal_plane_px_per_mm) {
+        // The resolution refers to the size EXIF states; a downscaled copy scales it.
+        let scale = exif
+            .exif_image_size_px
+            .map_or(1.0, |[w, h]| long_side / f64::from(w.max(h)));
+        // Plausibility: the implied sensor must be 2–60 mm wide, else the tag is bogus.
+        let sensor_mm = long_side / (res[0] * scale);
+        if (2.0..=60.0).contains(&sensor_mm) {
+            return Some(FocalEstimate {
+                focal_px: f_mm * res[0] * scale,
+                source: FocalSource::FocalPlaneResolution,
+            });
+        }
+    }
+    if let (Some(f_mm), Some(model)) = (exif.focal_length_mm, exif.camera_name()) {
+        let name = model.to_lowercase();
+        if let Some(&(_, _, width_mm, _)) = SENSOR_SIZES_MM.iter().find(|(_, m, _, _)| name == *m) {
+            return Some(FocalEstimate {
+                focal_px: f_mm * long_side / width_mm,
+                source: FocalSource::SensorTable,
+            });
+        }
+    }
+    exif.focal_length_35mm.map(|f35| FocalEstimate {
+        focal_px: f35 * long_side.hypot(short_side) / FULL_FRAME_DIAGONAL_MM,
+        source: FocalSource::Equivalent35mm,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 50 mm lens on a full-frame 6000 × 4000 sensor (36 mm wide) is 8333.3 px.
+    #[test]
+    fn equivalent_35mm_full_frame_closed_form() {
+        let exif = ExifInfo {
+            focal_length_35mm: Some(50.0),
+            ..ExifInfo::default()
+        };
+        let est = initial_focal_px(&exif, [6000, 4000]).unwrap();
+        assert_eq!(est.source, FocalSource::Equivalent35mm);
+        assert!(
+            (est.focal_px - 50.0 / 36.0 * 6000.0).abs() < 1e-6,
+            "{est:?}"
+        );
+    }
+
+    #[test]
+    fn focal_plane_resolution_rescales_to_stored_size() {
+        // 8000 px/inch stated for a 2272-wide image, stored at 480 wide.
+        let exif = ExifInfo {
+            focal_length_mm: Some(21.3),
+            focal_plane_px_per_mm: Some([8000.0 / 25.4, 8000.0 / 25.4]),
+            exif_image_size_px: Some([2272, 1704]),
+            ..ExifInfo::default()
+        };
+        let est = initial_focal_px(&exif, [480, 360]).unwrap();
+        let expected = 21.3 * 8000.0 / 25.4 * 480.0 / 2272.0;
+        assert!((est.focal_px - expected).abs() < 1e-9);
+    }
+
+    #[test]
+    fn nothing_known_gives_none() {
+        assert!(initial_focal_px(&ExifInfo::default(), [100, 100]).is_none());
+    }
+
+    #[test]
+    fn rfc3339_needs_an_offset() {
+        let mut exif = ExifInfo {
+            date_time_original: Some("2008:05:30 15:56:01".into()),
+            ..ExifInfo::default()
+        };
+        assert_eq!(exif.taken_at_rfc3339(), None);
+        exif.offset_time_original = Some("+02:00".into());
+        assert_eq!(
+            exif.taken_at_rfc3339().as_deref(),
+            Some("2008-05-30T15:56:01+02:00")
+        );
+    }
+}

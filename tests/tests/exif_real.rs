@@ -1,0 +1,137 @@
+//! EXIF and orientation on real camera JPEGs none of us wrote (`../shared/data/real/exif/`,
+//! expected values read with exiftool, see SOURCES.md there).
+
+use photomontage::photo::{self, FocalSource};
+use photomontage_tests::shared_file;
+
+/// DMS values in SOURCES.md are given to 0.01″ ≈ 3e-6°.
+const GPS_TOLERANCE_DEG: f64 = 1e-5;
+
+#[test]
+fn nikon_d70_focal_lengths() {
+    let Some(path) = shared_file("data/real/exif/Nikon_D70.jpg") else {
+        return;
+    };
+    let exif = photo::read_exif(&path).unwrap();
+    assert_eq!(exif.focal_length_mm, Some(100.0));
+    assert_eq!(exif.focal_length_35mm, Some(150.0));
+}
+
+#[test]
+fn southern_hemisphere_gps_is_negative() {
+    let Some(path) = shared_file("data/real/exif/Kodak_CX7530.jpg") else {
+        return;
+    };
+    let gps = photo::read_exif(&path).unwrap().gps.unwrap();
+    let lat = -(22.0 / 60.0 + 16.68 / 3600.0);
+    let lon = 36.0 + 3.0 / 60.0 + 23.10 / 3600.0;
+    assert!(
+        (gps.latitude_deg - lat).abs() < GPS_TOLERANCE_DEG,
+        "{gps:?}"
+    );
+    assert!(
+        (gps.longitude_deg - lon).abs() < GPS_TOLERANCE_DEG,
+        "{gps:?}"
+    );
+}
+
+#[test]
+fn coolpix_gps_north_east() {
+    let Some(path) = shared_file("data/real/exif/DSCN0010.jpg") else {
+        return;
+    };
+    let exif = photo::read_exif(&path).unwrap();
+    let gps = exif.gps.unwrap();
+    assert!((gps.latitude_deg - (43.0 + 28.0 / 60.0 + 2.81 / 3600.0)).abs() < GPS_TOLERANCE_DEG);
+    assert!((gps.longitude_deg - (11.0 + 53.0 / 60.0 + 6.46 / 3600.0)).abs() < GPS_TOLERANCE_DEG);
+    assert_eq!(exif.focal_length_35mm, Some(112.0));
+}
+
+#[test]
+fn orientation_6_swaps_width_and_height() {
+    let Some(path) = shared_file("data/real/exif/canon_hdr_NO.jpg") else {
+        return;
+    };
+    assert_eq!(photo::read_exif(&path).unwrap().orientation, 6);
+    // Stored 2048 × 1536, displayed rotated 90° clockwise.
+    assert_eq!(photo::size_px(&path).unwrap(), [1536, 2048]);
+    let img = photo::load(&path).unwrap();
+    assert_eq!(img.size_px(), [1536, 2048]);
+}
+
+#[test]
+fn orientation_test_images() {
+    // portrait_6 is stored 600 × 450 and displays as 450 × 600; landscape_6 the reverse.
+    let Some(p) = shared_file("data/real/exif/portrait_6.jpg") else {
+        return;
+    };
+    assert_eq!(photo::size_px(&p).unwrap(), [450, 600]);
+    let Some(l) = shared_file("data/real/exif/landscape_6.jpg") else {
+        return;
+    };
+    assert_eq!(photo::size_px(&l).unwrap(), [600, 450]);
+}
+
+#[test]
+fn focal_plane_resolution_in_centimetres() {
+    // Fujifilm E500: FocalPlaneResolutionUnit = cm, 4000 px/cm = 400 px/mm.
+    let Some(path) = shared_file("data/real/exif/Fujifilm_FinePix_E500.jpg") else {
+        return;
+    };
+    let exif = photo::read_exif(&path).unwrap();
+    let res = exif.focal_plane_px_per_mm.unwrap();
+    assert!((res[0] - 400.0).abs() < 1e-9, "{res:?}");
+}
+
+#[test]
+fn downscaled_copy_rescales_the_focal_plane_resolution() {
+    // PowerShot S40: EXIF says 2272 × 1704 at 8114.29 px/inch, the file is 480 × 360.
+    let Some(path) = shared_file("data/real/exif/Canon_PowerShot_S40.jpg") else {
+        return;
+    };
+    let exif = photo::read_exif(&path).unwrap();
+    let size = photo::size_px(&path).unwrap();
+    assert_eq!(size, [480, 360]);
+    let est = photo::initial_focal_px(&exif, size).unwrap();
+    assert_eq!(est.source, FocalSource::FocalPlaneResolution);
+    let expected = 21.3 * 8114.29 / 25.4 * 480.0 / 2272.0;
+    // SOURCES.md rounds the focal length (21.3125 mm in the file) to 21.3: 6e-4 relative.
+    assert!(
+        (est.focal_px - expected).abs() / expected < 1e-3,
+        "{est:?} vs {expected}"
+    );
+}
+
+#[test]
+fn copr_canon_450d_focal_in_pixels() {
+    // Canon EOS 450D, 30 mm on a 22.2 mm wide sensor, 4272 px wide: 5773 px (±1 % for the
+    // rounding of the sensor width in the spec sheet).
+    let Some(path) = shared_file("data/real/gcp/odm_data_copr/IMG_0031.jpg") else {
+        return;
+    };
+    let exif = photo::read_exif(&path).unwrap();
+    let size = photo::size_px(&path).unwrap();
+    let est = photo::initial_focal_px(&exif, size).unwrap();
+    let expected = 30.0 * 4272.0 / 22.2;
+    assert!((est.focal_px - expected).abs() / expected < 0.01, "{est:?}");
+}
+
+#[test]
+fn files_without_exif_give_an_error_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("plain.png");
+    image_free_png(&path);
+    assert!(photo::read_exif(&path).is_err());
+}
+
+/// A valid 1×1 PNG with no EXIF chunk, written without the image crate.
+fn image_free_png(path: &std::path::Path) {
+    const PNG_1X1: &[u8] = &[
+        0x89, 0x50, 0x4E, 0x47, 0x0D, 0x0A, 0x1A, 0x0A, 0x00, 0x00, 0x00, 0x0D, 0x49, 0x48, 0x44,
+        0x52, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x08, 0x06, 0x00, 0x00, 0x00, 0x1F,
+        0x15, 0xC4, 0x89, 0x00, 0x00, 0x00, 0x0D, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9C, 0x63, 0x00,
+        0x01, 0x00, 0x00, 0x05, 0x00, 0x01, 0x0D, 0x0A, 0x2D, 0xB4, 0x00, 0x00, 0x00, 0x00, 0x49,
+        0x45, 0x4E, 0x44, 0xAE, 0x42, 0x60, 0x82,
+    ];
+    std::fs::write(path, PNG_1X1).unwrap();
+}
