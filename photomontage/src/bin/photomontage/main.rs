@@ -1,22 +1,30 @@
 //! The `photomontage` command-line tool.
 
+mod info;
+
 use clap::{Parser, Subcommand};
 
 /// Photogrammetric photomontage: solve site cameras, model daylight, render planned buildings.
 ///
 /// Pixel convention everywhere: (0,0) is the centre of the top-left pixel of the photo as
-/// displayed (EXIF orientation applied); x runs right, y runs down.
+/// displayed (EXIF orientation applied); x runs right, y runs down. World coordinates are
+/// right-handed with Z up, in metres.
 #[derive(Parser)]
-#[command(name = "photomontage", version, about)]
+#[command(name = "photomontage", version, about, long_about)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Show what a site holds: photos (size, solved or not), points, polygons, models.
+    Info(info::Args),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Info(args) => info::run(&args),
+    }
 }
