@@ -10,4 +10,5 @@
 
 pub mod camera;
 pub mod photo;
+pub mod photogrammetry;
 pub mod site;
