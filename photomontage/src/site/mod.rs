@@ -15,9 +15,11 @@
 
 mod locate;
 mod schema;
+pub mod solve;
 mod validate;
 
 pub use schema::*;
+pub use solve::{SiteSolution, apply_solution, solve_site, stored_camera};
 pub use validate::SiteIssue;
 
 use std::io::Write;
@@ -101,6 +103,45 @@ impl SiteDocument {
     #[must_use]
     pub fn resolve(&self, relative: &str) -> PathBuf {
         self.base_dir().join(relative)
+    }
+
+    /// Saves atomically to `path` and makes it the document's path. When the new file is in
+    /// another folder, relative photo, model and material-library paths are rewritten as absolute
+    /// paths so they still point at the same files.
+    ///
+    /// # Errors
+    /// [`SiteError::Write`] or [`SiteError::Serialise`]; nothing changes in memory then.
+    pub fn save_as(&mut self, path: &Path) -> Result<(), SiteError> {
+        let new_dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let same_dir = match (
+            std::fs::canonicalize(self.base_dir()),
+            std::fs::canonicalize(new_dir),
+        ) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        let mut site = self.site.clone();
+        if !same_dir {
+            let rebase = |p: &mut String| {
+                if Path::new(p.as_str()).is_relative() {
+                    let joined = self.resolve(p);
+                    let abs = std::fs::canonicalize(&joined).unwrap_or(joined);
+                    *p = abs.to_string_lossy().into_owned();
+                }
+            };
+            site.photos.iter_mut().for_each(|ph| rebase(&mut ph.file));
+            site.models.iter_mut().for_each(|m| rebase(&mut m.file));
+            if let Some(lib) = site.lighting.material_library.as_mut() {
+                rebase(lib);
+            }
+        }
+        site.save(path)?;
+        self.site = site;
+        self.path = path.to_path_buf();
+        Ok(())
     }
 
     /// Saves atomically to the document's own path.

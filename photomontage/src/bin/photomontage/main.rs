@@ -1,6 +1,9 @@
 //! The `photomontage` command-line tool.
 
 mod info;
+mod report;
+mod resect;
+mod solve;
 
 use clap::{Parser, Subcommand};
 
@@ -20,11 +23,18 @@ struct Cli {
 enum Command {
     /// Show what a site holds: photos (size, solved or not), points, polygons, models.
     Info(info::Args),
+    /// Solve every photo of a site (resection, then bundle adjustment), print the residuals
+    /// and write the cameras back into the site atomically.
+    Solve(solve::Args),
+    /// Solve one photo from a control-point file (CSV or OpenDroneMap gcp_list.txt).
+    Resect(resect::Args),
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Info(args) => info::run(&args),
+        Command::Solve(args) => solve::run(&args),
+        Command::Resect(args) => resect::run(&args),
     }
 }

@@ -1,0 +1,125 @@
+//! `photomontage solve SITE`: solve every photo of a site and write the result back.
+
+use crate::report::{PhotoRecord, print_photo, rotation_rows};
+use anyhow::Context;
+use photomontage::site::{SiteDocument, apply_solution, solve_site};
+use serde::Serialize;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The site file (TOML).
+    site: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Write the solved site here instead of over SITE (relative paths are rebased).
+    #[arg(long, value_name = "PATH")]
+    out: Option<PathBuf>,
+    /// Solve and report without writing anything.
+    #[arg(long, conflicts_with = "out")]
+    no_write: bool,
+}
+
+#[derive(Serialize)]
+struct Output<'a> {
+    photos: Vec<PhotoRecord<'a>>,
+    failures: &'a [photomontage::site::solve::PhotoFailure],
+    tie_points: Vec<&'a photomontage::site::solve::PointSolution>,
+    bundle_rms_px: Option<f64>,
+    warnings: &'a [String],
+    written_to: Option<String>,
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let mut doc = SiteDocument::load(&args.site)?;
+    let solution = solve_site(&doc);
+    apply_solution(&mut doc.site, &solution);
+    let written_to = if args.no_write {
+        None
+    } else {
+        let target = args.out.clone().unwrap_or_else(|| args.site.clone());
+        doc.save_as(&target)
+            .with_context(|| format!("saving the solved site to {}", target.display()))?;
+        Some(target.display().to_string())
+    };
+    let records: Vec<PhotoRecord<'_>> = solution
+        .photos
+        .iter()
+        .map(|s| {
+            let intr = s.camera.intrinsics;
+            PhotoRecord {
+                id: &s.id,
+                camera_center: s.camera.pose.camera_center_in_world.coords.into(),
+                rotation_world_from_camera: rotation_rows(&s.camera),
+                focal_px: intr.focal_px,
+                principal_point_px: intr.principal_point_px,
+                distortion: intr.distortion,
+                image_size_px: intr.image_size_px,
+                rms_px: s.rms_px,
+                redundancy: s.redundancy,
+                sigma_center_m: s.sigma_center_m,
+                sigma_angles_deg: s.sigma_angles_deg,
+                sigma_focal_px: s.sigma_focal_px,
+                outliers: &s.outliers,
+                warnings: &s.warnings,
+                residuals: &s.residuals,
+                solved_by: s.solved_by,
+            }
+        })
+        .collect();
+    let ties: Vec<_> = solution.points.iter().filter(|p| !p.is_control).collect();
+    if args.json {
+        let out = Output {
+            photos: records,
+            failures: &solution.failures,
+            tie_points: ties,
+            bundle_rms_px: solution.bundle_rms_px,
+            warnings: &solution.warnings,
+            written_to,
+        };
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        for r in &records {
+            print_photo(r);
+            println!();
+        }
+        if !ties.is_empty() {
+            println!("tie points:");
+            for t in &ties {
+                println!(
+                    "  {:<12} X {:.4}  Y {:.4}  Z {:.4}   σ {:.4} {:.4} {:.4} m  ({} rays, RMS {:.2} px)",
+                    t.id,
+                    t.point_in_world.x,
+                    t.point_in_world.y,
+                    t.point_in_world.z,
+                    t.sigma_m[0],
+                    t.sigma_m[1],
+                    t.sigma_m[2],
+                    t.rays,
+                    t.rms_px
+                );
+            }
+        }
+        if let Some(rms) = solution.bundle_rms_px {
+            println!("bundle adjustment RMS {rms:.3} px");
+        }
+        for w in &solution.warnings {
+            println!("warning: {w}");
+        }
+        for f in &solution.failures {
+            println!("NOT SOLVED {}: {}", f.id, f.error);
+        }
+        if let Some(path) = &written_to {
+            println!("written to {path}");
+        }
+    }
+    if !solution.failures.is_empty() {
+        anyhow::bail!(
+            "{} of {} photos could not be solved",
+            solution.failures.len(),
+            doc.site.photos.len()
+        );
+    }
+    Ok(())
+}
