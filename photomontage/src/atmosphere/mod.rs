@@ -1,0 +1,6 @@
+//! Atmosphere between the camera and what it sees: Schachter's homogeneous model as used by
+//! Durisch 1992 (§3.2 eq. 2, inversions §4.2 eq. 7–8). See [`schachter`].
+
+pub mod schachter;
+
+pub use schachter::{AtmosphereError, Eq7Fit, SchachterAtmosphere};
