@@ -195,8 +195,12 @@ mod tests {
         // Interpolation halfway between two knots.
         let mid = cmf(555.5);
         assert!((mid[1] - 0.5 * (1.0 + 0.9998567)).abs() < 1e-12);
-        assert_eq!(cmf(359.0), [0.0; 3]);
-        assert_eq!(cmf(831.0), [0.0; 3]);
+        assert!(
+            cmf(359.0)
+                .iter()
+                .chain(&cmf(831.0))
+                .all(|v| v.abs() < 1e-300)
+        );
         // D65 at a 1 nm point between knots: the CIE 1 nm table gives 117.49 at 456 nm.
         assert!((d65_relative(456.0) - 117.49).abs() < 1e-3);
     }
@@ -246,7 +250,11 @@ mod tests {
         for c in 0..3 {
             assert!((l[c] + r[c] - whole[c]).abs() < 1e-12);
         }
-        assert_eq!(cmf_band_integral(600.0, 500.0), [0.0; 3]);
+        assert!(
+            cmf_band_integral(600.0, 500.0)
+                .iter()
+                .all(|v| v.abs() < 1e-300)
+        );
     }
 
     #[test]

@@ -99,7 +99,10 @@ fn basis_spectra_have_the_primaries_chromaticity() {
         assert!((got[0] - xy[0]).abs() < ROUNDOFF_TOL && (got[1] - xy[1]).abs() < ROUNDOFF_TOL);
         // Three steps, each non-negative, piecewise constant: at most 2 transitions.
         let b = up.basis(i);
-        let transitions = b.windows(2).filter(|w| w[0] != w[1]).count();
+        let transitions = b
+            .windows(2)
+            .filter(|w| w[0].to_bits() != w[1].to_bits())
+            .count();
         assert!(transitions <= 2 && b.iter().all(|&v| v >= 0.0));
     }
     // A red basis puts its largest step at the long-wave end, a blue one at the short-wave end.
