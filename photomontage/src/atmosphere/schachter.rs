@@ -207,6 +207,37 @@ impl SchachterAtmosphere {
         }
     }
 
+    /// Durisch §4.2 first inversion for every channel: fits τₐ per channel (and the common
+    /// true colour of the samples) to `samples` of one material, each `(distance_m, apparent
+    /// colour)`, given the horizon colour. Returns the atmosphere and the fitted true colour.
+    ///
+    /// # Errors
+    /// As [`fit_transmittance`] for any channel, or an invalid result (τₐ underflowing to 0).
+    pub fn fit(
+        horizon: Colour,
+        samples: &[(f64, Colour)],
+        reference_distance_m: f64,
+        channels: usize,
+    ) -> Result<(Self, Colour), AtmosphereError> {
+        let channels = channels.min(MAX_CHANNELS);
+        let mut transmittance = Colour::BLACK;
+        let mut true_colour = Colour::BLACK;
+        let mut channel_samples = Vec::with_capacity(samples.len());
+        for k in 0..channels {
+            channel_samples.clear();
+            channel_samples.extend(samples.iter().map(|(d, c)| (*d, f64::from(c.channels[k]))));
+            let fit = fit_transmittance(
+                f64::from(horizon.channels[k]),
+                &channel_samples,
+                reference_distance_m,
+            )?;
+            transmittance.channels[k] = fit.transmittance as f32;
+            true_colour.channels[k] = fit.true_radiance as f32;
+        }
+        let atmosphere = Self::new(transmittance, horizon, reference_distance_m, channels)?;
+        Ok((atmosphere, true_colour))
+    }
+
     /// Per-channel transmittance τₐ over the reference distance.
     #[must_use]
     pub fn transmittance(&self) -> Colour {

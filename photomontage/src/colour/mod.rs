@@ -11,6 +11,20 @@
 //! `from_linear_rgb` (photo pixels and material colours → channels, Appendix A in spectral mode)
 //! and `to_linear_rgb` (channels → display RGB, via XYZ in spectral mode).
 //!
+//! ```
+//! use photomontage::colour::{ColourMode, ColourSystem, RgbColourSpace, SampleSet, ToneMap};
+//! use photomontage::colour::{encode_srgb8, rgb::srgb_decode};
+//!
+//! let system = ColourSystem::new(ColourMode::Spectral(SampleSet::Durisch9), RgbColourSpace::srgb())?;
+//! // A photo pixel (8-bit sRGB) → linear → 9 non-negative spectral samples.
+//! let linear = [200u8, 120, 40].map(|v| srgb_decode(f64::from(v) / 255.0) as f32);
+//! let reflectance = system.from_linear_rgb(linear);
+//! let lit = reflectance * 0.5; // half the light
+//! let out = encode_srgb8(system.to_linear_rgb(&lit), &ToneMap::clamp());
+//! assert!(out[0] > out[1] && out[1] > out[2]);
+//! # Ok::<(), photomontage::colour::SpectrumError>(())
+//! ```
+//!
 //! # Known limitations
 //! Channels are `f32` (about 7 significant digits), enough for radiance but not for accumulating
 //! very many small contributions without care. Spectral mode uses at most 9 samples; finer

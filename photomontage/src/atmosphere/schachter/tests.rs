@@ -10,6 +10,9 @@ use rand_chacha::ChaCha8Rng;
 const ROUND_TRIP_TOL: f64 = 1e-10;
 /// The `Colour` path stores f32 (7 digits), amplified by 1/τ^(d/dₐ) ≤ ~20 in these cases.
 const COLOUR_ROUND_TRIP_TOL: f32 = 1e-5;
+/// Eq. 7 fit from samples stored as f32 colours: their 7-digit rounding (≈6e-8 relative) is
+/// amplified by the fit's conditioning (distances 0.15–4 dₐ) to ≲1e-6; 1e-5 leaves margin.
+const COLOUR_FIT_TOL: f32 = 1e-5;
 /// Noise-free synthetic data: Gauss–Newton converges quadratically to round-off.
 const FIT_TOL: f64 = 1e-9;
 
@@ -128,6 +131,26 @@ fn eq7_fit_recovers_seeded_ground_truth() {
             "{fit:?} vs L0 {l0}"
         );
         assert!(fit.rms_residual < FIT_TOL);
+    }
+}
+
+#[test]
+fn colour_fit_recovers_per_channel_haze() {
+    // Bluish haze: short wavelengths are scattered more, so τ is lowest in blue.
+    let tau = Colour::from_slice(&[0.85, 0.80, 0.70]);
+    let horizon = Colour::from_slice(&[0.70, 0.75, 0.90]);
+    let truth = SchachterAtmosphere::new(tau, horizon, 1000.0, 3).unwrap();
+    let wall = Colour::from_slice(&[0.35, 0.30, 0.20]);
+    let samples: Vec<(f64, Colour)> = [150.0, 600.0, 1400.0, 2500.0, 4000.0]
+        .iter()
+        .map(|&d| (d, truth.apparent(&wall, d)))
+        .collect();
+    let (fitted, l0) = SchachterAtmosphere::fit(horizon, &samples, 1000.0, 3).unwrap();
+    for k in 0..3 {
+        assert!(
+            (fitted.transmittance().channels[k] - tau.channels[k]).abs() < COLOUR_ROUND_TRIP_TOL
+        );
+        assert!((l0.channels[k] - wall.channels[k]).abs() < COLOUR_ROUND_TRIP_TOL);
     }
 }
 
