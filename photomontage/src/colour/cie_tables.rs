@@ -11,6 +11,10 @@
 //!
 //! The tables are checked in `cie1931`'s tests against independent published results (the D65
 //! white point, the luminous efficacy of measured daylight) and for typing slips (smoothness).
+//!
+//! # Known limitations
+//! Only these two tables: no CIE 1964 10° observer, no other illuminants (A, C, F-series). The
+//! 1931 table's z̄ is zero from 650 nm, as published.
 
 /// First wavelength of [`CIE1931_2DEG_1NM`], nanometres.
 pub const CMF_FIRST_NM: f64 = 360.0;

@@ -267,8 +267,7 @@ impl ColourSystem {
                 .space
                 .to_xyz([0, 1, 2].map(|i| f64::from(colour.channels[i]))),
             Some(up) => {
-                let n = up.sampling().len();
-                let s: Vec<f64> = colour.channels[..n].iter().map(|&v| f64::from(v)).collect();
+                let s = colour.channels.map(f64::from);
                 up.sampling().xyz(&s)
             }
         }

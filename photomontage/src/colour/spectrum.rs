@@ -25,10 +25,12 @@
 //! When a primary needs the fallback its basis spectrum has a different chromaticity, so
 //! `W⁻¹` has negative entries and some in-gamut colours would need negative weights; those are
 //! clamped to zero (spectra stay non-negative) and the round trip is then inexact near that
-//! primary. This happens for sRGB green with Meyer's 4 samples (sRGB green lies outside the cone
-//! of eq. 9.24's columns, so no non-negative 4-sample spectrum reproduces it) and can happen for
-//! NTSC green with coarse samplings. RGB components below zero (outside the gamut) are clamped
-//! too. The spectra are piecewise constant (6 transitions), not smooth.
+//! primary. This happens for NTSC red (0.67, 0.33), which lies just outside the 1931 spectrum
+//! locus (z = 0 needs λ ≥ 650 nm, where x ≥ 0.726): round-trip error 2e-4 at 1 nm, 2.5e-3 on
+//! Durisch's 9 bands; and for sRGB green with Meyer's 4 samples (it lies outside the cone of
+//! eq. 9.24's columns, so no non-negative 4-sample spectrum reproduces it). sRGB needs no
+//! fallback on the 1 nm or 9-band samplings. RGB components below zero (outside the gamut) are
+//! clamped too. The spectra are piecewise constant (6 transitions), not smooth.
 
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
