@@ -38,6 +38,8 @@ pub mod tonemap;
 
 use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Sub};
 
+use serde::{Deserialize, Serialize};
+
 pub use rgb::{Primaries, RgbColourSpace, RgbError};
 pub use spectrum::{RgbToSpectrum, SampleSet, SpectralSampling, SpectrumError};
 pub use tonemap::{ToneCurve, ToneMap, encode_srgb8};
@@ -46,7 +48,7 @@ pub use tonemap::{ToneCurve, ToneMap, encode_srgb8};
 pub const MAX_CHANNELS: usize = 9;
 
 /// How the renderer represents colour.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum ColourMode {
     /// Three linear RGB channels.
     Rgb,
@@ -67,7 +69,7 @@ impl ColourMode {
 
 /// A radiance (or reflectance, transmittance) value: up to [`MAX_CHANNELS`] floating-point
 /// channels; channels beyond the mode's count are zero. Arithmetic is channel-wise.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Colour {
     /// The channels (RGB: r, g, b; spectral: the samples in wavelength order).
     pub channels: [f32; MAX_CHANNELS],
@@ -298,6 +300,17 @@ mod tests {
             Colour::splat(1.0, ColourMode::Spectral(SampleSet::Meyer4)).channels[..5],
             [1.0, 1.0, 1.0, 1.0, 0.0]
         );
+    }
+
+    #[test]
+    fn settings_serialise() {
+        let mode = ColourMode::Spectral(SampleSet::Durisch9);
+        let json = serde_json::to_string(&mode).unwrap();
+        assert_eq!(json, r#"{"Spectral":"Durisch9"}"#);
+        assert_eq!(serde_json::from_str::<ColourMode>(&json).unwrap(), mode);
+        let tm = ToneMap::aces(-1.5);
+        let back: ToneMap = serde_json::from_str(&serde_json::to_string(&tm).unwrap()).unwrap();
+        assert_eq!(back, tm);
     }
 
     #[test]

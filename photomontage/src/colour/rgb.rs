@@ -38,7 +38,7 @@ pub enum RgbError {
 }
 
 /// Chromaticities `(x, y)` of three primaries and a white point.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Primaries {
     /// Red primary.
     pub red_xy: [f64; 2],

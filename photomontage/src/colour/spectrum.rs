@@ -33,6 +33,7 @@
 //! clamped too. The spectra are piecewise constant (6 transitions), not smooth.
 
 use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::cie_tables::CIE1931_2DEG_1NM;
@@ -107,7 +108,7 @@ pub enum SpectrumError {
 }
 
 /// Spectral sample sets for the renderer's spectral mode.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum SampleSet {
     /// Nine equal bands over 380–780 nm (Durisch 1992 §7).
     Durisch9,

@@ -16,7 +16,7 @@
 //! dithering before quantisation.
 
 /// Tone curve applied after exposure.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum ToneCurve {
     /// Identity, then clip to [0, 1]: colorimetrically exact inside [0, 1].
     #[default]
@@ -40,7 +40,7 @@ impl ToneCurve {
 }
 
 /// Exposure and tone curve of the display encoding.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct ToneMap {
     /// Exposure change in stops: linear values are multiplied by `2^exposure_stops`.
     pub exposure_stops: f64,
