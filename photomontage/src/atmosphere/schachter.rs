@@ -148,6 +148,9 @@ pub struct SchachterAtmosphere {
     horizon: Colour,
     reference_distance_m: f64,
     channels: usize,
+    /// `−ln τₐ / dₐ` per channel (extinction coefficient σ, 1/m): `τₐ^(d/dₐ) = e^(−σ d)`,
+    /// one `exp` per channel instead of a `powf`.
+    extinction_per_m: [f64; MAX_CHANNELS],
 }
 
 impl SchachterAtmosphere {
@@ -183,11 +186,20 @@ impl SchachterAtmosphere {
                 });
             }
         }
+        let mut extinction_per_m = [0.0; MAX_CHANNELS];
+        for (e, &t) in extinction_per_m
+            .iter_mut()
+            .zip(&transmittance.channels)
+            .take(channels)
+        {
+            *e = -f64::from(t).ln() / reference_distance_m;
+        }
         Ok(Self {
             transmittance,
             horizon,
             reference_distance_m,
             channels,
+            extinction_per_m,
         })
     }
 
@@ -204,6 +216,7 @@ impl SchachterAtmosphere {
             horizon: Colour::BLACK,
             reference_distance_m: 1.0,
             channels,
+            extinction_per_m: [0.0; MAX_CHANNELS],
         }
     }
 
@@ -261,26 +274,32 @@ impl SchachterAtmosphere {
     pub fn transmission(&self, distance_m: f64) -> Colour {
         let mut out = Colour::BLACK;
         for k in 0..self.channels {
-            out.channels[k] = transmission(
-                f64::from(self.transmittance.channels[k]),
-                distance_m.max(0.0),
-                self.reference_distance_m,
-            ) as f32;
+            out.channels[k] = self.transmission_f64(k, distance_m) as f32;
         }
         out
+    }
+
+    /// `τₐ^(d/dₐ)` of channel `k` in f64 (negative distances count as 0).
+    fn transmission_f64(&self, k: usize, distance_m: f64) -> f64 {
+        let sigma = self.extinction_per_m[k];
+        // σ = 0 (clear air) must give 1 even at infinite distance, not e^(−0·∞) = NaN.
+        if sigma == 0.0 {
+            1.0
+        } else {
+            (-sigma * distance_m.max(0.0)).exp()
+        }
     }
 
     /// Eq. 2: the colour seen at `distance_m` (negative distances count as 0, infinity gives the
     /// horizon colour).
     #[must_use]
     pub fn apparent(&self, true_colour: &Colour, distance_m: f64) -> Colour {
-        let t = self.transmission(distance_m);
         let mut out = Colour::BLACK;
         for k in 0..self.channels {
             let (l0, linf, tk) = (
                 f64::from(true_colour.channels[k]),
                 f64::from(self.horizon.channels[k]),
-                f64::from(t.channels[k]),
+                self.transmission_f64(k, distance_m),
             );
             out.channels[k] = (l0 * tk + linf * (1.0 - tk)) as f32;
         }
@@ -306,8 +325,7 @@ impl SchachterAtmosphere {
         }
         let mut out = Colour::BLACK;
         for k in 0..self.channels {
-            let tau = f64::from(self.transmittance.channels[k]);
-            let t = transmission(tau, distance_m, self.reference_distance_m);
+            let t = self.transmission_f64(k, distance_m);
             if t < MIN_INVERTIBLE_TRANSMISSION {
                 return Err(AtmosphereError::TooHazyToInvert {
                     channel: k,

@@ -76,7 +76,11 @@ impl ToneMap {
     /// One linear channel → display value in [0, 1] (steps 1–3 and the sRGB encoding).
     #[must_use]
     pub fn display_value(&self, linear: f64) -> f64 {
-        let exposed = linear * self.exposure_stops.exp2();
+        self.display_value_scaled(linear * self.exposure_stops.exp2())
+    }
+
+    /// Steps 2–4 for a value already multiplied by the exposure scale.
+    fn display_value_scaled(&self, exposed: f64) -> f64 {
         let toned = self.curve.apply(exposed.max(0.0));
         let clipped = if toned.is_nan() {
             0.0
@@ -91,8 +95,9 @@ impl ToneMap {
 /// channels become 0.
 #[must_use]
 pub fn encode_srgb8(linear_rgb: [f32; 3], tone_map: &ToneMap) -> [u8; 3] {
+    let scale = tone_map.exposure_stops.exp2();
     linear_rgb.map(|v| {
-        let d = tone_map.display_value(f64::from(v));
+        let d = tone_map.display_value_scaled(f64::from(v) * scale);
         // d is in [0, 1], so the product is in [0, 255] and the cast cannot truncate.
         (255.0 * d).round() as u8
     })
