@@ -8,12 +8,16 @@
 //!    the ACES reference rendering transform, `x(2.51x + 0.03)/(x(2.43x + 0.59) + 0.14)`.
 //! 3. **Clip** to [0, 1] (NaN and negatives → 0).
 //! 4. **Encode** with the sRGB transfer function (IEC 61966-2-1) and **quantise**
-//!    `round(255 · V)`.
+//!    `round(255 · V)`. [`encode_srgb8`] does steps 4 exactly but without a `powf`: the code is
+//!    the number of the 255 linear thresholds `decode((k + ½)/255)` at or below the value
+//!    (a binary search in a table built once).
 //!
 //! # Known limitations
 //! The curves act per channel, so very bright saturated colours desaturate towards white (no
 //! hue-preserving mapping) and out-of-gamut colours are clipped rather than gamut-mapped. No
 //! dithering before quantisation.
+
+use std::sync::OnceLock;
 
 /// Tone curve applied after exposure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -91,21 +95,46 @@ impl ToneMap {
     }
 }
 
+/// Linear values at which the 8-bit sRGB code steps from k to k + 1: `decode((k + ½)/255)`.
+fn srgb8_thresholds() -> &'static [f64; 255] {
+    static THRESHOLDS: OnceLock<[f64; 255]> = OnceLock::new();
+    THRESHOLDS
+        .get_or_init(|| std::array::from_fn(|k| super::rgb::srgb_decode((k as f64 + 0.5) / 255.0)))
+}
+
 /// Linear sRGB (HDR, any magnitude) → 8-bit sRGB through `tone_map`. NaN and negative
 /// channels become 0.
 #[must_use]
 pub fn encode_srgb8(linear_rgb: [f32; 3], tone_map: &ToneMap) -> [u8; 3] {
     let scale = tone_map.exposure_stops.exp2();
+    let thresholds = srgb8_thresholds();
     linear_rgb.map(|v| {
-        let d = tone_map.display_value_scaled(f64::from(v) * scale);
-        // d is in [0, 1], so the product is in [0, 255] and the cast cannot truncate.
-        (255.0 * d).round() as u8
+        let toned = tone_map.curve.apply((f64::from(v) * scale).max(0.0));
+        // NaN compares false everywhere and gives 0; at most 255 thresholds, so the count fits.
+        thresholds.partition_point(|&t| t <= toned) as u8
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn threshold_search_equals_direct_rounding() {
+        // The table lookup must give round(255 · encode(tone(x))) for every value; exact ties,
+        // where the two could differ by floating-point rounding, do not occur on this grid.
+        for tm in [
+            ToneMap::clamp(),
+            ToneMap::reinhard(1.0),
+            ToneMap::aces(-0.5),
+        ] {
+            for k in 0..=200_000_u32 {
+                let x = k as f32 / 150_000.0;
+                let direct = (255.0 * tm.display_value(f64::from(x))).round() as u8;
+                assert_eq!(encode_srgb8([x; 3], &tm)[0], direct, "{tm:?} x = {x}");
+            }
+        }
+    }
 
     #[test]
     fn clamp_known_codes() {
