@@ -8,7 +8,9 @@
 //! Frames and units are part of every name: `world_from_camera` maps camera coordinates to world
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
+pub mod atmosphere;
 pub mod camera;
+pub mod colour;
 pub mod photo;
 pub mod photogrammetry;
 pub mod site;
