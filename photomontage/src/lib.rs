@@ -8,4 +8,6 @@
 //! Frames and units are part of every name: `world_from_camera` maps camera coordinates to world
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
+pub mod bvh;
 pub mod camera;
+pub mod scene;
