@@ -38,6 +38,9 @@ struct Args {
     /// Scenes, comma-separated.
     #[arg(long, default_value = "city_10k,terrain_1m", value_delimiter = ',')]
     scenes: Vec<String>,
+    /// BVH build quality: fast, medium or high.
+    #[arg(long, default_value = "medium")]
+    quality: String,
     /// Folder with embree_threads{N}.json (default: BENCH_DIR/peers/results).
     #[arg(long)]
     peer_results: Option<PathBuf>,
@@ -84,6 +87,18 @@ fn read_hits(path: &Path) -> Result<Vec<(f32, u32)>> {
             )
         })
         .collect())
+}
+
+/// CPU seconds used by this process so far (all threads; user + system), from `/proc/self/stat`
+/// at the kernel's 100 Hz tick. `None` where that file does not exist.
+fn process_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -133,6 +148,12 @@ fn main() -> Result<()> {
         );
         return Ok(());
     };
+    let quality = match args.quality.as_str() {
+        "fast" => BuildQuality::Fast,
+        "medium" => BuildQuality::Medium,
+        "high" => BuildQuality::High,
+        other => bail!("unknown --quality {other} (fast, medium, high)"),
+    };
     let manifest_path = bench.join("data/embree/manifest.json");
     if !manifest_path.exists() {
         println!(
@@ -159,7 +180,11 @@ fn main() -> Result<()> {
         .collect();
 
     println!(
-        "scene       set            query     thr   ours Mrays/s  embree Mrays/s  ratio   mismatch   ties"
+        "Mrays/s: ours by wall clock (wall) and by CPU time per thread (cpu); Embree from its \
+         results JSON; r_ = ours / Embree; mismatch and ties are fractions of rays"
+    );
+    println!(
+        "scene       set            query     thr      wall       cpu    embree  r_wall  r_cpu   mismatch     ties"
     );
     for scene_name in &args.scenes {
         let sc = &manifest["scenes"][scene_name.as_str()];
@@ -182,7 +207,7 @@ fn main() -> Result<()> {
             let mut build_s = Vec::new();
             for _ in 0..3 {
                 let t = Instant::now();
-                let tracer = pool.install(|| SceneTracer::new(&scene, BuildQuality::Medium))?;
+                let tracer = pool.install(|| SceneTracer::new(&scene, quality))?;
                 build_s.push(t.elapsed().as_secs_f64());
                 drop(tracer);
             }
@@ -192,7 +217,7 @@ fn main() -> Result<()> {
                 median(build_s)
             );
         }
-        let tracer = SceneTracer::new(&scene, BuildQuality::Medium)?;
+        let tracer = SceneTracer::new(&scene, quality)?;
         let o = tracer.local_origin_in_world_m();
         #[allow(clippy::cast_possible_truncation)]
         let offset = Vec3A::new(o.x as f32, o.y as f32, o.z as f32);
@@ -209,7 +234,9 @@ fn main() -> Result<()> {
                     .build()?;
                 for query in ["closest", "occluded"] {
                     let mut times = Vec::new();
+                    let mut cpu_times = Vec::new();
                     for rep in 0..=args.reps {
+                        let cpu0 = process_cpu_s();
                         let t = Instant::now();
                         pool.install(|| {
                             if query == "closest" {
@@ -220,10 +247,20 @@ fn main() -> Result<()> {
                         });
                         if rep > 0 {
                             times.push(t.elapsed().as_secs_f64()); // rep 0 warms caches
+                            if let (Some(a), Some(b)) = (cpu0, process_cpu_s()) {
+                                cpu_times.push(b - a);
+                            }
                         }
                     }
                     #[allow(clippy::cast_precision_loss)]
+                    let n_times = times.len();
                     let ours = rays.len() as f64 / median(times) / 1e6;
+                    // Throughput per busy thread from CPU time: what the wall clock would show on
+                    // an otherwise idle machine (other processes steal cores, not CPU seconds).
+                    #[allow(clippy::cast_precision_loss)]
+                    let ours_cpu = (cpu_times.len() == n_times).then(|| {
+                        rays.len() as f64 * *threads as f64 / median(cpu_times).max(1e-2) / 1e6
+                    });
                     let theirs = embree_mrays(peer.as_ref(), scene_name, set, query);
                     let (mismatch, ties) = match (&embree_hits, query) {
                         (Some(h), "closest") => {
@@ -240,10 +277,16 @@ fn main() -> Result<()> {
                             |n| format!("{:.2e}", n as f64 / rays.len() as f64),
                         )
                     };
+                    let ratio = |x: Option<f64>| match (x, theirs) {
+                        (Some(x), Some(e)) => format!("{:.2}", x / e),
+                        _ => "n/a".to_owned(),
+                    };
                     println!(
-                        "{scene_name:<11} {set:<14} {query:<9} {threads:>3} {ours:>14.2} {:>15} {:>6} {:>10} {:>8}",
+                        "{scene_name:<11} {set:<14} {query:<9} {threads:>3} {ours:>9.2} {:>9} {:>9} {:>6} {:>6} {:>10} {:>8}",
+                        ours_cpu.map_or_else(|| "n/a".to_owned(), |c| format!("{c:.2}")),
                         theirs.map_or_else(|| "n/a".to_owned(), |e| format!("{e:.2}")),
-                        theirs.map_or_else(|| "n/a".to_owned(), |e| format!("{:.2}", ours / e)),
+                        ratio(Some(ours)),
+                        ratio(ours_cpu),
                         frac(mismatch),
                         frac(ties),
                     );

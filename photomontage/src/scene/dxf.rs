@@ -103,7 +103,10 @@ impl Converter {
         ];
         self.check(&c)?;
         self.face_counter += 1;
-        if c[3] == c[2] {
+        // DXF writes a triangle as a 3DFACE whose fourth corner repeats the third exactly.
+        #[allow(clippy::float_cmp)]
+        let is_triangle = c[3] == c[2];
+        if is_triangle {
             self.builder
                 .push_triangle([c[0], c[1], c[2]], Some(material));
         } else {

@@ -137,6 +137,11 @@ pub enum ImportWarning {
         /// The unit used.
         unit: LengthUnit,
     },
+    /// Polygons that could not be triangulated (no area, self-intersecting) were skipped.
+    PolygonsSkipped {
+        /// How many polygons.
+        count: usize,
+    },
     /// Entities of a kind that carries no surface were ignored.
     IgnoredEntities {
         /// Entity or primitive kind.
@@ -218,6 +223,7 @@ pub(crate) struct ModelBuilder {
     pub(crate) warnings: Vec<ImportWarning>,
     default_material: Option<u32>,
     faces_without_material: usize,
+    polygons_skipped: usize,
 }
 
 impl ModelBuilder {
@@ -260,6 +266,7 @@ impl ModelBuilder {
             warnings: Vec::new(),
             default_material: None,
             faces_without_material: 0,
+            polygons_skipped: 0,
         })
     }
 
@@ -313,7 +320,8 @@ impl ModelBuilder {
     }
 
     /// Adds a planar polygon (file coordinates), triangulated by ear clipping. Degenerate
-    /// polygons (collinear, fewer than 3 distinct vertices) are skipped: they have no area.
+    /// polygons (collinear, fewer than 3 distinct vertices, self-intersecting) are skipped and
+    /// counted in an [`ImportWarning::PolygonsSkipped`].
     pub(crate) fn push_polygon(&mut self, vertices_in_file: &[[f64; 3]], material: Option<u32>) {
         if vertices_in_file.len() == 3 {
             self.push_triangle(
@@ -327,17 +335,20 @@ impl ModelBuilder {
             return;
         }
         let points: Vec<Point3<f64>> = vertices_in_file.iter().map(|v| Point3::from(*v)).collect();
-        if let Ok(tris) = super::triangulate::triangulate_polygon(&points) {
-            for [a, b, c] in tris {
-                self.push_triangle(
-                    [
-                        vertices_in_file[a],
-                        vertices_in_file[b],
-                        vertices_in_file[c],
-                    ],
-                    material,
-                );
+        match super::triangulate::triangulate_polygon(&points) {
+            Ok(tris) => {
+                for [a, b, c] in tris {
+                    self.push_triangle(
+                        [
+                            vertices_in_file[a],
+                            vertices_in_file[b],
+                            vertices_in_file[c],
+                        ],
+                        material,
+                    );
+                }
             }
+            Err(_) => self.polygons_skipped += 1,
         }
     }
 
@@ -358,6 +369,11 @@ impl ModelBuilder {
                 extent_m,
                 min_m: self.min_extent_m,
                 max_m: self.max_extent_m,
+            });
+        }
+        if self.polygons_skipped > 0 {
+            self.warnings.push(ImportWarning::PolygonsSkipped {
+                count: self.polygons_skipped,
             });
         }
         if self.faces_without_material > 0 {
@@ -474,6 +490,28 @@ mod tests {
         ));
         let b = ModelBuilder::new(&ImportOptions::default(), LengthUnit::Metre, UpAxis::Z).unwrap();
         assert_eq!(b.finish().unwrap_err(), ModelError::NoFaces);
+    }
+
+    #[test]
+    fn degenerate_polygons_are_skipped_with_a_warning() {
+        let mut b =
+            ModelBuilder::new(&ImportOptions::default(), LengthUnit::Metre, UpAxis::Z).unwrap();
+        b.push_polygon(
+            &[[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]],
+            None,
+        );
+        b.push_polygon(
+            &[[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            None,
+        );
+        let m = b.finish().unwrap();
+        assert_eq!(m.triangles_in_world_m.len(), 2);
+        assert!(
+            m.warnings
+                .contains(&ImportWarning::PolygonsSkipped { count: 1 }),
+            "{:?}",
+            m.warnings
+        );
     }
 
     #[test]

@@ -96,7 +96,6 @@ pub fn load_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, O
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..tobj::LoadOptions::default()
     };
     let (models, materials) = tobj::load_obj(path, &load_options).map_err(|e| ObjError::Load {
         path: path_str.clone(),
