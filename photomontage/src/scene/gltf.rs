@@ -115,7 +115,13 @@ impl Walker<'_> {
         let Some(positions) = reader.read_positions() else {
             return Ok(());
         };
-        let positions: Vec<[f64; 3]> = positions.map(|p| p.map(f64::from)).collect();
+        // Accessor counts are untrusted: never collect more items than the buffers can hold
+        // (a position takes at least 12 bytes, an index at least 1), whatever the count claims.
+        let buffer_bytes: usize = self.buffers.iter().map(|b| b.0.len()).sum();
+        let positions: Vec<[f64; 3]> = positions
+            .take(buffer_bytes / 12)
+            .map(|p| p.map(f64::from))
+            .collect();
         ModelBuilder::check_finite(positions.iter().copied()).map_err(|e| match e {
             ModelError::NonFiniteVertex {
                 vertex_index,
@@ -135,7 +141,7 @@ impl Walker<'_> {
             })
             .collect();
         let indices: Vec<u32> = match reader.read_indices() {
-            Some(ix) => ix.into_u32().collect(),
+            Some(ix) => ix.into_u32().take(buffer_bytes).collect(),
             None => (0..u32::try_from(positions.len()).unwrap_or(u32::MAX)).collect(),
         };
         let material = match prim.material().index() {
