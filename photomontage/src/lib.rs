@@ -9,8 +9,10 @@
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
 pub mod atmosphere;
+pub mod bvh;
 pub mod camera;
 pub mod colour;
 pub mod photo;
 pub mod photogrammetry;
+pub mod scene;
 pub mod site;
