@@ -9,3 +9,7 @@
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
 pub mod camera;
+pub mod geo;
+pub mod sky;
+pub mod sky_dome;
+pub mod sun;

@@ -2,6 +2,9 @@
 
 use clap::{Parser, Subcommand};
 
+mod sky;
+mod sun;
+
 /// Photogrammetric photomontage: solve site cameras, model daylight, render planned buildings.
 ///
 /// Pixel convention everywhere: (0,0) is the centre of the top-left pixel of the photo as
@@ -14,9 +17,17 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Solar position (NREL SPA), sunrise and sunset.
+    Sun(sun::SunArgs),
+    /// CIE standard sky: E_h/L_z and a fisheye luminance map.
+    Sky(sky::SkyArgs),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Sun(args) => sun::run(&args),
+        Command::Sky(args) => sky::run(&args),
+    }
 }
