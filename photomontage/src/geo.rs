@@ -193,7 +193,9 @@ mod tests {
         assert!((lat - 45.0).abs() < 1e-9 && (lon - 3.0).abs() < 1e-9);
         // Southern hemisphere: false northing 10 000 km.
         let south = ProjectedCrs::utm(31, Hemisphere::South).expect("valid");
-        let (lat, lon) = south.to_lat_lon_deg(500_000.0, 10_000_000.0).expect("converts");
+        let (lat, lon) = south
+            .to_lat_lon_deg(500_000.0, 10_000_000.0)
+            .expect("converts");
         assert!(lat.abs() < 1e-9 && (lon - 3.0).abs() < 1e-9);
         // Off-meridian round trip (Zurich in zone 32).
         let zone32 = ProjectedCrs::utm(32, Hemisphere::North).expect("valid");
@@ -208,7 +210,9 @@ mod tests {
         // coordinates and WGS84": E 2 700 000, N 1 100 000 ↔ 46°02′38.87″N, 8°43′49.79″E. The
         // approximate formulas are good to about 1 m (≈1e-5°).
         let lv95 = ProjectedCrs::from_proj_string(SWISS_LV95).expect("valid");
-        let (lat, lon) = lv95.to_lat_lon_deg(2_700_000.0, 1_100_000.0).expect("converts");
+        let (lat, lon) = lv95
+            .to_lat_lon_deg(2_700_000.0, 1_100_000.0)
+            .expect("converts");
         let want_lat = 46.0 + 2.0 / 60.0 + 38.87 / 3600.0;
         let want_lon = 8.0 + 43.0 / 60.0 + 49.79 / 3600.0;
         assert!((lat - want_lat).abs() < 3e-5, "{lat}");

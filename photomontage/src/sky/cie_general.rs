@@ -169,7 +169,11 @@ mod tests {
         let chi = 150.0_f64.to_radians();
         for (t, want) in CieSkyType::all().zip(expected) {
             let got = t.parameters().relative_luminance(1e-12, chi, sun_zenith);
-            assert!((got - want).abs() < 6e-5, "type {}: {got} vs {want}", t.number());
+            assert!(
+                (got - want).abs() < 6e-5,
+                "type {}: {got} vs {want}",
+                t.number()
+            );
         }
     }
 }

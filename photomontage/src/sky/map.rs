@@ -75,8 +75,9 @@ pub fn sky_map(
         });
     }
     Ok(RgbImage::from_fn(size_px, size_px, |x, y| {
-        let value = direction_at_pixel(x, y, size_px)
-            .map_or(0, |dir| tone_map(model.relative_luminance(&dir, sun_dir_in_world)));
+        let value = direction_at_pixel(x, y, size_px).map_or(0, |dir| {
+            tone_map(model.relative_luminance(&dir, sun_dir_in_world))
+        });
         Rgb([value, value, value])
     }))
 }

@@ -141,14 +141,13 @@ pub fn clearness_and_brightness(
             diffuse_horizontal_w_m2,
         });
     }
-    if !(sun_zenith >= 0.0 && sun_zenith < std::f64::consts::FRAC_PI_2) {
+    if !(0.0..std::f64::consts::FRAC_PI_2).contains(&sun_zenith) {
         return Err(SkyError::SunBelowHorizon {
             elevation_deg: 90.0 - sun_zenith.to_degrees(),
         });
     }
     let z3 = 1.041 * sun_zenith.powi(3);
-    let clearness = ((diffuse_horizontal_w_m2 + direct_normal_w_m2) / diffuse_horizontal_w_m2
-        + z3)
+    let clearness = ((diffuse_horizontal_w_m2 + direct_normal_w_m2) / diffuse_horizontal_w_m2 + z3)
         / (1.0 + z3);
     let extraterrestrial = SOLAR_CONSTANT_W_M2 * eccentricity_correction(day_of_year);
     let brightness =
@@ -218,7 +217,8 @@ impl PerezSky {
     pub fn lv(&self, cos_zenith: f64, gamma: f64) -> f64 {
         let [a, b, c, d, e] = self.coefficients;
         let cos_g = gamma.cos();
-        (1.0 + a * (b / cos_zenith.max(0.01)).exp()) * (1.0 + c * (d * gamma).exp() + e * cos_g * cos_g)
+        (1.0 + a * (b / cos_zenith.max(0.01)).exp())
+            * (1.0 + c * (d * gamma).exp() + e * cos_g * cos_g)
     }
 
     /// L/L_z: lv at the element over lv at the zenith (whose angle to the sun is Z); 0 below the
@@ -243,7 +243,12 @@ mod tests {
             1.3525, -0.2576, -0.2690, -1.4366, -0.7670, 0.0007, 1.2734, -0.1233, 2.8000, 0.6004,
             1.2375, 1.0000, 1.8734, 0.6297, 0.9738, 0.2809, 0.0356, -0.1246, -0.5718, 0.9938,
         ];
-        let flat: Vec<f64> = PEREZ_COEFFICIENTS.iter().flatten().flatten().copied().collect();
+        let flat: Vec<f64> = PEREZ_COEFFICIENTS
+            .iter()
+            .flatten()
+            .flatten()
+            .copied()
+            .collect();
         assert_eq!(flat.len(), 160);
         for (got, want) in flat.iter().zip(bin1) {
             assert!((got - want).abs() < 1e-12);

@@ -51,9 +51,9 @@ mod tests {
     /// Overcast: the integrand (1 + 2u)u/3 is quadratic in u = cos Z, so the midpoint rule's error
     /// is exactly −h²/24·∫f'' · 2π = −(π/9)/m_h², i.e. −1/(7·m_h²) relative: 3.5e-5 at m_h = 64.
     const OVERCAST_FINEST_REL_TOL: f64 = 4e-5;
-    /// Clear sky type 12: the reference is quoted to 4 decimals (1e-5 relative) and the sun's
-    /// cusp converges like the facet size; 0.1 % at m_h = 64.
-    const CLEAR_FINEST_REL_TOL: f64 = 1e-3;
+    /// Clear sky type 12: the reference is quoted to 4 decimals (1e-5 relative); measured errors
+    /// 1.4e-1, 7.9e-3, 3.0e-3, 7.9e-4, 4.9e-5 for m_h 2, 4, 8, 16, 64; 1.5e-4 bound.
+    const CLEAR_FINEST_REL_TOL: f64 = 1.5e-4;
 
     #[test]
     fn equal_solid_angles_sum_to_hemisphere() {
@@ -85,7 +85,10 @@ mod tests {
             let dome = durisch_dome(m_h).expect("valid");
             let rel = illuminance(&dome.sources(&sky), &test_support::up()) / want - 1.0;
             let expected = -1.0 / (7.0 * f64::from(m_h * m_h));
-            assert!((rel - expected).abs() < 1e-12, "m_h {m_h}: {rel} vs {expected}");
+            assert!(
+                (rel - expected).abs() < 1e-12,
+                "m_h {m_h}: {rel} vs {expected}"
+            );
         }
     }
 
@@ -109,7 +112,14 @@ mod tests {
                     (e / want - 1.0).abs()
                 })
                 .collect();
-            eprintln!("{}: relative E_h errors by level {errors:.2e?}", module_path!());
+            eprintln!(
+                "{}: relative E_h errors by level {:?}",
+                module_path!(),
+                errors
+                    .iter()
+                    .map(|e| format!("{e:.2e}"))
+                    .collect::<Vec<_>>()
+            );
             for w in errors.windows(2) {
                 assert!(w[1] < w[0], "not decreasing: {errors:?}");
             }

@@ -179,10 +179,7 @@ fn limit_zero2one(x: f64) -> f64 {
 /// Σ A·cos(B + C·JME) over one table.
 #[inline]
 fn periodic_sum<const N: usize>(table: &[[f64; 3]; N], jme: f64) -> f64 {
-    table
-        .iter()
-        .map(|[a, b, c]| a * (b + c * jme).cos())
-        .sum()
+    table.iter().map(|[a, b, c]| a * (b + c * jme).cos()).sum()
 }
 
 /// Earth heliocentric longitude L (degrees 0…360), latitude B (degrees) and radius R (AU), §3.2.
@@ -298,8 +295,11 @@ fn geocentric(jd: f64, delta_t_s: f64) -> Geocentric {
     let beta = beta_deg.to_radians();
     let (sin_l, cos_l) = lambda.sin_cos();
     let (sin_e, cos_e) = epsilon.sin_cos();
-    let right_ascension_deg =
-        limit_degrees((sin_l * cos_e - beta.tan() * sin_e).atan2(cos_l).to_degrees());
+    let right_ascension_deg = limit_degrees(
+        (sin_l * cos_e - beta.tan() * sin_e)
+            .atan2(cos_l)
+            .to_degrees(),
+    );
     let declination_deg = (beta.sin() * cos_e + beta.cos() * sin_e * sin_l)
         .asin()
         .to_degrees();
@@ -336,7 +336,11 @@ fn equation_of_time_min(g: &Geocentric) -> f64 {
     let e_min = limit_degrees_180pm(e_deg) * 4.0;
     if e_min.abs() > 20.0 {
         // The C code's limit_minutes: wrap by a day's 1440 minutes.
-        if e_min < 0.0 { e_min + 1440.0 } else { e_min - 1440.0 }
+        if e_min < 0.0 {
+            e_min + 1440.0
+        } else {
+            e_min - 1440.0
+        }
     } else {
         e_min
     }
@@ -515,7 +519,9 @@ pub fn sun_rise_transit_set<Tz: TimeZone>(
         let utc_seconds = local_midnight_utc + local_seconds;
         let whole = utc_seconds.floor();
         // Sub-second part in nanoseconds, < 1e9 by construction.
-        let nanos = ((utc_seconds - whole) * 1.0e9).round().clamp(0.0, 999_999_999.0) as u32;
+        let nanos = ((utc_seconds - whole) * 1.0e9)
+            .round()
+            .clamp(0.0, 999_999_999.0) as u32;
         DateTime::from_timestamp(whole as i64, nanos)
             .map(|t| t.with_timezone(tz))
             .ok_or(SunError::InvalidDate)
@@ -604,8 +610,8 @@ mod tests {
     #[test]
     fn paper_test_case_rise_set() {
         let (time, params) = golden();
-        let rts = sun_rise_transit_set(time.date_naive(), time.offset(), &params)
-            .expect("valid inputs");
+        let rts =
+            sun_rise_transit_set(time.date_naive(), time.offset(), &params).expect("valid inputs");
         let hms = |t: DateTime<FixedOffset>| {
             f64::from(t.hour() * 3600 + t.minute() * 60 + t.second())
                 + f64::from(t.nanosecond()) * 1e-9
@@ -614,9 +620,15 @@ mod tests {
         // algorithm) gives 06:12:43.46, 11:46:04.96, 17:20:19.18 — we check to 0.05 s of pvlib.
         let sunrise = hms(rts.sunrise.expect("sun rises"));
         let sunset = hms(rts.sunset.expect("sun sets"));
-        assert!((sunrise - (6.0 * 3600.0 + 12.0 * 60.0 + 43.46)).abs() < 0.05, "{sunrise}");
+        assert!(
+            (sunrise - (6.0 * 3600.0 + 12.0 * 60.0 + 43.46)).abs() < 0.05,
+            "{sunrise}"
+        );
         assert!((hms(rts.transit) - (11.0 * 3600.0 + 46.0 * 60.0 + 4.96)).abs() < 0.05);
-        assert!((sunset - (17.0 * 3600.0 + 20.0 * 60.0 + 19.18)).abs() < 0.05, "{sunset}");
+        assert!(
+            (sunset - (17.0 * 3600.0 + 20.0 * 60.0 + 19.18)).abs() < 0.05,
+            "{sunset}"
+        );
     }
 
     #[test]

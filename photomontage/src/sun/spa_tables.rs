@@ -7,6 +7,9 @@
 //! # Known limitations
 //! VSOP87 truncated as in the paper: valid −2000…6000 with the paper's stated ±0.0003° overall.
 
+// The tables print π to 3 or 4 digits (3.14, 3.142); those are the published values, not π.
+#![allow(clippy::approx_constant)]
+
 /// Earth heliocentric longitude terms L0 (64 rows of A, B, C: term = A·cos(B + C·JME)).
 pub const L0: [[f64; 3]; 64] = [
     [175347046.0, 0.0, 0.0],
@@ -156,9 +159,7 @@ pub const L4: [[f64; 3]; 3] = [
 ];
 
 /// Earth heliocentric longitude terms L5 (1 rows of A, B, C: term = A·cos(B + C·JME)).
-pub const L5: [[f64; 3]; 1] = [
-    [1.0, 3.14, 0.0],
-];
+pub const L5: [[f64; 3]; 1] = [[1.0, 3.14, 0.0]];
 
 /// Earth heliocentric latitude terms B0 (5 rows of A, B, C: term = A·cos(B + C·JME)).
 pub const B0: [[f64; 3]; 5] = [
@@ -170,10 +171,7 @@ pub const B0: [[f64; 3]; 5] = [
 ];
 
 /// Earth heliocentric latitude terms B1 (2 rows of A, B, C: term = A·cos(B + C·JME)).
-pub const B1: [[f64; 3]; 2] = [
-    [9.0, 3.9, 5507.55],
-    [6.0, 1.73, 5223.69],
-];
+pub const B1: [[f64; 3]; 2] = [[9.0, 3.9, 5507.55], [6.0, 1.73, 5223.69]];
 
 /// Earth radius vector terms R0 (40 rows of A, B, C: term = A·cos(B + C·JME)).
 pub const R0: [[f64; 3]; 40] = [
@@ -244,15 +242,10 @@ pub const R2: [[f64; 3]; 6] = [
 ];
 
 /// Earth radius vector terms R3 (2 rows of A, B, C: term = A·cos(B + C·JME)).
-pub const R3: [[f64; 3]; 2] = [
-    [145.0, 4.273, 6283.076],
-    [7.0, 3.92, 12566.15],
-];
+pub const R3: [[f64; 3]; 2] = [[145.0, 4.273, 6283.076], [7.0, 3.92, 12566.15]];
 
 /// Earth radius vector terms R4 (1 rows of A, B, C: term = A·cos(B + C·JME)).
-pub const R4: [[f64; 3]; 1] = [
-    [4.0, 2.56, 6283.08],
-];
+pub const R4: [[f64; 3]; 1] = [[4.0, 2.56, 6283.08]];
 
 /// Nutation argument multipliers Y_i0..Y_i4 of X0..X4 (Table A4.3).
 pub const NUTATION_Y: [[i8; 5]; 63] = [

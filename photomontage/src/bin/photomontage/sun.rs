@@ -35,12 +35,13 @@ pub struct SunArgs {
 
 /// Runs the subcommand.
 pub fn run(args: &SunArgs) -> Result<()> {
-    let time: DateTime<FixedOffset> = DateTime::parse_from_rfc3339(&args.time).with_context(|| {
-        format!(
-            "cannot parse --time {:?} as RFC 3339 (e.g. 2003-10-17T12:30:30-07:00)",
-            args.time
-        )
-    })?;
+    let time: DateTime<FixedOffset> =
+        DateTime::parse_from_rfc3339(&args.time).with_context(|| {
+            format!(
+                "cannot parse --time {:?} as RFC 3339 (e.g. 2003-10-17T12:30:30-07:00)",
+                args.time
+            )
+        })?;
     if !(-90.0..=90.0).contains(&args.lat) {
         bail!("--lat {} is outside −90…90 degrees", args.lat);
     }
@@ -84,7 +85,10 @@ pub fn run(args: &SunArgs) -> Result<()> {
     } else {
         println!("time           {}", time.to_rfc3339());
         println!("zenith         {:.6}°", position.zenith_deg);
-        println!("azimuth        {:.6}° (east of north)", position.azimuth_deg);
+        println!(
+            "azimuth        {:.6}° (east of north)",
+            position.azimuth_deg
+        );
         println!("elevation      {:.6}°", position.elevation_deg);
         println!("sunrise        {}", sunrise.as_deref().unwrap_or("none"));
         println!("transit        {transit}");
