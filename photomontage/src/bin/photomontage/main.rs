@@ -3,7 +3,9 @@
 mod info;
 mod report;
 mod resect;
+mod sky;
 mod solve;
+mod sun;
 
 use clap::{Parser, Subcommand};
 
@@ -28,6 +30,10 @@ enum Command {
     Solve(solve::Args),
     /// Solve one photo from a control-point file (CSV or OpenDroneMap gcp_list.txt).
     Resect(resect::Args),
+    /// Solar position (NREL SPA), sunrise and sunset.
+    Sun(sun::SunArgs),
+    /// CIE standard sky: E_h/L_z and a fisheye luminance map.
+    Sky(sky::SkyArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -36,5 +42,7 @@ fn main() -> anyhow::Result<()> {
         Command::Info(args) => info::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Resect(args) => resect::run(&args),
+        Command::Sun(args) => sun::run(&args),
+        Command::Sky(args) => sky::run(&args),
     }
 }
