@@ -1,0 +1,49 @@
+//! Every photo format the site accepts decodes to float RGB as displayed.
+
+use photomontage::photo::{self, Transfer};
+use photomontage_tests::shared_file;
+
+#[test]
+fn exr_is_read_as_linear_float() {
+    let Some(path) = shared_file("bench/data/mitsuba/llvm_ad_rgb_16spp_without_box.exr") else {
+        return;
+    };
+    let img = photo::load(&path).unwrap();
+    assert_eq!(img.transfer, Transfer::Linear);
+    let meta: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(shared_file("bench/data/mitsuba/scene.json").unwrap()).unwrap(),
+    )
+    .unwrap();
+    let camera = &meta["camera"];
+    assert_eq!(
+        [u64::from(img.size_px()[0]), u64::from(img.size_px()[1])],
+        [
+            camera["width"].as_u64().unwrap(),
+            camera["height"].as_u64().unwrap()
+        ]
+    );
+    // Linear HDR values of a sunlit scene: finite and non-negative.
+    assert!(
+        img.pixels
+            .pixels()
+            .all(|p| p.0.iter().all(|v| v.is_finite() && *v >= 0.0))
+    );
+}
+
+#[test]
+fn tiff_and_jpeg_round_trip_through_the_loader() {
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbImage::from_fn(8, 4, |x, y| {
+        image::Rgb([(x * 30) as u8, (y * 60) as u8, 90])
+    });
+    for name in ["p.tif", "p.jpg", "p.png"] {
+        let path = dir.path().join(name);
+        img.save(&path).unwrap();
+        let photo = photo::load(&path).unwrap();
+        assert_eq!(photo.size_px(), [8, 4], "{name}");
+        assert_eq!(photo.transfer, Transfer::Srgb);
+        let p = photo.pixels.get_pixel(0, 0);
+        // JPEG is lossy: within 6/255 on a flat corner.
+        assert!((p[2] - 90.0 / 255.0).abs() < 6.0 / 255.0, "{name}: {p:?}");
+    }
+}
