@@ -34,7 +34,13 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("bundle_adjust");
     group.sample_size(10);
     group.bench_function("30_photos_300_points", |bch| {
-        bch.iter(|| bundle_adjust(black_box(&photos), black_box(&b.control), black_box(&options)));
+        bch.iter(|| {
+            bundle_adjust(
+                black_box(&photos),
+                black_box(&b.control),
+                black_box(&options),
+            )
+        });
     });
     group.finish();
 }

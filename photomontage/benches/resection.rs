@@ -57,7 +57,9 @@ fn synthetic(n: usize) -> Data {
         image_size_px: [6000, 4000],
         distance_m: 80.0,
         points: n,
-        layout: Layout::Volume { depth_fraction: 0.3 },
+        layout: Layout::Volume {
+            depth_fraction: 0.3,
+        },
         sigma_px: 0.5,
         outlier_fraction: 0.0,
         seed: 20_240_601,

@@ -23,7 +23,8 @@ const CONTROL_SIGMA_M: f64 = 0.1;
 
 #[test]
 fn copr_gcp_list_parses_and_the_mislabelled_point_is_named() {
-    let Some(path) = photomontage_tests::shared_file("data/real/gcp/odm_data_copr/gcp_list.txt") else {
+    let Some(path) = photomontage_tests::shared_file("data/real/gcp/odm_data_copr/gcp_list.txt")
+    else {
         return;
     };
     let text = std::fs::read_to_string(path).expect("readable");
@@ -31,7 +32,9 @@ fn copr_gcp_list_parses_and_the_mislabelled_point_is_named() {
     assert!(list.crs.starts_with("+proj=utm +zone=11"));
     assert_eq!(list.rows.len(), 27);
     assert_eq!(list.images().len(), 22);
-    let control = list.control_points([CONTROL_SIGMA_M; 3]).expect("consistent");
+    let control = list
+        .control_points([CONTROL_SIGMA_M; 3])
+        .expect("consistent");
     assert_eq!(control.len(), 10);
     assert!(control.iter().all(|c| c.point_in_world.z == 0.0));
 
@@ -47,7 +50,9 @@ fn copr_gcp_list_parses_and_the_mislabelled_point_is_named() {
             pixel_distance_px,
             world_distance_m,
         }) => {
-            println!("IMG_0031: {first} and {second}: {pixel_distance_px:.2} px apart, {world_distance_m:.2} m apart");
+            println!(
+                "IMG_0031: {first} and {second}: {pixel_distance_px:.2} px apart, {world_distance_m:.2} m apart"
+            );
             let mut pair = [first, second];
             pair.sort();
             assert_eq!(pair, ["gcp00".to_owned(), "gcp04".to_owned()]);
@@ -59,7 +64,10 @@ fn copr_gcp_list_parses_and_the_mislabelled_point_is_named() {
         let obs = list.observations(image, SIGMA_PX);
         assert_eq!(
             resect(&control, &obs, &options).err(),
-            Some(PhotogrammetryError::NotEnoughPoints { required: 4, found: 2 }),
+            Some(PhotogrammetryError::NotEnoughPoints {
+                required: 4,
+                found: 2
+            }),
             "{image}"
         );
     }

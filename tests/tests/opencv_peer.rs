@@ -40,7 +40,8 @@ struct Problem {
 
 fn problem(data: &Value) -> Problem {
     let k = matrix3(&data["K"]);
-    let size = [0, 1].map(|i| u32::try_from(data["image_size"][i].as_u64().expect("size")).expect("fits"));
+    let size =
+        [0, 1].map(|i| u32::try_from(data["image_size"][i].as_u64().expect("size")).expect("fits"));
     let sigma_px = f(&data["noise"]["sigma_px"]);
     let mut control = Vec::new();
     let mut observations = Vec::new();
@@ -71,7 +72,9 @@ fn problem(data: &Value) -> Problem {
         observations,
         intrinsics,
         true_center: Point3::new(f(&c[0]), f(&c[1]), f(&c[2])),
-        true_world_from_camera: Rotation3::from_matrix(&matrix3(&data["true_pose"]["R_world_to_cam"]).transpose()),
+        true_world_from_camera: Rotation3::from_matrix(
+            &matrix3(&data["true_pose"]["R_world_to_cam"]).transpose(),
+        ),
     }
 }
 
@@ -85,13 +88,22 @@ fn pnp_accuracy_is_no_worse_than_opencv_iterative() {
             return;
         };
         let p = problem(&data);
-        let r = resect(&p.control, &p.observations, &ResectionOptions::new(p.intrinsics)).expect("solvable");
+        let r = resect(
+            &p.control,
+            &p.observations,
+            &ResectionOptions::new(p.intrinsics),
+        )
+        .expect("solvable");
         let position_error_m = (r.camera.pose.camera_center_in_world - p.true_center).norm();
-        let rotation_error_deg = (p.true_world_from_camera.inverse() * r.camera.pose.rotation_world_from_camera)
+        let rotation_error_deg = (p.true_world_from_camera.inverse()
+            * r.camera.pose.rotation_world_from_camera)
             .angle()
             .to_degrees();
         let methods = &peers["pnp"][n]["methods"];
-        println!("pnp_{n}: ours position {position_error_m:.6} m, rotation {rotation_error_deg:.6} deg, rms {:.4} px, outliers {:?}", r.rms_px, r.outliers);
+        println!(
+            "pnp_{n}: ours position {position_error_m:.6} m, rotation {rotation_error_deg:.6} deg, rms {:.4} px, outliers {:?}",
+            r.rms_px, r.outliers
+        );
         for m in ["ITERATIVE", "SQPNP", "EPNP"] {
             println!(
                 "pnp_{n}: OpenCV {m:9} position {:.6} m, rotation {:.6} deg",
@@ -107,7 +119,10 @@ fn pnp_accuracy_is_no_worse_than_opencv_iterative() {
 
 #[test]
 fn one_image_focal_length_is_no_worse_than_opencv_calibrate_camera() {
-    let (Some(peers), Some(data)) = (load("bench/peers/results/opencv.json"), load("bench/data/opencv/calib_50.json")) else {
+    let (Some(peers), Some(data)) = (
+        load("bench/peers/results/opencv.json"),
+        load("bench/data/opencv/calib_50.json"),
+    ) else {
         return;
     };
     let p = problem(&data);
@@ -123,7 +138,12 @@ fn one_image_focal_length_is_no_worse_than_opencv_calibrate_camera() {
     let focal_error_px = (r.camera.intrinsics.focal_px - true_focal_px).abs();
     println!(
         "calib_50: ours f {:.4} px (error {focal_error_px:.4}, σ {:?}), k1 {:.5}, k2 {:.5}, rms {:.4} px, warnings {:?}",
-        r.camera.intrinsics.focal_px, r.sigma_focal_px, r.camera.intrinsics.distortion.k1, r.camera.intrinsics.distortion.k2, r.rms_px, r.warnings
+        r.camera.intrinsics.focal_px,
+        r.sigma_focal_px,
+        r.camera.intrinsics.distortion.k1,
+        r.camera.intrinsics.distortion.k2,
+        r.rms_px,
+        r.warnings
     );
     println!(
         "calib_50: OpenCV f {:.4} px (error {:.4}), k1 {:.5}, k2 {:.5}",
@@ -132,6 +152,10 @@ fn one_image_focal_length_is_no_worse_than_opencv_calibrate_camera() {
         f(&theirs["k1"]),
         f(&theirs["k2"])
     );
-    assert!(r.estimated.focal && r.estimated.k1 && r.estimated.k2, "{:?}", r.warnings);
+    assert!(
+        r.estimated.focal && r.estimated.k1 && r.estimated.k2,
+        "{:?}",
+        r.warnings
+    );
     assert!(focal_error_px <= f(&theirs["f_error_px"]) * (1.0 + PEER_SLACK));
 }

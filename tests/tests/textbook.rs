@@ -9,7 +9,9 @@
 
 use nalgebra::{Matrix3, Point2, Point3};
 use photomontage::camera::Intrinsics;
-use photomontage::photogrammetry::{ControlPoint, ImageObservation, Resection, ResectionOptions, resect};
+use photomontage::photogrammetry::{
+    ControlPoint, ImageObservation, Resection, ResectionOptions, resect,
+};
 
 /// σ of a film measurement; only scales σ₀, the solution is unweighted like the books'.
 const SIGMA_MM: f64 = 0.01;
@@ -59,7 +61,10 @@ fn omega_phi_kappa(m: &Matrix3<f64>) -> [f64; 3] {
 }
 
 fn ssr_mm2(r: &Resection) -> f64 {
-    r.residuals.iter().map(|v| v.residual_px[0].powi(2) + v.residual_px[1].powi(2)).sum()
+    r.residuals
+        .iter()
+        .map(|v| v.residual_px[0].powi(2) + v.residual_px[1].powi(2))
+        .sum()
 }
 
 fn read(relative: &str) -> Option<String> {
@@ -70,13 +75,21 @@ fn parse_rows(text: &str) -> Vec<(String, [f64; 5])> {
     text.lines()
         .filter_map(|l| {
             let t: Vec<&str> = l.split_whitespace().collect();
-            (t.len() == 6).then(|| (t[0].to_owned(), [1, 2, 3, 4, 5].map(|i| t[i].parse::<f64>().expect("number"))))
+            (t.len() == 6).then(|| {
+                (
+                    t[0].to_owned(),
+                    [1, 2, 3, 4, 5].map(|i| t[i].parse::<f64>().expect("number")),
+                )
+            })
         })
         .collect()
 }
 
 fn as_rows(parsed: &[(String, [f64; 5])]) -> Vec<(&str, f64, f64, f64, f64, f64)> {
-    parsed.iter().map(|(id, v)| (id.as_str(), v[0], v[1], v[2], v[3], v[4])).collect()
+    parsed
+        .iter()
+        .map(|(id, v)| (id.as_str(), v[0], v[1], v[2], v[3], v[4]))
+        .collect()
 }
 
 /// Mikhail §1: published to ~16 digits by a scipy `leastsq` run; the helper's independent run
@@ -95,7 +108,13 @@ fn mikhail_resection_matches_published_answer() {
     let r = solve(152.222, &as_rows(&parsed));
     let [omega, phi, kappa] = omega_phi_kappa(&wolf_m(&r));
     let c = r.camera.pose.camera_center_in_world;
-    println!("Mikhail: ω {omega:.12} φ {phi:.12} κ {kappa:.12} XL {:.6} YL {:.6} ZL {:.6} SSR {:.10}", c.x, c.y, c.z, ssr_mm2(&r));
+    println!(
+        "Mikhail: ω {omega:.12} φ {phi:.12} κ {kappa:.12} XL {:.6} YL {:.6} ZL {:.6} SSR {:.10}",
+        c.x,
+        c.y,
+        c.z,
+        ssr_mm2(&r)
+    );
     assert!((omega - -0.006507481065393404).abs() < MIKHAIL_ANGLE_TOLERANCE_RAD);
     assert!((phi - -0.008521803480548321).abs() < MIKHAIL_ANGLE_TOLERANCE_RAD);
     assert!((kappa - -1.5753221236972152).abs() < MIKHAIL_ANGLE_TOLERANCE_RAD);
@@ -116,13 +135,25 @@ fn dewitt_resection_matches_reference_answer() {
     let Some(text) = read("data/real/gcp/dewitt_public_domain/resect_sample.dat") else {
         return;
     };
-    let f_mm: f64 = text.lines().next().expect("focal line").trim().parse().expect("focal");
+    let f_mm: f64 = text
+        .lines()
+        .next()
+        .expect("focal line")
+        .trim()
+        .parse()
+        .expect("focal");
     let parsed = parse_rows(&text);
     assert_eq!(parsed.len(), 5);
     let r = solve(f_mm, &as_rows(&parsed));
     let [omega, phi, kappa] = omega_phi_kappa(&wolf_m(&r)).map(f64::to_degrees);
     let c = r.camera.pose.camera_center_in_world;
-    println!("Dewitt: ω {omega:.6}° φ {phi:.6}° κ {kappa:.6}° XL {:.5} YL {:.5} ZL {:.5} SSR {:.4e}", c.x, c.y, c.z, ssr_mm2(&r));
+    println!(
+        "Dewitt: ω {omega:.6}° φ {phi:.6}° κ {kappa:.6}° XL {:.5} YL {:.5} ZL {:.5} SSR {:.4e}",
+        c.x,
+        c.y,
+        c.z,
+        ssr_mm2(&r)
+    );
     assert!((omega - -0.41091).abs() < DEWITT_ANGLE_TOLERANCE_DEG);
     assert!((phi - 1.21083).abs() < DEWITT_ANGLE_TOLERANCE_DEG);
     assert!((kappa - 102.80031).abs() < DEWITT_ANGLE_TOLERANCE_DEG);
@@ -163,7 +194,10 @@ fn wuhan_resection_matches_textbook_answer() {
     let [omega, phi, kappa] = omega_phi_kappa(&m);
     println!(
         "Wuhan: Xs {:.4} Ys {:.4} Zs {:.4}; φωκ (Chinese) {phi_c:.8} {omega_c:.8} {kappa_c:.8}; ωφκ (Wolf) {omega:.8} {phi:.8} {kappa:.8}; SSR {:.4e}",
-        c.x, c.y, c.z, ssr_mm2(&r)
+        c.x,
+        c.y,
+        c.z,
+        ssr_mm2(&r)
     );
     assert!((c.x - 39795.45).abs() < WUHAN_POSITION_TOLERANCE_M);
     assert!((c.y - 27476.46).abs() < WUHAN_POSITION_TOLERANCE_M);

@@ -33,8 +33,8 @@ use super::projection::{
 };
 use super::resection::ObservationResidual;
 use super::{
-    ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, intersect, validate_control,
-    validate_intrinsics, validate_observations,
+    ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, intersect,
+    validate_control, validate_intrinsics, validate_observations,
 };
 use crate::camera::Camera;
 
@@ -256,7 +256,11 @@ impl NormalEquations for Problem {
                 let k = self.camera_block(p);
                 Camera {
                     pose: apply_pose_increment(&c.pose, &d[o..o + 6]),
-                    intrinsics: apply_intrinsics_increment(&c.intrinsics, &self.free[p], &d[o + 6..o + k]),
+                    intrinsics: apply_intrinsics_increment(
+                        &c.intrinsics,
+                        &self.free[p],
+                        &d[o + 6..o + k],
+                    ),
                 }
             })
             .collect();
@@ -277,7 +281,12 @@ impl NormalEquations for Problem {
 }
 
 /// Solves N x = b by eliminating the 3×3 point blocks.
-fn schur_solve(n: &DMatrix<f64>, b: &DVector<f64>, nc: usize, points: usize) -> Option<DVector<f64>> {
+fn schur_solve(
+    n: &DMatrix<f64>,
+    b: &DVector<f64>,
+    nc: usize,
+    points: usize,
+) -> Option<DVector<f64>> {
     let (s, rs, cinv) = reduce(n, b, nc, points)?;
     let chol = s.cholesky()?;
     let xc = chol.solve(&rs);
@@ -304,8 +313,13 @@ fn reduce(n: &DMatrix<f64>, b: &DVector<f64>, nc: usize, points: usize) -> Optio
         let ci = n.fixed_view::<3, 3>(o, o).into_owned().try_inverse()?;
         let bq = n.view((0, o), (nc, 3));
         // Only cameras observing q have non-zero rows in B_q.
-        let rows: Vec<usize> = (0..nc).filter(|&i| bq.row(i).iter().any(|v| *v != 0.0)).collect();
-        let bci: Vec<nalgebra::RowVector3<f64>> = rows.iter().map(|&i| bq.fixed_view::<1, 3>(i, 0) * ci).collect();
+        let rows: Vec<usize> = (0..nc)
+            .filter(|&i| bq.row(i).iter().any(|v| *v != 0.0))
+            .collect();
+        let bci: Vec<nalgebra::RowVector3<f64>> = rows
+            .iter()
+            .map(|&i| bq.fixed_view::<1, 3>(i, 0) * ci)
+            .collect();
         let bq_rhs = b.fixed_rows::<3>(o);
         for (a, &i) in rows.iter().enumerate() {
             for &j in &rows {
@@ -319,7 +333,11 @@ fn reduce(n: &DMatrix<f64>, b: &DVector<f64>, nc: usize, points: usize) -> Optio
 }
 
 /// Camera block of N⁻¹ and the 3×3 point blocks of N⁻¹.
-fn reduced_inverse(n: &DMatrix<f64>, nc: usize, points: usize) -> Option<(DMatrix<f64>, Vec<Matrix3<f64>>)> {
+fn reduced_inverse(
+    n: &DMatrix<f64>,
+    nc: usize,
+    points: usize,
+) -> Option<(DMatrix<f64>, Vec<Matrix3<f64>>)> {
     let zero = DVector::zeros(nc + 3 * points);
     let (s, _, cinv) = reduce(n, &zero, nc, points)?;
     let s_inv = super::least_squares::spd_inverse(&s)?;
@@ -354,14 +372,21 @@ pub fn bundle_adjust(
         }
     }
     if photos.is_empty() {
-        return Err(PhotogrammetryError::NotEnoughPoints { required: 1, found: 0 });
+        return Err(PhotogrammetryError::NotEnoughPoints {
+            required: 1,
+            found: 0,
+        });
     }
     let mut warnings = Vec::new();
-    let control_by_id: HashMap<&str, &ControlPoint> = control.iter().map(|c| (c.id.as_str(), c)).collect();
+    let control_by_id: HashMap<&str, &ControlPoint> =
+        control.iter().map(|c| (c.id.as_str(), c)).collect();
     let origin = if control.is_empty() {
         Vector3::zeros()
     } else {
-        control.iter().fold(Vector3::zeros(), |a, c| a + c.point_in_world.coords) / control.len() as f64
+        control
+            .iter()
+            .fold(Vector3::zeros(), |a, c| a + c.point_in_world.coords)
+            / control.len() as f64
     };
     let reduced_cameras: Vec<Camera> = photos
         .iter()
@@ -393,7 +418,9 @@ pub fn bundle_adjust(
             if c.sigma_m.iter().all(|s| *s == 0.0) {
                 point_index.insert(id.to_owned(), PointRef::Fixed(reduced));
             } else {
-                let sigma = c.sigma_m.map(|s| if s > 0.0 { s } else { FIXED_AXIS_SIGMA_M });
+                let sigma = c
+                    .sigma_m
+                    .map(|s| if s > 0.0 { s } else { FIXED_AXIS_SIGMA_M });
                 point_index.insert(id.to_owned(), PointRef::Unknown(start_points.len()));
                 start_points.push(reduced);
                 priors.push(Some((reduced, sigma)));
@@ -403,11 +430,15 @@ pub fn bundle_adjust(
             continue;
         }
         if obs.len() < 2 {
-            warnings.push(format!("{id} is neither control nor seen in two photos: ignored"));
+            warnings.push(format!(
+                "{id} is neither control nor seen in two photos: ignored"
+            ));
             continue;
         }
-        let ray_list: Vec<(Camera, ImageObservation)> =
-            obs.iter().map(|(pi, o)| (reduced_cameras[*pi], (*o).clone())).collect();
+        let ray_list: Vec<(Camera, ImageObservation)> = obs
+            .iter()
+            .map(|(pi, o)| (reduced_cameras[*pi], (*o).clone()))
+            .collect();
         match intersect(&ray_list) {
             Ok(x) => {
                 point_index.insert(id.to_owned(), PointRef::Unknown(start_points.len()));
@@ -454,15 +485,22 @@ pub fn bundle_adjust(
         }
     };
     let mut problem = build(&free, observations);
-    let unsolvable = || PhotogrammetryError::Degenerate {
+    let unsolvable = || {
+        PhotogrammetryError::Degenerate {
         reason: "the adjustment is singular: control does not fix every photo and point (datum, or too few rays)".to_owned(),
+    }
     };
 
     // Solve; drop unsupported intrinsics; then outlier rounds.
-    let mut solution = levenberg_marquardt(&problem, state.clone()).ok_or(PhotogrammetryError::NoConvergence)?;
+    let mut solution =
+        levenberg_marquardt(&problem, state.clone()).ok_or(PhotogrammetryError::NoConvergence)?;
     if free.iter().any(SelfCalibration::any) {
-        let (s_inv, _) = reduced_inverse(&solution.normal, problem.camera_columns, problem.priors.len())
-            .ok_or_else(unsolvable)?;
+        let (s_inv, _) = reduced_inverse(
+            &solution.normal,
+            problem.camera_columns,
+            problem.priors.len(),
+        )
+        .ok_or_else(unsolvable)?;
         let mut changed = false;
         for (p, f) in free.iter_mut().enumerate() {
             let cols = intrinsic_indices(f);
@@ -489,18 +527,26 @@ pub fn bundle_adjust(
         }
         if changed {
             problem = build(&free, problem.observations);
-            solution = levenberg_marquardt(&problem, state.clone()).ok_or(PhotogrammetryError::NoConvergence)?;
+            solution = levenberg_marquardt(&problem, state.clone())
+                .ok_or(PhotogrammetryError::NoConvergence)?;
         }
     }
     state = solution.state.clone();
     for _ in 0..options.max_outlier_rounds {
         let mut worst: Option<(usize, f64)> = None;
-        for (k, o) in problem.observations.iter().enumerate().filter(|(_, o)| o.active) {
+        for (k, o) in problem
+            .observations
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.active)
+        {
             let x = Problem::point_position(&state, o.point);
-            let w = state.cameras[o.photo].project(&x).map_or(f64::INFINITY, |p| {
-                let v = (p - o.observation.pixel) / o.observation.sigma_px;
-                v.x.abs().max(v.y.abs())
-            });
+            let w = state.cameras[o.photo]
+                .project(&x)
+                .map_or(f64::INFINITY, |p| {
+                    let v = (p - o.observation.pixel) / o.observation.sigma_px;
+                    v.x.abs().max(v.y.abs())
+                });
             if w > options.outlier_threshold_sigma && worst.is_none_or(|(_, b)| w > b) {
                 worst = Some((k, w));
             }
@@ -522,16 +568,21 @@ pub fn bundle_adjust(
                         o.active = false;
                     }
                 }
-                warnings.push(format!("tie point {} dropped: fewer than two consistent rays", point_ids[q]));
+                warnings.push(format!(
+                    "tie point {} dropped: fewer than two consistent rays",
+                    point_ids[q]
+                ));
             }
         }
-        solution = levenberg_marquardt(&problem, state).ok_or(PhotogrammetryError::NoConvergence)?;
+        solution =
+            levenberg_marquardt(&problem, state).ok_or(PhotogrammetryError::NoConvergence)?;
         state = solution.state.clone();
     }
 
     // Statistics.
     let nc = problem.camera_columns;
-    let (s_inv, point_cov) = reduced_inverse(&solution.normal, nc, problem.priors.len()).ok_or_else(unsolvable)?;
+    let (s_inv, point_cov) =
+        reduced_inverse(&solution.normal, nc, problem.priors.len()).ok_or_else(unsolvable)?;
     let active = problem.observations.iter().filter(|o| o.active).count();
     let prior_rows: usize = problem.priors.iter().flatten().count() * 3;
     let redundancy = (2 * active + prior_rows) as i64 - problem.unknowns() as i64;
@@ -559,8 +610,14 @@ pub fn bundle_adjust(
                     (v, v / o.observation.sigma_px)
                 }
                 None => {
-                    photo_warnings.push(format!("{} lies behind the adjusted camera", o.observation.point_id));
-                    (nalgebra::Vector2::repeat(f64::NAN), nalgebra::Vector2::repeat(f64::NAN))
+                    photo_warnings.push(format!(
+                        "{} lies behind the adjusted camera",
+                        o.observation.point_id
+                    ));
+                    (
+                        nalgebra::Vector2::repeat(f64::NAN),
+                        nalgebra::Vector2::repeat(f64::NAN),
+                    )
                 }
             };
             if o.active {
@@ -589,14 +646,19 @@ pub fn bundle_adjust(
         let off = problem.offsets[p];
         let sd = |i: usize| (s_inv[(off + i, off + i)] * variance).max(0.0).sqrt();
         let rot = camera.pose.rotation_world_from_camera.matrix();
-        let cov_theta = rot * s_inv.fixed_view::<3, 3>(off + 3, off + 3) * rot.transpose() * variance;
+        let cov_theta =
+            rot * s_inv.fixed_view::<3, 3>(off + 3, off + 3) * rot.transpose() * variance;
         let focal_col = intrinsic_indices(&free[p]).iter().position(|c| *c == 0);
         let mut camera_out = camera;
         camera_out.pose.camera_center_in_world += origin;
         photo_reports.push(BundlePhotoReport {
             id: photo.id.clone(),
             camera: camera_out,
-            rms_px: if used > 0 { (sum_sq / (2 * used) as f64).sqrt() } else { f64::NAN },
+            rms_px: if used > 0 {
+                (sum_sq / (2 * used) as f64).sqrt()
+            } else {
+                f64::NAN
+            },
             sigma_center_m: [sd(0), sd(1), sd(2)],
             sigma_angles_deg: [0, 1, 2].map(|i| cov_theta[(i, i)].max(0.0).sqrt().to_degrees()),
             sigma_focal_px: focal_col.map(|c| sd(6 + c)),
@@ -650,7 +712,11 @@ pub fn bundle_adjust(
     Ok(BundleReport {
         photos: photo_reports,
         points,
-        rms_px: if active > 0 { (total_sq / (2 * active) as f64).sqrt() } else { f64::NAN },
+        rms_px: if active > 0 {
+            (total_sq / (2 * active) as f64).sqrt()
+        } else {
+            f64::NAN
+        },
         sigma0,
         redundancy,
         warnings,

@@ -23,7 +23,8 @@ fn photos(b: &crate::photogrammetry::synthetic::SyntheticBlock) -> Vec<BundlePho
 
 fn check(spec: &BlockSpec) -> BundleReport {
     let b = block(spec);
-    let report = bundle_adjust(&photos(&b), &b.control, &BundleOptions::default()).expect("solvable");
+    let report =
+        bundle_adjust(&photos(&b), &b.control, &BundleOptions::default()).expect("solvable");
     assert!(report.converged, "{:?}", report.warnings);
     for (p, truth) in report.photos.iter().zip(&b.true_cameras) {
         let dc = p.camera.pose.camera_center_in_world - truth.pose.camera_center_in_world;
@@ -35,15 +36,34 @@ fn check(spec: &BlockSpec) -> BundleReport {
                 p.sigma_center_m
             );
         }
-        let angle = rotation_error(&truth.pose.rotation_world_from_camera, &p.camera.pose.rotation_world_from_camera);
-        let sigma = p.sigma_angles_deg.iter().map(|s| s * s).sum::<f64>().sqrt().to_radians();
-        assert!(angle <= SIGMA_BOUND * sigma, "{}: rotation {angle} vs σ {sigma}", p.id);
+        let angle = rotation_error(
+            &truth.pose.rotation_world_from_camera,
+            &p.camera.pose.rotation_world_from_camera,
+        );
+        let sigma = p
+            .sigma_angles_deg
+            .iter()
+            .map(|s| s * s)
+            .sum::<f64>()
+            .sqrt()
+            .to_radians();
+        assert!(
+            angle <= SIGMA_BOUND * sigma,
+            "{}: rotation {angle} vs σ {sigma}",
+            p.id
+        );
     }
-    let truth: HashMap<&str, Point3<f64>> = b.points.iter().map(|(id, x)| (id.as_str(), *x)).collect();
+    let truth: HashMap<&str, Point3<f64>> =
+        b.points.iter().map(|(id, x)| (id.as_str(), *x)).collect();
     for pt in report.points.iter().filter(|p| !p.is_control) {
         let d = pt.point_in_world - truth[pt.id.as_str()];
         for axis in 0..3 {
-            assert!(d[axis].abs() <= SIGMA_BOUND * pt.sigma_m[axis], "{}: {d} vs {:?}", pt.id, pt.sigma_m);
+            assert!(
+                d[axis].abs() <= SIGMA_BOUND * pt.sigma_m[axis],
+                "{}: {d} vs {:?}",
+                pt.id,
+                pt.sigma_m
+            );
         }
     }
     report
@@ -102,7 +122,11 @@ fn gross_errors_in_tie_points_are_flagged() {
         .iter()
         .position(|o| {
             o.point_id.starts_with('t')
-                && ph.iter().filter(|p| p.observations.iter().any(|x| x.point_id == o.point_id)).count() >= 4
+                && ph
+                    .iter()
+                    .filter(|p| p.observations.iter().any(|x| x.point_id == o.point_id))
+                    .count()
+                    >= 4
         })
         .expect("a well-observed tie point");
     let bad_id = ph[2].observations[bad].point_id.clone();

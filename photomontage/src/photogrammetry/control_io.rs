@@ -86,7 +86,10 @@ pub fn parse_odm_gcp_list(text: &str) -> Result<OdmGcpList, ControlIoError> {
         if tokens.len() < 6 {
             return Err(ControlIoError::Parse {
                 line,
-                message: format!("expected `geo_x geo_y geo_z im_x im_y image [name]`, found {} fields", tokens.len()),
+                message: format!(
+                    "expected `geo_x geo_y geo_z im_x im_y image [name]`, found {} fields",
+                    tokens.len()
+                ),
             });
         }
         let point_in_world = Point3::new(
@@ -94,10 +97,14 @@ pub fn parse_odm_gcp_list(text: &str) -> Result<OdmGcpList, ControlIoError> {
             number(tokens[1], line, "geo_y")?,
             number(tokens[2], line, "geo_z")?,
         );
-        let pixel = Point2::new(number(tokens[3], line, "im_x")?, number(tokens[4], line, "im_y")?);
-        let gcp_id = tokens
-            .get(6)
-            .map_or_else(|| format!("{} {} {}", tokens[0], tokens[1], tokens[2]), |s| (*s).to_owned());
+        let pixel = Point2::new(
+            number(tokens[3], line, "im_x")?,
+            number(tokens[4], line, "im_y")?,
+        );
+        let gcp_id = tokens.get(6).map_or_else(
+            || format!("{} {} {}", tokens[0], tokens[1], tokens[2]),
+            |s| (*s).to_owned(),
+        );
         rows.push(OdmGcpRow {
             line,
             point_in_world,
@@ -206,7 +213,10 @@ pub fn parse_points_csv(text: &str) -> Result<PointsCsv, ControlIoError> {
         if !(6..=7).contains(&fields.len()) {
             return Err(ControlIoError::Parse {
                 line,
-                message: format!("expected `id,X,Y,Z,x,y[,sigma_px]`, found {} fields", fields.len()),
+                message: format!(
+                    "expected `id,X,Y,Z,x,y[,sigma_px]`, found {} fields",
+                    fields.len()
+                ),
             });
         }
         if fields[0].is_empty() {
@@ -247,7 +257,11 @@ impl PointsCsv {
     /// Control points (σ = `sigma_m` per axis) and observations (σ from the file or
     /// `default_sigma_px`).
     #[must_use]
-    pub fn split(&self, sigma_m: [f64; 3], default_sigma_px: f64) -> (Vec<ControlPoint>, Vec<ImageObservation>) {
+    pub fn split(
+        &self,
+        sigma_m: [f64; 3],
+        default_sigma_px: f64,
+    ) -> (Vec<ControlPoint>, Vec<ImageObservation>) {
         let control = self
             .rows
             .iter()
@@ -285,10 +299,16 @@ mod tests {
         assert_eq!(list.rows.len(), 3);
         assert_eq!(list.rows[2].gcp_id, "441024.15 4564001.87 345.16");
         assert_eq!(list.rows[1].line, 3);
-        assert_eq!(list.images(), ["IMG_0037.jpg", "IMG_0121.jpg", "IMG_1356_RGB.jpg"]);
+        assert_eq!(
+            list.images(),
+            ["IMG_0037.jpg", "IMG_0121.jpg", "IMG_1356_RGB.jpg"]
+        );
         let control = list.control_points([0.02; 3]).expect("consistent");
         assert_eq!(control.len(), 2);
-        assert_eq!(list.observations("IMG_0121.jpg", 1.0)[0].pixel, Point2::new(589.5, 1026.0));
+        assert_eq!(
+            list.observations("IMG_0121.jpg", 1.0)[0].pixel,
+            Point2::new(589.5, 1026.0)
+        );
     }
 
     #[test]
@@ -300,10 +320,14 @@ mod tests {
         assert!(matches!(e, ControlIoError::Parse { line: 2, .. }), "{e}");
         let e = parse_odm_gcp_list("EPSG:32611\n1 2 NaN 4 5 a.jpg\n").unwrap_err();
         assert!(matches!(e, ControlIoError::Parse { line: 2, .. }), "{e}");
-        let list = parse_odm_gcp_list("EPSG:32611\n1 2 3 4 5 a.jpg g\n1 2 4 4 5 b.jpg g\n").expect("parses");
+        let list = parse_odm_gcp_list("EPSG:32611\n1 2 3 4 5 a.jpg g\n1 2 4 4 5 b.jpg g\n")
+            .expect("parses");
         assert_eq!(
             list.control_points([0.0; 3]),
-            Err(ControlIoError::ConflictingCoordinates { id: "g".to_owned(), line: 3 })
+            Err(ControlIoError::ConflictingCoordinates {
+                id: "g".to_owned(),
+                line: 3
+            })
         );
     }
 

@@ -26,7 +26,12 @@ fn direction(
     to: Point3<f64>,
     what: &'static str,
 ) -> Result<Unit<Vector3<f64>>, IlluminationError> {
-    if !(from.coords.iter().chain(to.coords.iter()).all(|v| v.is_finite())) {
+    if !(from
+        .coords
+        .iter()
+        .chain(to.coords.iter())
+        .all(|v| v.is_finite()))
+    {
         return Err(IlluminationError::NonFinite { what });
     }
     let d = to - from;
@@ -69,8 +74,9 @@ mod tests {
 
     #[test]
     fn zenith_of_a_tilted_edge() {
-        let z = zenith_dir_from_vertical_edge(Point3::new(1.0, 2.0, 0.0), Point3::new(1.0, 5.0, 4.0))
-            .expect("distinct");
+        let z =
+            zenith_dir_from_vertical_edge(Point3::new(1.0, 2.0, 0.0), Point3::new(1.0, 5.0, 4.0))
+                .expect("distinct");
         assert!((z.into_inner() - Vector3::new(0.0, 0.6, 0.8)).norm() < DIRECTION_TOLERANCE);
     }
 

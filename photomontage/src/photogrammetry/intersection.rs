@@ -95,8 +95,18 @@ pub fn intersect(rays: &[(Camera, ImageObservation)]) -> Result<Intersection, Ph
     let mut warnings = Vec::new();
     for (camera, o) in rays {
         validate_intrinsics(&camera.intrinsics)?;
-        let finite = camera.pose.camera_center_in_world.coords.iter().all(|v| v.is_finite())
-            && camera.pose.rotation_world_from_camera.matrix().iter().all(|v| v.is_finite())
+        let finite = camera
+            .pose
+            .camera_center_in_world
+            .coords
+            .iter()
+            .all(|v| v.is_finite())
+            && camera
+                .pose
+                .rotation_world_from_camera
+                .matrix()
+                .iter()
+                .all(|v| v.is_finite())
             && o.pixel.x.is_finite()
             && o.pixel.y.is_finite();
         if !finite {
@@ -118,10 +128,9 @@ pub fn intersect(rays: &[(Camera, ImageObservation)]) -> Result<Intersection, Ph
         }
     }
     // Linear start: the point nearest to all rays, in coordinates reduced to the camera centroid.
-    let origin = rays
-        .iter()
-        .fold(Vector3::zeros(), |a, (c, _)| a + c.pose.camera_center_in_world.coords)
-        / rays.len() as f64;
+    let origin = rays.iter().fold(Vector3::zeros(), |a, (c, _)| {
+        a + c.pose.camera_center_in_world.coords
+    }) / rays.len() as f64;
     let mut a = Matrix3::zeros();
     let mut b = Vector3::zeros();
     let mut dirs = Vec::with_capacity(rays.len());
@@ -149,7 +158,8 @@ pub fn intersect(rays: &[(Camera, ImageObservation)]) -> Result<Intersection, Ph
         }
     }
     let problem = Problem { rays, origin };
-    let solution = levenberg_marquardt(&problem, start).ok_or(PhotogrammetryError::NoConvergence)?;
+    let solution =
+        levenberg_marquardt(&problem, start).ok_or(PhotogrammetryError::NoConvergence)?;
     let point_in_world = solution.state + origin;
     let redundancy = 2 * rays.len() as i64 - 3;
     let sigma0 = if redundancy > 0 {
@@ -157,17 +167,18 @@ pub fn intersect(rays: &[(Camera, ImageObservation)]) -> Result<Intersection, Ph
     } else {
         1.0
     };
-    let covariance = spd_inverse(&solution.normal).ok_or_else(|| PhotogrammetryError::Degenerate {
-        reason: format!("the intersection of {point_id} is singular"),
-    })? * sigma0.max(1.0).powi(2);
+    let covariance =
+        spd_inverse(&solution.normal).ok_or_else(|| PhotogrammetryError::Degenerate {
+            reason: format!("the intersection of {point_id} is singular"),
+        })? * sigma0.max(1.0).powi(2);
     let mut residuals_px = Vec::with_capacity(rays.len());
     let mut sum_sq = 0.0;
     for (camera, o) in rays {
-        let p = camera
-            .project(&point_in_world)
-            .ok_or_else(|| PhotogrammetryError::PointBehindCamera {
+        let p = camera.project(&point_in_world).ok_or_else(|| {
+            PhotogrammetryError::PointBehindCamera {
                 point_id: o.point_id.clone(),
-            })?;
+            }
+        })?;
         let v = p - o.pixel;
         sum_sq += v.norm_squared();
         residuals_px.push([v.x, v.y]);
@@ -258,7 +269,10 @@ mod tests {
             ray(camera(Point3::new(0.0, 0.0, 0.0), far), &far, [0.0; 2]),
             ray(camera(Point3::new(2.0, 0.0, 0.0), far), &far, [0.0; 2]),
         ];
-        assert!(matches!(intersect(&parallel), Err(PhotogrammetryError::Degenerate { .. })));
+        assert!(matches!(
+            intersect(&parallel),
+            Err(PhotogrammetryError::Degenerate { .. })
+        ));
     }
 
     #[test]
@@ -267,7 +281,10 @@ mod tests {
         let one = vec![ray(camera(Point3::origin(), x), &x, [0.0; 2])];
         assert_eq!(
             intersect(&one).err(),
-            Some(PhotogrammetryError::NotEnoughPoints { required: 2, found: 1 })
+            Some(PhotogrammetryError::NotEnoughPoints {
+                required: 2,
+                found: 1
+            })
         );
         // Two cameras looking away from each other whose rays cross behind the first.
         let c1 = camera(Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 10.0, 0.0));
@@ -282,13 +299,18 @@ mod tests {
         let rays = vec![(c1, obs(Point2::new(1499.5, 999.5))), (c2, obs(p2))];
         assert_eq!(
             intersect(&rays).err(),
-            Some(PhotogrammetryError::PointBehindCamera { point_id: "b".to_owned() })
+            Some(PhotogrammetryError::PointBehindCamera {
+                point_id: "b".to_owned()
+            })
         );
         let mut nan = vec![
             ray(camera(Point3::new(-5.0, 0.0, 0.0), x), &x, [0.0; 2]),
             ray(camera(Point3::new(5.0, 0.0, 0.0), x), &x, [0.0; 2]),
         ];
         nan[1].1.pixel.x = f64::NAN;
-        assert!(matches!(intersect(&nan), Err(PhotogrammetryError::NonFinite { .. })));
+        assert!(matches!(
+            intersect(&nan),
+            Err(PhotogrammetryError::NonFinite { .. })
+        ));
     }
 }

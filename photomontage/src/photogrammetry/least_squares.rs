@@ -69,9 +69,8 @@ pub(crate) fn levenberg_marquardt<P: NormalEquations>(
             continue;
         };
         let delta = -step;
-        let small_step = (0..n).all(|i| {
-            delta[i].abs() * normal[(i, i)].max(1e-300).sqrt() <= STEP_TOLERANCE
-        });
+        let small_step =
+            (0..n).all(|i| delta[i].abs() * normal[(i, i)].max(1e-300).sqrt() <= STEP_TOLERANCE);
         let trial = problem.update(&state, &delta);
         match problem.cost(&trial) {
             Some(trial_cost) if trial_cost <= cost => {
@@ -118,16 +117,22 @@ pub(crate) fn spd_inverse(normal: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let chol = scaled.cholesky()?;
     let l = chol.l_dirty();
     let min_pivot = (0..n).map(|i| l[(i, i)]).fold(f64::INFINITY, f64::min);
-    if !(min_pivot > 1e-9) {
+    if min_pivot.is_nan() || min_pivot <= 1e-9 {
         return None;
     }
     let inv = chol.inverse();
-    Some(DMatrix::from_fn(n, n, |i, j| inv[(i, j)] * scale[i] * scale[j]))
+    Some(DMatrix::from_fn(n, n, |i, j| {
+        inv[(i, j)] * scale[i] * scale[j]
+    }))
 }
 
 /// Multiple correlation coefficient of unknown `index` with all others:
 /// ρ² = 1 − 1 / (N_ii · (N⁻¹)_ii). Near 1 means the data cannot separate it from the rest.
-pub(crate) fn multiple_correlation(normal: &DMatrix<f64>, inverse: &DMatrix<f64>, index: usize) -> f64 {
+pub(crate) fn multiple_correlation(
+    normal: &DMatrix<f64>,
+    inverse: &DMatrix<f64>,
+    index: usize,
+) -> f64 {
     let product = normal[(index, index)] * inverse[(index, index)];
     if product <= 1.0 {
         0.0
@@ -154,7 +159,13 @@ mod tests {
             2
         }
         fn cost(&self, s: &[f64; 2]) -> Option<f64> {
-            Some(self.xs.iter().zip(&self.ys).map(|(x, y)| (s[0] * (s[1] * x).exp() - y).powi(2)).sum())
+            Some(
+                self.xs
+                    .iter()
+                    .zip(&self.ys)
+                    .map(|(x, y)| (s[0] * (s[1] * x).exp() - y).powi(2))
+                    .sum(),
+            )
         }
         fn normal_equations(&self, s: &[f64; 2]) -> Option<(DMatrix<f64>, DVector<f64>, f64)> {
             let mut n = DMatrix::zeros(2, 2);
@@ -181,7 +192,10 @@ mod tests {
         let ys = xs.iter().map(|x| 2.5 * (-1.3 * x).exp()).collect();
         let sol = levenberg_marquardt(&Exp { xs, ys }, [1.0, 0.0]).expect("valid start");
         assert!(sol.converged);
-        assert!((sol.state[0] - 2.5).abs() < FIT_TOLERANCE && (sol.state[1] + 1.3).abs() < FIT_TOLERANCE);
+        assert!(
+            (sol.state[0] - 2.5).abs() < FIT_TOLERANCE
+                && (sol.state[1] + 1.3).abs() < FIT_TOLERANCE
+        );
     }
 
     #[test]

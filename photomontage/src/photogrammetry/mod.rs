@@ -47,7 +47,9 @@ pub(crate) mod projection;
 pub mod resection;
 pub mod synthetic;
 
-pub use bundle::{BundleOptions, BundlePhoto, BundlePhotoReport, BundlePointReport, BundleReport, bundle_adjust};
+pub use bundle::{
+    BundleOptions, BundlePhoto, BundlePhotoReport, BundlePointReport, BundleReport, bundle_adjust,
+};
 pub use illumination::{IlluminationError, sun_dir_from_shadow, zenith_dir_from_vertical_edge};
 pub use intersection::{Intersection, intersect};
 pub use resection::{ObservationResidual, Resection, ResectionOptions, resect};
@@ -100,7 +102,9 @@ impl SelfCalibration {
 pub enum PhotogrammetryError {
     #[error("not enough points: {required} required, {found} found")]
     NotEnoughPoints { required: usize, found: usize },
-    #[error("the control points are collinear; the camera rotation about their line is undetermined")]
+    #[error(
+        "the control points are collinear; the camera rotation about their line is undetermined"
+    )]
     Collinear,
     #[error("point {point_id} lies behind the camera")]
     PointBehindCamera { point_id: String },

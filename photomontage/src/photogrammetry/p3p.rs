@@ -87,8 +87,14 @@ pub fn absolute_orientation(
         return None;
     }
     let inv_n = 1.0 / n as f64;
-    let cw = points_in_world.iter().fold(Vector3::zeros(), |a, p| a + p.coords) * inv_n;
-    let cc = points_in_camera.iter().fold(Vector3::zeros(), |a, p| a + p.coords) * inv_n;
+    let cw = points_in_world
+        .iter()
+        .fold(Vector3::zeros(), |a, p| a + p.coords)
+        * inv_n;
+    let cc = points_in_camera
+        .iter()
+        .fold(Vector3::zeros(), |a, p| a + p.coords)
+        * inv_n;
     let mut h = Matrix3::zeros();
     for (w, c) in points_in_world.iter().zip(points_in_camera) {
         h += (c.coords - cc) * (w.coords - cw).transpose();

@@ -53,14 +53,7 @@ pub(crate) fn project_with_jacobian(
         intr.focal_px * d.x + intr.principal_point_px[0],
         intr.focal_px * d.y + intr.principal_point_px[1],
     );
-    let dn_dp = Matrix2x3::new(
-        inv_z,
-        0.0,
-        -n.x * inv_z,
-        0.0,
-        inv_z,
-        -n.y * inv_z,
-    );
+    let dn_dp = Matrix2x3::new(inv_z, 0.0, -n.x * inv_z, 0.0, inv_z, -n.y * inv_z);
     let dpix_dp = intr.focal_px * dist.distort_jacobian(n) * dn_dp;
     let d_center = -dpix_dp * r_cw;
     let d_theta = dpix_dp * skew(&p);
@@ -112,8 +105,14 @@ pub(crate) fn apply_pose_increment(pose: &Pose, delta: &[f64]) -> Pose {
     let rotation = pose.rotation_world_from_camera
         * Rotation3::new(Vector3::new(delta[3], delta[4], delta[5]));
     Pose {
-        rotation_world_from_camera: Rotation3::from_matrix_eps(rotation.matrix(), 1e-15, 8, rotation),
-        camera_center_in_world: pose.camera_center_in_world + Vector3::new(delta[0], delta[1], delta[2]),
+        rotation_world_from_camera: Rotation3::from_matrix_eps(
+            rotation.matrix(),
+            1e-15,
+            8,
+            rotation,
+        ),
+        camera_center_in_world: pose.camera_center_in_world
+            + Vector3::new(delta[0], delta[1], delta[2]),
     }
 }
 
@@ -191,7 +190,10 @@ mod tests {
                 ..cam
             };
             let num = (cp.project(&x).expect("p") - cm.project(&x).expect("m")) / (2.0 * h);
-            assert!(close(num.x, j.d_pose[(0, k)]) && close(num.y, j.d_pose[(1, k)]), "pose {k}");
+            assert!(
+                close(num.x, j.d_pose[(0, k)]) && close(num.y, j.d_pose[(1, k)]),
+                "pose {k}"
+            );
         }
         for k in 0..5 {
             let mut dp = [0.0; 5];
@@ -215,9 +217,12 @@ mod tests {
         for k in 0..3 {
             let mut e = Vector3::zeros();
             e[k] = h;
-            let num = (cam.project(&(x + e)).expect("p") - cam.project(&(x - e)).expect("m"))
-                / (2.0 * h);
-            assert!(close(num.x, j.d_point[(0, k)]) && close(num.y, j.d_point[(1, k)]), "point {k}");
+            let num =
+                (cam.project(&(x + e)).expect("p") - cam.project(&(x - e)).expect("m")) / (2.0 * h);
+            assert!(
+                close(num.x, j.d_point[(0, k)]) && close(num.y, j.d_point[(1, k)]),
+                "point {k}"
+            );
         }
     }
 }

@@ -36,7 +36,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::least_squares::{NormalEquations, levenberg_marquardt, multiple_correlation, spd_inverse};
+use super::least_squares::{
+    NormalEquations, levenberg_marquardt, multiple_correlation, spd_inverse,
+};
 use super::projection::{
     apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
 };
@@ -230,11 +232,11 @@ impl NormalEquations for Problem<'_> {
 /// C⁻¹ where C Cᵀ = σ_px² I + J_X Σ_X J_Xᵀ (control σ projected into the image).
 fn whitening_matrix(o: &Obs, camera: &Camera) -> Matrix2<f64> {
     let mut cov = Matrix2::identity() * (o.sigma_px * o.sigma_px);
-    if o.control_sigma_m.iter().any(|s| *s > 0.0) {
-        if let Some(pj) = project_with_jacobian(camera, &o.point) {
-            let s = Vector3::from(o.control_sigma_m.map(|s| s * s));
-            cov += pj.d_point * nalgebra::Matrix3::from_diagonal(&s) * pj.d_point.transpose();
-        }
+    if o.control_sigma_m.iter().any(|s| *s > 0.0)
+        && let Some(pj) = project_with_jacobian(camera, &o.point)
+    {
+        let s = Vector3::from(o.control_sigma_m.map(|s| s * s));
+        cov += pj.d_point * nalgebra::Matrix3::from_diagonal(&s) * pj.d_point.transpose();
     }
     cov.cholesky()
         .and_then(|c| c.l().try_inverse())
@@ -265,9 +267,12 @@ pub fn resect(
     let by_id: HashMap<&str, &ControlPoint> = control.iter().map(|c| (c.id.as_str(), c)).collect();
     let mut matched = Vec::with_capacity(observations.len());
     for o in observations {
-        let c = by_id
-            .get(o.point_id.as_str())
-            .ok_or_else(|| PhotogrammetryError::UnknownPoint { id: o.point_id.clone() })?;
+        let c =
+            by_id
+                .get(o.point_id.as_str())
+                .ok_or_else(|| PhotogrammetryError::UnknownPoint {
+                    id: o.point_id.clone(),
+                })?;
         matched.push(*c);
     }
     let n = observations.len();
@@ -278,7 +283,10 @@ pub fn resect(
         });
     }
     // Reduce to the centroid for conditioning.
-    let origin = matched.iter().fold(Vector3::zeros(), |a, c| a + c.point_in_world.coords) / n as f64;
+    let origin = matched
+        .iter()
+        .fold(Vector3::zeros(), |a, c| a + c.point_in_world.coords)
+        / n as f64;
     let all: Vec<Obs> = observations
         .iter()
         .zip(&matched)
@@ -297,21 +305,19 @@ pub fn resect(
     }
     let planar = extents[2] <= PLANARITY_RATIO * extents[0];
     let mut warnings = Vec::new();
-    if planar {
-        if let Some((a, b, dp, dw)) = coincident_pair(&all) {
-            if n - 1 < MIN_POINTS {
-                return Err(PhotogrammetryError::CoincidentObservations {
-                    first: observations[a].point_id.clone(),
-                    second: observations[b].point_id.clone(),
-                    pixel_distance_px: dp,
-                    world_distance_m: dw,
-                });
-            }
-            warnings.push(format!(
-                "observations of {} and {} are {dp:.2} px apart but the points are {dw:.2} m apart on a plane: one label is wrong",
-                observations[a].point_id, observations[b].point_id
-            ));
+    if planar && let Some((a, b, dp, dw)) = coincident_pair(&all) {
+        if n - 1 < MIN_POINTS {
+            return Err(PhotogrammetryError::CoincidentObservations {
+                first: observations[a].point_id.clone(),
+                second: observations[b].point_id.clone(),
+                pixel_distance_px: dp,
+                world_distance_m: dw,
+            });
         }
+        warnings.push(format!(
+            "observations of {} and {} are {dp:.2} px apart but the points are {dw:.2} m apart on a plane: one label is wrong",
+            observations[a].point_id, observations[b].point_id
+        ));
     }
     if n < MIN_POINTS {
         return Err(PhotogrammetryError::NotEnoughPoints {
@@ -322,7 +328,8 @@ pub fn resect(
 
     let intrinsics = options.initial_intrinsics;
     let threshold = options.outlier_threshold_sigma;
-    let diagonal_px = f64::from(intrinsics.image_size_px[0]).hypot(f64::from(intrinsics.image_size_px[1]));
+    let diagonal_px =
+        f64::from(intrinsics.image_size_px[0]).hypot(f64::from(intrinsics.image_size_px[1]));
     let gate_px = if options.self_calibration.any() {
         SELF_CALIBRATION_GATE_FRACTION * diagonal_px
     } else {
@@ -330,8 +337,10 @@ pub fn resect(
     };
 
     // Step 2: robust start.
-    let start_pose = ransac(&all, &intrinsics, options, gate_px).ok_or_else(|| PhotogrammetryError::Degenerate {
-        reason: "no pose from any three control points explains a fourth".to_owned(),
+    let start_pose = ransac(&all, &intrinsics, options, gate_px).ok_or_else(|| {
+        PhotogrammetryError::Degenerate {
+            reason: "no pose from any three control points explains a fourth".to_owned(),
+        }
     })?;
     let mut camera = Camera {
         intrinsics,
@@ -375,7 +384,8 @@ pub fn resect(
         }
         active.remove(worst.0);
         let problem = Problem::new(&active, &camera, free);
-        let sol = levenberg_marquardt(&problem, camera).ok_or(PhotogrammetryError::NoConvergence)?;
+        let sol =
+            levenberg_marquardt(&problem, camera).ok_or(PhotogrammetryError::NoConvergence)?;
         camera = sol.state;
         converged = sol.converged;
     }
@@ -483,7 +493,11 @@ fn principal_extents(points: &[Point3<f64>]) -> [f64; 3] {
         let d = p.coords - c;
         scatter += d * d.transpose();
     }
-    let mut e: Vec<f64> = scatter.symmetric_eigenvalues().iter().map(|v| v.max(0.0).sqrt()).collect();
+    let mut e: Vec<f64> = scatter
+        .symmetric_eigenvalues()
+        .iter()
+        .map(|v| v.max(0.0).sqrt())
+        .collect();
     e.sort_by(|a, b| b.total_cmp(a));
     [e[0], e[1], e[2]]
 }
@@ -495,7 +509,11 @@ fn coincident_pair(all: &[Obs]) -> Option<(usize, usize, f64, f64)> {
             let (oa, ob) = (&all[a], &all[b]);
             let dp = (oa.pixel - ob.pixel).norm();
             let dw = (oa.point - ob.point).norm();
-            let sigma_world = oa.control_sigma_m.iter().chain(&ob.control_sigma_m).fold(0.0_f64, |m, s| m.max(*s));
+            let sigma_world = oa
+                .control_sigma_m
+                .iter()
+                .chain(&ob.control_sigma_m)
+                .fold(0.0_f64, |m, s| m.max(*s));
             if dp <= COINCIDENT_SIGMA * oa.sigma_px.hypot(ob.sigma_px)
                 && dw > 10.0 * sigma_world.max(1e-6)
             {
@@ -515,19 +533,24 @@ fn normalised_error_sq(camera: &Camera, o: &Obs) -> Option<f64> {
     }
     let pixel = camera.project(&o.point)?;
     let sigma_ctrl = o.control_sigma_m.iter().fold(0.0_f64, |m, s| m.max(*s));
-    let sigma_sq = o.sigma_px * o.sigma_px + (camera.intrinsics.focal_px * sigma_ctrl / pc.z).powi(2);
+    let sigma_sq =
+        o.sigma_px * o.sigma_px + (camera.intrinsics.focal_px * sigma_ctrl / pc.z).powi(2);
     Some((pixel - o.pixel).norm_squared() / sigma_sq)
 }
 
 /// Whether `o` is consistent with `camera`: within `threshold` σ or within the gate (pixels).
 fn is_inlier(camera: &Camera, o: &Obs, threshold: f64, gate_px: f64) -> bool {
-    normalised_error_sq(camera, o).is_some_and(|e2| {
-        e2 <= threshold * threshold || e2.sqrt() * o.sigma_px <= gate_px
-    })
+    normalised_error_sq(camera, o)
+        .is_some_and(|e2| e2 <= threshold * threshold || e2.sqrt() * o.sigma_px <= gate_px)
 }
 
 /// RANSAC over P3P samples; returns the pose with the best MSAC score.
-fn ransac(all: &[Obs], intrinsics: &Intrinsics, options: &ResectionOptions, gate_px: f64) -> Option<Pose> {
+fn ransac(
+    all: &[Obs],
+    intrinsics: &Intrinsics,
+    options: &ResectionOptions,
+    gate_px: f64,
+) -> Option<Pose> {
     let n = all.len();
     let bearings: Vec<Unit<Vector3<f64>>> = all
         .iter()
@@ -566,7 +589,9 @@ fn ransac(all: &[Obs], intrinsics: &Intrinsics, options: &ResectionOptions, gate
         let p = [all[t[0]].point, all[t[1]].point, all[t[2]].point];
         for pose in p3p::p3p(&b, &p) {
             let (cost, inliers) = score(&pose);
-            if top.len() < LOCAL_OPTIMISATION_CANDIDATES || top.last().is_some_and(|(c, _, _)| cost < *c) {
+            if top.len() < LOCAL_OPTIMISATION_CANDIDATES
+                || top.last().is_some_and(|(c, _, _)| cost < *c)
+            {
                 let at = top.partition_point(|(c, _, _)| *c <= cost);
                 top.insert(at, (cost, inliers, pose));
                 top.truncate(LOCAL_OPTIMISATION_CANDIDATES);
@@ -586,7 +611,9 @@ fn ransac(all: &[Obs], intrinsics: &Intrinsics, options: &ResectionOptions, gate
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
         let mut needed = options.max_ransac_iterations;
         let mut iteration = 0;
-        while iteration < needed.max(MIN_RANSAC_ITERATIONS) && iteration < options.max_ransac_iterations {
+        while iteration < needed.max(MIN_RANSAC_ITERATIONS)
+            && iteration < options.max_ransac_iterations
+        {
             iteration += 1;
             let a = rng.random_range(0..n);
             let mut b = rng.random_range(0..n - 1);
@@ -606,7 +633,9 @@ fn ransac(all: &[Obs], intrinsics: &Intrinsics, options: &ResectionOptions, gate
                 needed = if miss <= 1e-12 {
                     0
                 } else {
-                    ((1.0 - options.ransac_confidence).ln() / miss.ln()).ceil().max(0.0) as usize
+                    ((1.0 - options.ransac_confidence).ln() / miss.ln())
+                        .ceil()
+                        .max(0.0) as usize
                 };
             }
         }
@@ -668,7 +697,8 @@ fn refine_and_reclassify(
             });
         }
         let problem = Problem::new(&active, &camera, free);
-        let sol = levenberg_marquardt(&problem, camera).ok_or(PhotogrammetryError::NoConvergence)?;
+        let sol =
+            levenberg_marquardt(&problem, camera).ok_or(PhotogrammetryError::NoConvergence)?;
         camera = sol.state;
         converged = sol.converged;
         let next: Vec<Obs> = all
@@ -676,7 +706,8 @@ fn refine_and_reclassify(
             .filter(|o| is_inlier(&camera, o, threshold, gate_px))
             .cloned()
             .collect();
-        let same = next.len() == active.len() && next.iter().zip(&active).all(|(a, b)| a.index == b.index);
+        let same =
+            next.len() == active.len() && next.iter().zip(&active).all(|(a, b)| a.index == b.index);
         if same || next.len() < MIN_POINTS {
             break;
         }
@@ -748,8 +779,14 @@ fn supported_intrinsics(
         let columns = intrinsic_indices(&free);
         let Some(inverse) = spd_inverse(&normal) else {
             // Singular: drop the last requested parameter and retry.
-            let name = names.iter().rev().find(|(name, _)| requested(&free, name)).map_or("", |n| n.0);
-            warnings.push(format!("{name} kept fixed: the normal matrix is singular with it free"));
+            let name = names
+                .iter()
+                .rev()
+                .find(|(name, _)| requested(&free, name))
+                .map_or("", |n| n.0);
+            warnings.push(format!(
+                "{name} kept fixed: the normal matrix is singular with it free"
+            ));
             set(&mut free, name, false);
             continue;
         };

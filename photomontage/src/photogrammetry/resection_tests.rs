@@ -50,8 +50,17 @@ fn check_scene(spec: &SceneSpec, label: &str) {
             r.sigma_center_m
         );
     }
-    let angle = rotation_error(&truth.rotation_world_from_camera, &r.camera.pose.rotation_world_from_camera);
-    let sigma_angle = r.sigma_angles_deg.iter().map(|s| s * s).sum::<f64>().sqrt().to_radians();
+    let angle = rotation_error(
+        &truth.rotation_world_from_camera,
+        &r.camera.pose.rotation_world_from_camera,
+    );
+    let sigma_angle = r
+        .sigma_angles_deg
+        .iter()
+        .map(|s| s * s)
+        .sum::<f64>()
+        .sqrt()
+        .to_radians();
     assert!(
         angle <= SIGMA_BOUND * sigma_angle,
         "{label}: rotation error {} deg vs σ {:?}",
@@ -59,10 +68,22 @@ fn check_scene(spec: &SceneSpec, label: &str) {
         r.sigma_angles_deg
     );
     for id in &scene.outlier_ids {
-        assert!(r.outliers.contains(id), "{label}: outlier {id} missed; flagged {:?}", r.outliers);
+        assert!(
+            r.outliers.contains(id),
+            "{label}: outlier {id} missed; flagged {:?}",
+            r.outliers
+        );
     }
-    let false_flags = r.outliers.iter().filter(|id| !scene.outlier_ids.contains(id)).count();
-    assert!(false_flags <= MAX_FALSE_FLAGS, "{label}: false flags {:?}", r.outliers);
+    let false_flags = r
+        .outliers
+        .iter()
+        .filter(|id| !scene.outlier_ids.contains(id))
+        .count();
+    assert!(
+        false_flags <= MAX_FALSE_FLAGS,
+        "{label}: false flags {:?}",
+        r.outliers
+    );
     assert!(r.redundancy >= 2 && r.sigma0.is_finite());
 }
 
@@ -70,7 +91,12 @@ fn check_scene(spec: &SceneSpec, label: &str) {
 fn synthetic_cameras_recover_pose_within_reported_sigma() {
     let mut seed = 100;
     for lens in &LENSES {
-        for layout in [Layout::Volume { depth_fraction: 0.3 }, Layout::Ground] {
+        for layout in [
+            Layout::Volume {
+                depth_fraction: 0.3,
+            },
+            Layout::Ground,
+        ] {
             for points in [4, 6, 12, 30, 100] {
                 for outlier_fraction in [0.0, 0.2] {
                     if outlier_fraction > 0.0 && points < 12 {
@@ -89,7 +115,10 @@ fn synthetic_cameras_recover_pose_within_reported_sigma() {
                         outlier_fraction,
                         seed,
                     };
-                    let label = format!("{} {layout:?} n={points} outliers={outlier_fraction}", lens.name);
+                    let label = format!(
+                        "{} {layout:?} n={points} outliers={outlier_fraction}",
+                        lens.name
+                    );
                     check_scene(&spec, &label);
                 }
             }
@@ -104,7 +133,9 @@ fn focal_length_is_estimated_from_volume_control() {
         image_size_px: IMAGE,
         distance_m: 30.0,
         points: 50,
-        layout: Layout::Volume { depth_fraction: 0.4 },
+        layout: Layout::Volume {
+            depth_fraction: 0.4,
+        },
         sigma_px: 0.5,
         outlier_fraction: 0.0,
         seed: 7,
@@ -138,7 +169,11 @@ fn focal_length_of_a_head_on_facade_stays_fixed_with_a_warning() {
     options.self_calibration.focal = true;
     let r = resect(&scene.control, &scene.observations, &options).expect("solvable");
     assert!(!r.estimated.focal);
-    assert!(r.warnings.iter().any(|w| w.starts_with("focal kept fixed")), "{:?}", r.warnings);
+    assert!(
+        r.warnings.iter().any(|w| w.starts_with("focal kept fixed")),
+        "{:?}",
+        r.warnings
+    );
     assert!(r.sigma_focal_px.is_none());
 }
 
@@ -148,7 +183,9 @@ fn scene(points: usize) -> crate::photogrammetry::synthetic::SyntheticScene {
         image_size_px: IMAGE,
         distance_m: 30.0,
         points,
-        layout: Layout::Volume { depth_fraction: 0.3 },
+        layout: Layout::Volume {
+            depth_fraction: 0.3,
+        },
         sigma_px: 0.5,
         outlier_fraction: 0.0,
         seed: 9,
@@ -161,11 +198,17 @@ fn too_few_points_name_required_and_found() {
     let options = ResectionOptions::new(s.camera.intrinsics);
     assert_eq!(
         resect(&s.control, &s.observations, &options).err(),
-        Some(PhotogrammetryError::NotEnoughPoints { required: 4, found: 3 })
+        Some(PhotogrammetryError::NotEnoughPoints {
+            required: 4,
+            found: 3
+        })
     );
     assert_eq!(
         resect(&s.control, &s.observations[..2], &options).err(),
-        Some(PhotogrammetryError::NotEnoughPoints { required: 4, found: 2 })
+        Some(PhotogrammetryError::NotEnoughPoints {
+            required: 4,
+            found: 2
+        })
     );
 }
 
@@ -201,7 +244,9 @@ fn invalid_input_is_a_typed_error() {
     dup[3].id = dup[0].id.clone();
     assert_eq!(
         resect(&dup, &s.observations, &options).err(),
-        Some(PhotogrammetryError::DuplicateId { id: dup[0].id.clone() })
+        Some(PhotogrammetryError::DuplicateId {
+            id: dup[0].id.clone()
+        })
     );
     let mut dup_obs = s.observations.clone();
     dup_obs[5].point_id = dup_obs[4].point_id.clone();
@@ -214,7 +259,9 @@ fn invalid_input_is_a_typed_error() {
     unknown[0].point_id = "nope".to_owned();
     assert_eq!(
         resect(&s.control, &unknown, &options).err(),
-        Some(PhotogrammetryError::UnknownPoint { id: "nope".to_owned() })
+        Some(PhotogrammetryError::UnknownPoint {
+            id: "nope".to_owned()
+        })
     );
     // Zero σ.
     let mut zero = s.observations.clone();
@@ -236,7 +283,11 @@ fn points_behind_the_camera_are_flagged_not_fitted() {
     let options = ResectionOptions::new(s.camera.intrinsics);
     let r = resect(&control, &s.observations, &options).expect("solvable from the others");
     assert!(r.outliers.contains(&control[4].id), "{:?}", r.outliers);
-    assert!(r.warnings.iter().any(|w| w.contains("behind")), "{:?}", r.warnings);
+    assert!(
+        r.warnings.iter().any(|w| w.contains("behind")),
+        "{:?}",
+        r.warnings
+    );
 }
 
 #[test]

@@ -71,8 +71,18 @@ pub fn single_photo(spec: &SceneSpec) -> SyntheticScene {
     let d = spec.distance_m;
     let (center, target) = match spec.layout {
         // Oblique view of the ground from 45° elevation.
-        Layout::Ground => (Point3::new(5.0, -d * 0.7071, d * 0.7071), Point3::new(5.0, 0.0, 0.0)),
-        _ => (Point3::new(-0.3 * d, -0.95 * d, 0.15 * d), Point3::new(0.0, 0.0, 0.0)),
+        Layout::Ground => (
+            Point3::new(
+                5.0,
+                -d * std::f64::consts::FRAC_1_SQRT_2,
+                d * std::f64::consts::FRAC_1_SQRT_2,
+            ),
+            Point3::new(5.0, 0.0, 0.0),
+        ),
+        _ => (
+            Point3::new(-0.3 * d, -0.95 * d, 0.15 * d),
+            Point3::new(0.0, 0.0, 0.0),
+        ),
     };
     let pose = look_at(center, target, Vector3::z());
     let camera = Camera { intrinsics, pose };
@@ -82,7 +92,10 @@ pub fn single_photo(spec: &SceneSpec) -> SyntheticScene {
     let mut observations = Vec::with_capacity(spec.points);
     let mut outlier_ids = Vec::new();
     while control.len() < spec.points {
-        let pixel = Point2::new(rng.random_range(0.05 * w..0.95 * w), rng.random_range(0.05 * h..0.95 * h));
+        let pixel = Point2::new(
+            rng.random_range(0.05 * w..0.95 * w),
+            rng.random_range(0.05 * h..0.95 * h),
+        );
         let ray = camera.ray_dir_in_world(pixel);
         let point = match spec.layout {
             Layout::Volume { depth_fraction } => {
@@ -196,9 +209,18 @@ pub fn block(spec: &BlockSpec) -> SyntheticBlock {
     let mut initial_cameras = Vec::with_capacity(spec.photos);
     let mut observations = Vec::with_capacity(spec.photos);
     for p in 0..spec.photos {
-        let azimuth = std::f64::consts::TAU * p as f64 / spec.photos as f64 + rng.random_range(-0.05..0.05);
-        let center = Point3::new(60.0 * azimuth.cos(), 60.0 * azimuth.sin(), rng.random_range(10.0..30.0));
-        let target = Point3::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), 3.0);
+        let azimuth =
+            std::f64::consts::TAU * p as f64 / spec.photos as f64 + rng.random_range(-0.05..0.05);
+        let center = Point3::new(
+            60.0 * azimuth.cos(),
+            60.0 * azimuth.sin(),
+            rng.random_range(10.0..30.0),
+        );
+        let target = Point3::new(
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-3.0..3.0),
+            3.0,
+        );
         let camera = Camera {
             intrinsics,
             pose: look_at(center, target, Vector3::z()),
