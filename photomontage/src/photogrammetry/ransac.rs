@@ -17,7 +17,9 @@ use super::p3p;
 use super::resection::{MIN_POINTS, Obs, Problem, ResectionOptions};
 use crate::camera::{Camera, Intrinsics, Pose};
 
-const MIN_RANSAC_ITERATIONS: usize = 20;
+/// Samples drawn even when the adaptive stop says fewer suffice: with every point an inlier the
+/// adaptive count is 0, and a few extra samples guard against a lucky first consensus.
+const MIN_RANSAC_ITERATIONS: usize = 3;
 /// Number of best RANSAC poses given a local least-squares optimisation.
 const LOCAL_OPTIMISATION_CANDIDATES: usize = 5;
 
@@ -28,7 +30,9 @@ pub(super) fn normalised_error_sq(camera: &Camera, o: &Obs) -> Option<f64> {
     if pc.z <= 0.0 {
         return None;
     }
-    let pixel = camera.project(&o.point)?;
+    let pixel = camera
+        .intrinsics
+        .pixel_from_normalised(nalgebra::Point2::new(pc.x / pc.z, pc.y / pc.z));
     let sigma_ctrl = o.control_sigma_m.iter().fold(0.0_f64, |m, s| m.max(*s));
     let sigma_sq =
         o.sigma_px * o.sigma_px + (camera.intrinsics.focal_px * sigma_ctrl / pc.z).powi(2);

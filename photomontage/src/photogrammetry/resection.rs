@@ -31,7 +31,7 @@
 
 use std::collections::HashMap;
 
-use nalgebra::{DMatrix, DVector, Matrix2, Point2, Point3, Vector2, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix2, Point2, Point3, SMatrix, SVector, Vector2, Vector3};
 use serde::Serialize;
 
 use super::least_squares::{
@@ -153,6 +153,10 @@ pub(super) struct Obs {
     pub(super) control_sigma_m: [f64; 3],
 }
 
+/// Pose (6) + all intrinsics (focal, ppx, ppy, k1, k2).
+const MAX_UNKNOWNS: usize = 11;
+type Rows = SMatrix<f64, 2, MAX_UNKNOWNS>;
+
 pub(super) struct Problem<'a> {
     obs: &'a [Obs],
     /// Whitening matrices C⁻¹ with C Cᵀ = Σ of each observation.
@@ -173,14 +177,14 @@ impl<'a> Problem<'a> {
     }
 
     /// Whitened residual and Jacobian rows of observation `k`.
-    fn rows(&self, camera: &Camera, k: usize) -> Option<(Vector2<f64>, DMatrix<f64>)> {
+    /// Columns beyond `unknowns()` are zero (fixed size: no allocation in the hot loop).
+    fn rows(&self, camera: &Camera, k: usize) -> Option<(Vector2<f64>, Rows)> {
         let o = &self.obs[k];
         let pj = project_with_jacobian(camera, &o.point)?;
         let l = self.whitening[k];
         let r = l * (pj.pixel - o.pixel);
-        let m = 6 + self.intrinsic_columns.len();
-        let mut j = DMatrix::zeros(2, m);
-        j.view_mut((0, 0), (2, 6)).copy_from(&(l * pj.d_pose));
+        let mut j = Rows::zeros();
+        j.fixed_view_mut::<2, 6>(0, 0).copy_from(&(l * pj.d_pose));
         for (c, &col) in self.intrinsic_columns.iter().enumerate() {
             let d = l * pj.d_intrinsics.column(col);
             j[(0, 6 + c)] = d.x;
@@ -205,16 +209,20 @@ impl NormalEquations for Problem<'_> {
     }
     fn normal_equations(&self, camera: &Camera) -> Option<(DMatrix<f64>, DVector<f64>, f64)> {
         let m = self.unknowns();
-        let mut n = DMatrix::zeros(m, m);
-        let mut g = DVector::zeros(m);
+        let mut n = SMatrix::<f64, MAX_UNKNOWNS, MAX_UNKNOWNS>::zeros();
+        let mut g = SVector::<f64, MAX_UNKNOWNS>::zeros();
         let mut cost = 0.0;
         for k in 0..self.obs.len() {
             let (r, j) = self.rows(camera, k)?;
-            n += j.transpose() * &j;
+            n += j.transpose() * j;
             g += j.transpose() * r;
             cost += r.norm_squared();
         }
-        Some((n, g, cost))
+        Some((
+            DMatrix::from_fn(m, m, |a, b| n[(a, b)]),
+            DVector::from_fn(m, |a, _| g[a]),
+            cost,
+        ))
     }
     fn update(&self, camera: &Camera, delta: &DVector<f64>) -> Camera {
         let d = delta.as_slice();
@@ -572,11 +580,19 @@ fn refine_and_reclassify(
 /// w = r / √(redundancy number), maximised over the two coordinates of each observation.
 fn worst_normalised(problem: &Problem<'_>, camera: &Camera) -> Option<(usize, f64)> {
     let (normal, _, _) = problem.normal_equations(camera)?;
-    let inverse = spd_inverse(&normal)?;
+    let inverse_dyn = spd_inverse(&normal)?;
+    let m = inverse_dyn.nrows();
+    let inverse = SMatrix::<f64, MAX_UNKNOWNS, MAX_UNKNOWNS>::from_fn(|a, b| {
+        if a < m && b < m {
+            inverse_dyn[(a, b)]
+        } else {
+            0.0
+        }
+    });
     let mut worst: Option<(usize, f64)> = None;
     for k in 0..problem.obs.len() {
         let (r, j) = problem.rows(camera, k)?;
-        let h = &j * &inverse * j.transpose();
+        let h = j * inverse * j.transpose();
         for c in 0..2 {
             let redundancy_number = 1.0 - h[(c, c)];
             if redundancy_number <= 1e-6 {
