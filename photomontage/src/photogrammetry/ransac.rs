@@ -22,6 +22,12 @@ use crate::camera::{Camera, Intrinsics, Pose};
 const MIN_RANSAC_ITERATIONS: usize = 3;
 /// Number of best RANSAC poses given a local least-squares optimisation.
 const LOCAL_OPTIMISATION_CANDIDATES: usize = 5;
+/// Below this many triples (8 points) every triple is tried: deterministic and as cheap as
+/// sampling.
+const EXHAUSTIVE_MAX_TRIPLES: usize = 56;
+/// Above this many points only the best candidate gets the local optimisation: with many
+/// points the best MSAC pose is reliably in the right basin.
+const FEW_POINTS: usize = 8;
 
 /// Squared normalised reprojection error of `o` for a camera, using σ_px and the control σ
 /// scaled by focal/depth (isotropic approximation, good enough for scoring).
@@ -94,7 +100,7 @@ pub(super) fn ransac(
         }
     };
     let triples = n * (n - 1) * (n - 2) / 6;
-    if triples <= options.max_ransac_iterations {
+    if triples <= EXHAUSTIVE_MAX_TRIPLES.min(options.max_ransac_iterations) {
         for a in 0..n {
             for b in a + 1..n {
                 for c in b + 1..n {
@@ -143,7 +149,8 @@ pub(super) fn ransac(
     // the other points by many σ (tele lenses, small sets). Refine the best candidates on their
     // closest points and score again.
     let mut best = top[0];
-    for &(_, inliers, pose) in &top {
+    let candidates = if n <= FEW_POINTS { top.len() } else { 1 };
+    for &(_, inliers, pose) in &top[..candidates] {
         let camera = Camera {
             intrinsics: *intrinsics,
             pose,
