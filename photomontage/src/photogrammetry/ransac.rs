@@ -25,8 +25,9 @@ const LOCAL_OPTIMISATION_CANDIDATES: usize = 5;
 /// Below this many triples (8 points) every triple is tried: deterministic and as cheap as
 /// sampling.
 const EXHAUSTIVE_MAX_TRIPLES: usize = 56;
-/// Above this many points only the best candidate gets the local optimisation: with many
-/// points the best MSAC pose is reliably in the right basin.
+/// Up to this many points the best candidates get the local optimisation; with more points
+/// the best MSAC pose is reliably in the right basin and the refinement that follows
+/// ([`super::resection`]) does the same job.
 const FEW_POINTS: usize = 8;
 
 /// Squared normalised reprojection error of `o` for a camera, using σ_px and the control σ
@@ -149,7 +150,7 @@ pub(super) fn ransac(
     // the other points by many σ (tele lenses, small sets). Refine the best candidates on their
     // closest points and score again.
     let mut best = top[0];
-    let candidates = if n <= FEW_POINTS { top.len() } else { 1 };
+    let candidates = if n <= FEW_POINTS { top.len() } else { 0 };
     for &(_, inliers, pose) in &top[..candidates] {
         let camera = Camera {
             intrinsics: *intrinsics,
