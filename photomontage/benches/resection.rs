@@ -2,6 +2,10 @@
 //! statistics and data snooping included. Peers (OpenCV 5.0, same data, 1 thread, from
 //! `shared/bench/peers/results/opencv.json`): SQPnP 14.6 µs, ITERATIVE 68 µs (12 points).
 //!
+//! Measured 2026-11-21 (release, 2-core shared Xeon, load ≈ 3): median 59 µs (12 points) and
+//! 148 µs (50 points), i.e. 0.87× and 1.7× OpenCV ITERATIVE (68 / 86 µs), 4.1× and 9.9×
+//! SQPnP (14.6 / 15.0 µs). Our time includes the RANSAC start, covariance and data snooping.
+//!
 //! Data: `shared/bench/data/opencv/pnp_{12,50}.json` (set `PHOTOMONTAGE_SHARED` or keep the
 //! shared folder beside the checkout), else seeded synthetic scenes of the same geometry.
 

@@ -594,6 +594,7 @@ pub fn bundle_adjust(
     let variance = sigma0.max(1.0).powi(2);
     let mut photo_reports = Vec::with_capacity(photos.len());
     let mut point_sq = vec![(0.0, 0usize); problem.priors.len()];
+    let mut fixed_sq: HashMap<String, (f64, usize)> = HashMap::new();
     let mut total_sq = 0.0;
     for (p, photo) in photos.iter().enumerate() {
         let camera = state.cameras[p];
@@ -623,9 +624,18 @@ pub fn bundle_adjust(
             if o.active {
                 sum_sq += v.norm_squared();
                 used += 1;
-                if let PointRef::Unknown(q) = o.point {
-                    point_sq[q].0 += v.norm_squared();
-                    point_sq[q].1 += 1;
+                match o.point {
+                    PointRef::Unknown(q) => {
+                        point_sq[q].0 += v.norm_squared();
+                        point_sq[q].1 += 1;
+                    }
+                    PointRef::Fixed(_) => {
+                        let e = fixed_sq
+                            .entry(o.observation.point_id.clone())
+                            .or_insert((0.0, 0));
+                        e.0 += v.norm_squared();
+                        e.1 += 1;
+                    }
                 }
             } else {
                 outliers.push(o.observation.point_id.clone());
@@ -691,17 +701,18 @@ pub fn bundle_adjust(
     }
     for (id, r) in &point_index {
         if let PointRef::Fixed(x) = r {
+            let (sq, rays) = fixed_sq.get(id).copied().unwrap_or((0.0, 0));
             points.push(BundlePointReport {
                 id: id.clone(),
                 point_in_world: x + origin,
                 sigma_m: [0.0; 3],
-                rms_px: f64::NAN,
+                rms_px: if rays > 0 {
+                    (sq / (2 * rays) as f64).sqrt()
+                } else {
+                    f64::NAN
+                },
                 is_control: true,
-                rays: problem
-                    .observations
-                    .iter()
-                    .filter(|o| o.active && o.observation.point_id == *id)
-                    .count(),
+                rays,
             });
         }
     }

@@ -155,3 +155,34 @@ fn no_control_is_degenerate() {
         Err(PhotogrammetryError::Degenerate { .. } | PhotogrammetryError::NoConvergence)
     ));
 }
+
+#[test]
+fn focal_lengths_are_estimated_per_photo_where_supported() {
+    let spec = BlockSpec {
+        photos: 8,
+        points: 80,
+        control: 8,
+        control_sigma_m: 0.0,
+        sigma_px: 0.5,
+        initial_center_error_m: 0.3,
+        initial_rotation_error: 0.005,
+        seed: 15,
+    };
+    let b = block(&spec);
+    let mut ph = photos(&b);
+    for p in &mut ph {
+        p.camera.intrinsics.focal_px *= 1.03;
+        p.self_calibration.focal = true;
+    }
+    let report = bundle_adjust(&ph, &b.control, &BundleOptions::default()).expect("solvable");
+    for (p, truth) in report.photos.iter().zip(&b.true_cameras) {
+        assert!(p.estimated.focal, "{:?}", report.warnings);
+        let sigma = p.sigma_focal_px.expect("estimated");
+        let error = p.camera.intrinsics.focal_px - truth.intrinsics.focal_px;
+        assert!(
+            error.abs() <= SIGMA_BOUND * sigma,
+            "{}: focal error {error} vs σ {sigma}",
+            p.id
+        );
+    }
+}

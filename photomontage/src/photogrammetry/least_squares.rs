@@ -117,7 +117,7 @@ pub(crate) fn spd_inverse(normal: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let chol = scaled.cholesky()?;
     let l = chol.l_dirty();
     let min_pivot = (0..n).map(|i| l[(i, i)]).fold(f64::INFINITY, f64::min);
-    if !(min_pivot > 1e-9) {
+    if min_pivot.is_nan() || min_pivot <= 1e-9 {
         return None;
     }
     let inv = chol.inverse();

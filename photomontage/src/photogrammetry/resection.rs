@@ -31,9 +31,7 @@
 
 use std::collections::HashMap;
 
-use nalgebra::{DMatrix, DVector, Matrix2, Point2, Point3, Unit, Vector2, Vector3};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use nalgebra::{DMatrix, DVector, Matrix2, Point2, Point3, SMatrix, SVector, Vector2, Vector3};
 use serde::Serialize;
 
 use super::least_squares::{
@@ -42,11 +40,12 @@ use super::least_squares::{
 use super::projection::{
     apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
 };
+use super::ransac::{normalised_error_sq, ransac};
 use super::{
-    ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, p3p, validate_control,
+    ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, validate_control,
     validate_intrinsics, validate_observations,
 };
-use crate::camera::{Camera, Intrinsics, Pose};
+use crate::camera::{Camera, Intrinsics};
 
 /// Tunables of [`resect`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -142,22 +141,23 @@ const COINCIDENT_SIGMA: f64 = 3.0;
 const PLANARITY_RATIO: f64 = 1e-3;
 /// Collinear when the second principal extent is below this fraction of the largest.
 const COLLINEARITY_RATIO: f64 = 1e-6;
-const MIN_RANSAC_ITERATIONS: usize = 20;
-/// Number of best RANSAC poses given a local least-squares optimisation.
-const LOCAL_OPTIMISATION_CANDIDATES: usize = 5;
 const MAX_REFINE_ROUNDS: usize = 5;
 
 /// One active observation inside the adjustment.
 #[derive(Clone)]
-struct Obs {
-    index: usize,
-    point: Point3<f64>,
-    pixel: Point2<f64>,
-    sigma_px: f64,
-    control_sigma_m: [f64; 3],
+pub(super) struct Obs {
+    pub(super) index: usize,
+    pub(super) point: Point3<f64>,
+    pub(super) pixel: Point2<f64>,
+    pub(super) sigma_px: f64,
+    pub(super) control_sigma_m: [f64; 3],
 }
 
-struct Problem<'a> {
+/// Pose (6) + all intrinsics (focal, ppx, ppy, k1, k2).
+const MAX_UNKNOWNS: usize = 11;
+type Rows = SMatrix<f64, 2, MAX_UNKNOWNS>;
+
+pub(super) struct Problem<'a> {
     obs: &'a [Obs],
     /// Whitening matrices C⁻¹ with C Cᵀ = Σ of each observation.
     whitening: Vec<Matrix2<f64>>,
@@ -166,7 +166,7 @@ struct Problem<'a> {
 }
 
 impl<'a> Problem<'a> {
-    fn new(obs: &'a [Obs], camera: &Camera, free: SelfCalibration) -> Self {
+    pub(super) fn new(obs: &'a [Obs], camera: &Camera, free: SelfCalibration) -> Self {
         let whitening = obs.iter().map(|o| whitening_matrix(o, camera)).collect();
         Self {
             obs,
@@ -177,14 +177,14 @@ impl<'a> Problem<'a> {
     }
 
     /// Whitened residual and Jacobian rows of observation `k`.
-    fn rows(&self, camera: &Camera, k: usize) -> Option<(Vector2<f64>, DMatrix<f64>)> {
+    /// Columns beyond `unknowns()` are zero (fixed size: no allocation in the hot loop).
+    fn rows(&self, camera: &Camera, k: usize) -> Option<(Vector2<f64>, Rows)> {
         let o = &self.obs[k];
         let pj = project_with_jacobian(camera, &o.point)?;
         let l = self.whitening[k];
         let r = l * (pj.pixel - o.pixel);
-        let m = 6 + self.intrinsic_columns.len();
-        let mut j = DMatrix::zeros(2, m);
-        j.view_mut((0, 0), (2, 6)).copy_from(&(l * pj.d_pose));
+        let mut j = Rows::zeros();
+        j.fixed_view_mut::<2, 6>(0, 0).copy_from(&(l * pj.d_pose));
         for (c, &col) in self.intrinsic_columns.iter().enumerate() {
             let d = l * pj.d_intrinsics.column(col);
             j[(0, 6 + c)] = d.x;
@@ -209,16 +209,20 @@ impl NormalEquations for Problem<'_> {
     }
     fn normal_equations(&self, camera: &Camera) -> Option<(DMatrix<f64>, DVector<f64>, f64)> {
         let m = self.unknowns();
-        let mut n = DMatrix::zeros(m, m);
-        let mut g = DVector::zeros(m);
+        let mut n = SMatrix::<f64, MAX_UNKNOWNS, MAX_UNKNOWNS>::zeros();
+        let mut g = SVector::<f64, MAX_UNKNOWNS>::zeros();
         let mut cost = 0.0;
         for k in 0..self.obs.len() {
             let (r, j) = self.rows(camera, k)?;
-            n += j.transpose() * &j;
+            n += j.transpose() * j;
             g += j.transpose() * r;
             cost += r.norm_squared();
         }
-        Some((n, g, cost))
+        Some((
+            DMatrix::from_fn(m, m, |a, b| n[(a, b)]),
+            DVector::from_fn(m, |a, _| g[a]),
+            cost,
+        ))
     }
     fn update(&self, camera: &Camera, delta: &DVector<f64>) -> Camera {
         let d = delta.as_slice();
@@ -232,11 +236,11 @@ impl NormalEquations for Problem<'_> {
 /// C⁻¹ where C Cᵀ = σ_px² I + J_X Σ_X J_Xᵀ (control σ projected into the image).
 fn whitening_matrix(o: &Obs, camera: &Camera) -> Matrix2<f64> {
     let mut cov = Matrix2::identity() * (o.sigma_px * o.sigma_px);
-    if o.control_sigma_m.iter().any(|s| *s > 0.0) {
-        if let Some(pj) = project_with_jacobian(camera, &o.point) {
-            let s = Vector3::from(o.control_sigma_m.map(|s| s * s));
-            cov += pj.d_point * nalgebra::Matrix3::from_diagonal(&s) * pj.d_point.transpose();
-        }
+    if o.control_sigma_m.iter().any(|s| *s > 0.0)
+        && let Some(pj) = project_with_jacobian(camera, &o.point)
+    {
+        let s = Vector3::from(o.control_sigma_m.map(|s| s * s));
+        cov += pj.d_point * nalgebra::Matrix3::from_diagonal(&s) * pj.d_point.transpose();
     }
     cov.cholesky()
         .and_then(|c| c.l().try_inverse())
@@ -305,21 +309,19 @@ pub fn resect(
     }
     let planar = extents[2] <= PLANARITY_RATIO * extents[0];
     let mut warnings = Vec::new();
-    if planar {
-        if let Some((a, b, dp, dw)) = coincident_pair(&all) {
-            if n - 1 < MIN_POINTS {
-                return Err(PhotogrammetryError::CoincidentObservations {
-                    first: observations[a].point_id.clone(),
-                    second: observations[b].point_id.clone(),
-                    pixel_distance_px: dp,
-                    world_distance_m: dw,
-                });
-            }
-            warnings.push(format!(
-                "observations of {} and {} are {dp:.2} px apart but the points are {dw:.2} m apart on a plane: one label is wrong",
-                observations[a].point_id, observations[b].point_id
-            ));
+    if planar && let Some((a, b, dp, dw)) = coincident_pair(&all) {
+        if n - 1 < MIN_POINTS {
+            return Err(PhotogrammetryError::CoincidentObservations {
+                first: observations[a].point_id.clone(),
+                second: observations[b].point_id.clone(),
+                pixel_distance_px: dp,
+                world_distance_m: dw,
+            });
         }
+        warnings.push(format!(
+            "observations of {} and {} are {dp:.2} px apart but the points are {dw:.2} m apart on a plane: one label is wrong",
+            observations[a].point_id, observations[b].point_id
+        ));
     }
     if n < MIN_POINTS {
         return Err(PhotogrammetryError::NotEnoughPoints {
@@ -526,154 +528,10 @@ fn coincident_pair(all: &[Obs]) -> Option<(usize, usize, f64, f64)> {
     None
 }
 
-/// Squared normalised reprojection error of `o` for a camera, using σ_px and the control σ
-/// scaled by focal/depth (isotropic approximation, good enough for scoring).
-fn normalised_error_sq(camera: &Camera, o: &Obs) -> Option<f64> {
-    let pc = camera.pose.camera_from_world(&o.point);
-    if pc.z <= 0.0 {
-        return None;
-    }
-    let pixel = camera.project(&o.point)?;
-    let sigma_ctrl = o.control_sigma_m.iter().fold(0.0_f64, |m, s| m.max(*s));
-    let sigma_sq =
-        o.sigma_px * o.sigma_px + (camera.intrinsics.focal_px * sigma_ctrl / pc.z).powi(2);
-    Some((pixel - o.pixel).norm_squared() / sigma_sq)
-}
-
 /// Whether `o` is consistent with `camera`: within `threshold` σ or within the gate (pixels).
 fn is_inlier(camera: &Camera, o: &Obs, threshold: f64, gate_px: f64) -> bool {
     normalised_error_sq(camera, o)
         .is_some_and(|e2| e2 <= threshold * threshold || e2.sqrt() * o.sigma_px <= gate_px)
-}
-
-/// RANSAC over P3P samples; returns the pose with the best MSAC score.
-fn ransac(
-    all: &[Obs],
-    intrinsics: &Intrinsics,
-    options: &ResectionOptions,
-    gate_px: f64,
-) -> Option<Pose> {
-    let n = all.len();
-    let bearings: Vec<Unit<Vector3<f64>>> = all
-        .iter()
-        .map(|o| {
-            let p = intrinsics.normalised_from_pixel(o.pixel);
-            Unit::new_normalize(Vector3::new(p.x, p.y, 1.0))
-        })
-        .collect();
-    let threshold = options.outlier_threshold_sigma;
-    let score = |pose: &Pose| -> (f64, usize) {
-        let camera = Camera {
-            intrinsics: *intrinsics,
-            pose: *pose,
-        };
-        let mut cost = 0.0;
-        let mut inliers = 0;
-        for o in all {
-            let cap = if gate_px > 0.0 {
-                (gate_px / o.sigma_px).max(threshold).powi(2)
-            } else {
-                threshold * threshold
-            };
-            let e2 = normalised_error_sq(&camera, o).unwrap_or(f64::INFINITY);
-            if e2 < cap {
-                inliers += 1;
-                cost += e2;
-            } else {
-                cost += cap;
-            }
-        }
-        (cost, inliers)
-    };
-    let mut top: Vec<(f64, usize, Pose)> = Vec::with_capacity(LOCAL_OPTIMISATION_CANDIDATES + 1);
-    let try_triple = |t: [usize; 3], top: &mut Vec<(f64, usize, Pose)>| {
-        let b = [bearings[t[0]], bearings[t[1]], bearings[t[2]]];
-        let p = [all[t[0]].point, all[t[1]].point, all[t[2]].point];
-        for pose in p3p::p3p(&b, &p) {
-            let (cost, inliers) = score(&pose);
-            if top.len() < LOCAL_OPTIMISATION_CANDIDATES
-                || top.last().is_some_and(|(c, _, _)| cost < *c)
-            {
-                let at = top.partition_point(|(c, _, _)| *c <= cost);
-                top.insert(at, (cost, inliers, pose));
-                top.truncate(LOCAL_OPTIMISATION_CANDIDATES);
-            }
-        }
-    };
-    let triples = n * (n - 1) * (n - 2) / 6;
-    if triples <= options.max_ransac_iterations {
-        for a in 0..n {
-            for b in a + 1..n {
-                for c in b + 1..n {
-                    try_triple([a, b, c], &mut top);
-                }
-            }
-        }
-    } else {
-        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-        let mut needed = options.max_ransac_iterations;
-        let mut iteration = 0;
-        while iteration < needed.max(MIN_RANSAC_ITERATIONS)
-            && iteration < options.max_ransac_iterations
-        {
-            iteration += 1;
-            let a = rng.random_range(0..n);
-            let mut b = rng.random_range(0..n - 1);
-            if b >= a {
-                b += 1;
-            }
-            let mut c = rng.random_range(0..n - 2);
-            for lo in [a.min(b), a.max(b)] {
-                if c >= lo {
-                    c += 1;
-                }
-            }
-            try_triple([a, b, c], &mut top);
-            if let Some((_, inliers, _)) = top.first() {
-                let w = *inliers as f64 / n as f64;
-                let miss = 1.0 - w.powi(3);
-                needed = if miss <= 1e-12 {
-                    0
-                } else {
-                    ((1.0 - options.ransac_confidence).ln() / miss.ln())
-                        .ceil()
-                        .max(0.0) as usize
-                };
-            }
-        }
-    }
-    let (_, best_inliers, _) = *top.first()?;
-    if best_inliers == n {
-        return top.first().map(|t| t.2);
-    }
-    // Local optimisation (Chum, Matas & Kittler 2003): a P3P pose from three noisy rays can miss
-    // the other points by many σ (tele lenses, small sets). Refine the best candidates on their
-    // closest points and score again.
-    let mut best = top[0];
-    for &(_, inliers, pose) in &top {
-        let camera = Camera {
-            intrinsics: *intrinsics,
-            pose,
-        };
-        let mut ranked: Vec<(f64, &Obs)> = all
-            .iter()
-            .filter_map(|o| normalised_error_sq(&camera, o).map(|e| (e, o)))
-            .collect();
-        ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let keep = inliers.max(MIN_POINTS);
-        if ranked.len() < keep {
-            continue;
-        }
-        let subset: Vec<Obs> = ranked[..keep].iter().map(|(_, o)| (*o).clone()).collect();
-        let problem = Problem::new(&subset, &camera, SelfCalibration::default());
-        if let Some(sol) = levenberg_marquardt(&problem, camera) {
-            let (cost, inliers) = score(&sol.state.pose);
-            if cost < best.0 {
-                best = (cost, inliers, sol.state.pose);
-            }
-        }
-    }
-    (best.1 >= MIN_POINTS).then_some(best.2)
 }
 
 /// Alternates LM on the current inliers with reclassification of every observation until the
@@ -722,11 +580,19 @@ fn refine_and_reclassify(
 /// w = r / √(redundancy number), maximised over the two coordinates of each observation.
 fn worst_normalised(problem: &Problem<'_>, camera: &Camera) -> Option<(usize, f64)> {
     let (normal, _, _) = problem.normal_equations(camera)?;
-    let inverse = spd_inverse(&normal)?;
+    let inverse_dyn = spd_inverse(&normal)?;
+    let m = inverse_dyn.nrows();
+    let inverse = SMatrix::<f64, MAX_UNKNOWNS, MAX_UNKNOWNS>::from_fn(|a, b| {
+        if a < m && b < m {
+            inverse_dyn[(a, b)]
+        } else {
+            0.0
+        }
+    });
     let mut worst: Option<(usize, f64)> = None;
     for k in 0..problem.obs.len() {
         let (r, j) = problem.rows(camera, k)?;
-        let h = &j * &inverse * j.transpose();
+        let h = j * inverse * j.transpose();
         for c in 0..2 {
             let redundancy_number = 1.0 - h[(c, c)];
             if redundancy_number <= 1e-6 {

@@ -310,3 +310,39 @@ fn coincident_plane_points_in_a_small_set_are_an_error() {
         Err(PhotogrammetryError::CoincidentObservations { .. })
     ));
 }
+
+#[test]
+fn control_sigma_propagates_into_the_pose_sigma() {
+    // Surveyed positions carry 5 cm errors (σ = 0.05 m per axis); at 30 m with f = 3000 px that
+    // is ~5 px, ten times σ_px, so the pose σ must come from the control σ to cover the error.
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    let s = scene(30);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+    let sigma_m = 0.05;
+    let control: Vec<ControlPoint> = s
+        .control
+        .iter()
+        .map(|c| {
+            let mut e = || -> f64 { StandardNormal.sample(&mut rng) };
+            ControlPoint {
+                id: c.id.clone(),
+                point_in_world: c.point_in_world + Vector3::new(e(), e(), e()) * sigma_m,
+                sigma_m: [sigma_m; 3],
+            }
+        })
+        .collect();
+    let options = ResectionOptions::new(s.camera.intrinsics);
+    let r = resect(&control, &s.observations, &options).expect("solvable");
+    assert!(r.outliers.is_empty(), "{:?}", r.outliers);
+    let dc = r.camera.pose.camera_center_in_world - s.camera.pose.camera_center_in_world;
+    for axis in 0..3 {
+        assert!(
+            dc[axis].abs() <= SIGMA_BOUND * r.sigma_center_m[axis],
+            "{dc} vs {:?}",
+            r.sigma_center_m
+        );
+    }
+    // σ₀ stays near 1 because the weights include the control σ.
+    assert!(r.sigma0 < 1.5, "σ0 {}", r.sigma0);
+}

@@ -72,7 +72,11 @@ pub fn single_photo(spec: &SceneSpec) -> SyntheticScene {
     let (center, target) = match spec.layout {
         // Oblique view of the ground from 45° elevation.
         Layout::Ground => (
-            Point3::new(5.0, -d * 0.7071, d * 0.7071),
+            Point3::new(
+                5.0,
+                -d * std::f64::consts::FRAC_1_SQRT_2,
+                d * std::f64::consts::FRAC_1_SQRT_2,
+            ),
             Point3::new(5.0, 0.0, 0.0),
         ),
         _ => (
