@@ -9,3 +9,4 @@
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
 pub mod camera;
+pub mod luminaire;

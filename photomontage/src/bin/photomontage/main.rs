@@ -1,5 +1,7 @@
 //! The `photomontage` command-line tool.
 
+mod luminaire;
+
 use clap::{Parser, Subcommand};
 
 /// Photogrammetric photomontage: solve site cameras, model daylight, render planned buildings.
@@ -14,9 +16,14 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Read an IES LM-63 or EULUMDAT file: format, flux, max intensity, symmetry, plot.
+    Luminaire(luminaire::LuminaireArgs),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Luminaire(args) => luminaire::run(&args),
+    }
 }
