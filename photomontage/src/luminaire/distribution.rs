@@ -35,6 +35,7 @@
 
 use nalgebra::{Point3, Rotation3, Vector3};
 use serde::Serialize;
+use std::f64::consts::TAU;
 use thiserror::Error;
 
 /// Angles closer than this (degrees) are the same angle when planes are mirrored and merged.
@@ -462,61 +463,34 @@ impl PhotometricWeb {
     }
 
     /// Total luminous flux (lm): the exact integral of the bilinear interpolant over the sphere
-    /// (see the module doc for the quadrature).
+    /// (see the module doc for the quadrature), evaluated as Σ_h Σ_v w_h · w_v · I[h][v] with
+    /// weights that depend only on the angles.
     #[must_use]
     pub fn total_flux_lm(&self) -> f64 {
-        let nh = self.horizontal_deg.len();
-        let nv = self.vertical_deg.len();
         let hs: Vec<f64> = self.horizontal_deg.iter().map(|a| a.to_radians()).collect();
         let vs: Vec<f64> = self.vertical_deg.iter().map(|a| a.to_radians()).collect();
-        match self.photometric_type {
-            PhotometricType::C => {
-                // Cyclic trapezoid weights over C.
-                let weights: Vec<f64> = if nh == 1 {
-                    vec![std::f64::consts::TAU]
-                } else {
-                    (0..nh)
-                        .map(|i| {
-                            let prev = if i == 0 {
-                                hs[0] - (hs[nh - 1] - std::f64::consts::TAU)
-                            } else {
-                                hs[i] - hs[i - 1]
-                            };
-                            let next = if i + 1 == nh {
-                                hs[0] + std::f64::consts::TAU - hs[i]
-                            } else {
-                                hs[i + 1] - hs[i]
-                            };
-                            0.5 * (prev + next)
-                        })
-                        .collect()
-                };
-                (0..nh)
-                    .map(|h| {
-                        let column: Vec<f64> = (0..nv).map(|v| self.value(h, v)).collect();
-                        weights[h] * integrate_linear_times(&vs, &column, Kernel::Sin)
-                    })
-                    .sum()
-            }
-            PhotometricType::A => {
-                // Latitude is V (within each H plane); trapezoid over H.
-                (0..nh)
-                    .map(|h| {
-                        let column: Vec<f64> = (0..nv).map(|v| self.value(h, v)).collect();
-                        trapezoid_weight(&hs, h) * integrate_linear_times(&vs, &column, Kernel::Cos)
-                    })
-                    .sum()
-            }
-            PhotometricType::B => {
-                // Latitude is H; trapezoid over V.
-                (0..nv)
-                    .map(|v| {
-                        let column: Vec<f64> = (0..nh).map(|h| self.value(h, v)).collect();
-                        trapezoid_weight(&vs, v) * integrate_linear_times(&hs, &column, Kernel::Cos)
-                    })
-                    .sum()
-            }
-        }
+        let (wh, wv) = match self.photometric_type {
+            // Cyclic trapezoid over C, exact sin-weighted integral over γ.
+            PhotometricType::C => (
+                cyclic_trapezoid_weights(&hs),
+                linear_quadrature_weights(&vs, Kernel::Sin),
+            ),
+            // Latitude is V (within each H plane); trapezoid over H.
+            PhotometricType::A => (
+                trapezoid_weights(&hs),
+                linear_quadrature_weights(&vs, Kernel::Cos),
+            ),
+            // Latitude is H; trapezoid over V.
+            PhotometricType::B => (
+                linear_quadrature_weights(&hs, Kernel::Cos),
+                trapezoid_weights(&vs),
+            ),
+        };
+        let nv = vs.len();
+        wh.iter()
+            .zip(self.intensity_cd.chunks_exact(nv))
+            .map(|(w, row)| w * row.iter().zip(&wv).map(|(i, wi)| i * wi).sum::<f64>())
+            .sum()
     }
 }
 
@@ -533,44 +507,73 @@ enum Kernel {
     Cos,
 }
 
-/// Half the span of the neighbouring intervals (non-cyclic trapezoid weight).
-fn trapezoid_weight(angles: &[f64], i: usize) -> f64 {
+/// Trapezoid weights (radians) on a non-cyclic axis; a single angle gets weight 0.
+fn trapezoid_weights(angles: &[f64]) -> Vec<f64> {
     let n = angles.len();
-    if n < 2 {
-        return 0.0;
-    }
-    let left = if i == 0 {
-        0.0
-    } else {
-        angles[i] - angles[i - 1]
-    };
-    let right = if i + 1 == n {
-        0.0
-    } else {
-        angles[i + 1] - angles[i]
-    };
-    0.5 * (left + right)
+    (0..n)
+        .map(|i| {
+            if n < 2 {
+                return 0.0;
+            }
+            let left = if i == 0 {
+                0.0
+            } else {
+                angles[i] - angles[i - 1]
+            };
+            let right = if i + 1 == n {
+                0.0
+            } else {
+                angles[i + 1] - angles[i]
+            };
+            0.5 * (left + right)
+        })
+        .collect()
 }
 
-/// ∫ f(x)·k(x) dx for f linear between the samples, k = sin or cos, in closed form.
-fn integrate_linear_times(x: &[f64], f: &[f64], kernel: Kernel) -> f64 {
-    let mut sum = 0.0;
-    for i in 1..x.len().min(f.len()) {
+/// Trapezoid weights over a cyclic axis of period 2π; a single angle gets the full 2π.
+fn cyclic_trapezoid_weights(angles: &[f64]) -> Vec<f64> {
+    let n = angles.len();
+    if n == 1 {
+        return vec![TAU];
+    }
+    (0..n)
+        .map(|i| {
+            let prev = if i == 0 {
+                angles[0] - (angles[n - 1] - TAU)
+            } else {
+                angles[i] - angles[i - 1]
+            };
+            let next = if i + 1 == n {
+                angles[0] + TAU - angles[i]
+            } else {
+                angles[i + 1] - angles[i]
+            };
+            0.5 * (prev + next)
+        })
+        .collect()
+}
+
+/// Weights w such that Σ w_i f_i = ∫ f(x)·k(x) dx exactly for f linear between the samples,
+/// k = sin or cos. Per segment [a, b] of width h:
+/// sin: ∫ sin = cos a − cos b and ∫ (x−a) sin x = −h cos b + sin b − sin a;
+/// cos: ∫ cos = sin b − sin a and ∫ (x−a) cos x = h sin b + cos b − cos a.
+fn linear_quadrature_weights(x: &[f64], kernel: Kernel) -> Vec<f64> {
+    let mut w = vec![0.0; x.len()];
+    for i in 1..x.len() {
         let (a, b) = (x[i - 1], x[i]);
-        let (fa, fb) = (f[i - 1], f[i]);
-        let w = b - a;
-        if w <= 0.0 {
+        let h = b - a;
+        if h <= 0.0 {
             continue;
         }
-        let slope = (fb - fa) / w;
-        sum += match kernel {
-            // ∫ sin = cos a − cos b; ∫ (x−a) sin x = −w cos b + sin b − sin a.
-            Kernel::Sin => fa * (a.cos() - b.cos()) + slope * (-w * b.cos() + b.sin() - a.sin()),
-            // ∫ cos = sin b − sin a; ∫ (x−a) cos x = w sin b + cos b − cos a.
-            Kernel::Cos => fa * (b.sin() - a.sin()) + slope * (w * b.sin() + b.cos() - a.cos()),
+        let (whole, first_moment) = match kernel {
+            Kernel::Sin => (a.cos() - b.cos(), -h * b.cos() + b.sin() - a.sin()),
+            Kernel::Cos => (b.sin() - a.sin(), h * b.sin() + b.cos() - a.cos()),
         };
+        // f = f_a + (f_b − f_a)(x − a)/h.
+        w[i - 1] += whole - first_moment / h;
+        w[i] += first_moment / h;
     }
-    sum
+    w
 }
 
 /// A luminaire as a light source: a photometric web placed at a point and aimed by a rotation.

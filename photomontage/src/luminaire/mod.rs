@@ -85,13 +85,13 @@ pub enum LuminaireError {
         message: String,
     },
     /// An IES parse error.
-    #[error("IES LM-63: {0}")]
+    #[error(transparent)]
     Ies(#[from] IesError),
     /// An EULUMDAT parse error.
-    #[error("EULUMDAT: {0}")]
+    #[error(transparent)]
     Eulumdat(#[from] EulumdatError),
     /// The photometric web could not be built.
-    #[error("distribution: {0}")]
+    #[error(transparent)]
     Distribution(#[from] DistributionError),
 }
 
