@@ -355,3 +355,32 @@ fn parsers_never_panic_on_mutated_real_files() {
         }
     }
 }
+
+#[test]
+fn polynomial_fit_of_a_real_curve_improves_with_degree() {
+    use photomontage::luminaire::curve_fit::PolynomialFit;
+    // Üncü & Kayakuş §2.1 on the BEGA LED downlight (axial, 73 γ angles to 180°). Least squares
+    // over nested polynomial spaces: the residual can never grow with the degree.
+    let Some(path) =
+        shared_file("data/real/ies/Testlamp_Isym1_007cfb11e343e2f42e3b476be4ab684e.ies")
+    else {
+        return;
+    };
+    let web = IesFile::read(&path).unwrap().distribution().unwrap();
+    let gammas = web.vertical_deg().to_vec();
+    let values: Vec<f64> = gammas.iter().map(|&g| web.intensity_cd(0.0, g)).collect();
+    let mut previous = f64::INFINITY;
+    for degree in 0..=12 {
+        let fit = PolynomialFit::fit(&gammas, &values, degree).unwrap();
+        eprintln!(
+            "degree {degree:2}: rms residual {:.2} cd ({:.2} % of peak)",
+            fit.rms_residual,
+            100.0 * fit.rms_residual / web.max_intensity_cd()
+        );
+        assert!(
+            fit.rms_residual <= previous * (1.0 + 1e-9),
+            "degree {degree}"
+        );
+        previous = fit.rms_residual;
+    }
+}

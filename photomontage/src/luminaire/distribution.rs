@@ -29,7 +29,8 @@
 //! Type A/B files are evaluated in their own frame (never resampled to C/γ), with mirroring only
 //! for lateral symmetry (horizontal angles starting at 0); vertical angles starting at 0 are taken
 //! literally (no light below V = 0). Tilt multipliers depend only on the luminaire's tilt from
-//! its photometric position, for all three lamp-to-luminaire geometries (as ies2rad does).
+//! its photometric position (the angle between its nadir axis and the world's downward
+//! vertical) for all three lamp-to-luminaire geometries; the geometry code is kept, not used.
 //! Interpolation is linear, not the cubic spline some tools offer (the echowuzangye table shows
 //! the two differ by < 0.01 % in flux).
 
