@@ -1,6 +1,6 @@
 //! The photometric web: luminous intensity I in candela over a grid of angles, expanded to the
 //! full sphere from the symmetry the file declares, with bilinear interpolation, total flux by
-//! exact integration of that interpolant, and a positioned, aimed [`Luminaire`].
+//! exact integration of that interpolant (the positioned, aimed source is in [`super::source`]).
 //!
 //! Sources: IES LM-63-2002 §§ on photometric types and angle ranges (via the summary in
 //! `reference/lighting.md` §4.1); CIE 121:1996 / EN 13032-1 for the A, B and C coordinate
@@ -34,7 +34,7 @@
 //! Interpolation is linear, not the cubic spline some tools offer (the echowuzangye table shows
 //! the two differ by < 0.01 % in flux).
 
-use nalgebra::{Point3, Rotation3, Vector3};
+use nalgebra::Vector3;
 use serde::Serialize;
 use std::f64::consts::TAU;
 use thiserror::Error;
@@ -577,74 +577,6 @@ fn linear_quadrature_weights(x: &[f64], kernel: Kernel) -> Vec<f64> {
     w
 }
 
-/// A luminaire as a light source: a photometric web placed at a point and aimed by a rotation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Luminaire {
-    /// The intensity distribution in the luminaire frame.
-    pub distribution: PhotometricWeb,
-    /// Optional tilt multipliers (LM-63 TILT=INCLUDE).
-    pub tilt: Option<TiltTable>,
-    /// Photometric centre in world coordinates (m).
-    pub position_in_world: Point3<f64>,
-    /// Rotation taking luminaire-frame directions to world directions (identity: nadir down).
-    pub world_from_luminaire: Rotation3<f64>,
-}
-
-impl Luminaire {
-    /// A luminaire hanging in its photometric position (nadir = world −z) at `position_in_world`.
-    #[must_use]
-    pub fn new(distribution: PhotometricWeb, position_in_world: Point3<f64>) -> Self {
-        Self {
-            distribution,
-            tilt: None,
-            position_in_world,
-            world_from_luminaire: Rotation3::identity(),
-        }
-    }
-
-    /// The angle (degrees) between the luminaire's nadir axis and the world's downward vertical.
-    #[must_use]
-    pub fn tilt_deg(&self) -> f64 {
-        let nadir = self.world_from_luminaire * Vector3::new(0.0, 0.0, -1.0);
-        (-nadir.z).clamp(-1.0, 1.0).acos().to_degrees()
-    }
-
-    /// Intensity (cd) emitted toward `dir_in_world`, tilt multiplier included.
-    #[must_use]
-    pub fn intensity_toward_cd(&self, dir_in_world: &Vector3<f64>) -> f64 {
-        let dir_in_luminaire = self.world_from_luminaire.inverse() * dir_in_world;
-        let tilt_factor = self
-            .tilt
-            .as_ref()
-            .map_or(1.0, |t| t.multiplier_at(self.tilt_deg()));
-        self.distribution.intensity_toward_cd(&dir_in_luminaire) * tilt_factor
-    }
-
-    /// Direct illuminance (lx) at `point_in_world` on a surface with normal `normal_in_world`,
-    /// by the inverse-square cosine law E = I cos θ / d² (no occlusion).
-    #[must_use]
-    pub fn illuminance_lx(
-        &self,
-        point_in_world: &Point3<f64>,
-        normal_in_world: &Vector3<f64>,
-    ) -> f64 {
-        let to_point = point_in_world - self.position_in_world;
-        let d2 = to_point.norm_squared();
-        let Some(n) = normal_in_world.try_normalize(1e-300) else {
-            return 0.0;
-        };
-        if d2 <= 0.0 {
-            return 0.0;
-        }
-        let dir = to_point / d2.sqrt();
-        let cos_incidence = -dir.dot(&n);
-        if cos_incidence <= 0.0 {
-            return 0.0;
-        }
-        self.intensity_toward_cd(&dir) * cos_incidence / d2
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -814,32 +746,6 @@ mod tests {
                 found: 1
             })
         );
-    }
-
-    #[test]
-    fn luminaire_inverse_square_and_aiming() {
-        let v = grid(5.0, 0.0, 180.0);
-        let web = PhotometricWeb::from_planes(
-            PhotometricType::C,
-            Symmetry::Axial,
-            &[0.0],
-            &v,
-            &v.iter()
-                .map(|g| if *g < 90.0 { 1000.0 } else { 0.0 })
-                .collect::<Vec<_>>(),
-        )
-        .unwrap();
-        let lum = Luminaire::new(web.clone(), Point3::new(0.0, 0.0, 5.0));
-        // 1000 cd straight down onto a floor 5 m below: 40 lx.
-        let e = lum.illuminance_lx(&Point3::origin(), &Vector3::z());
-        assert_relative_eq!(e, 40.0, max_relative = 1e-12);
-        // Aimed straight up (rotated 180° about x), the floor is dark and a ceiling is lit.
-        let mut up = Luminaire::new(web, Point3::new(0.0, 0.0, 5.0));
-        up.world_from_luminaire = Rotation3::from_axis_angle(&Vector3::x_axis(), PI);
-        assert_relative_eq!(up.tilt_deg(), 180.0, epsilon = 1e-9);
-        assert_relative_eq!(up.illuminance_lx(&Point3::origin(), &Vector3::z()), 0.0);
-        let e_ceiling = up.illuminance_lx(&Point3::new(0.0, 0.0, 7.0), &-Vector3::z());
-        assert_relative_eq!(e_ceiling, 250.0, max_relative = 1e-12);
     }
 
     #[test]

@@ -8,7 +8,8 @@
 //!
 //! - [`ies`]: LM-63 parser (all editions, TILT, types A/B/C, absolute photometry).
 //! - [`eulumdat`]: `.ldt` parser (Isym 0–4, lamp sets, comma decimals, non-equidistant angles).
-//! - [`distribution`]: [`PhotometricWeb`] (I(C, γ), flux, max) and [`Luminaire`].
+//! - [`distribution`]: [`PhotometricWeb`] (I(C, γ), flux, max), tilt tables.
+//! - [`source`]: [`Luminaire`], a positioned and aimed light source.
 //! - [`curve_fit`]: polynomial least-squares fit of intensity curves.
 //! - [`polar_plot`]: polar intensity diagram as an image.
 //!
@@ -23,13 +24,14 @@ pub mod distribution;
 pub mod eulumdat;
 pub mod ies;
 pub mod polar_plot;
+pub mod source;
 
 pub use distribution::{
-    DistributionError, LampGeometry, Luminaire, PhotometricType, PhotometricWeb, Symmetry,
-    TiltTable,
+    DistributionError, LampGeometry, PhotometricType, PhotometricWeb, Symmetry, TiltTable,
 };
 pub use eulumdat::{EulumdatError, EulumdatFile};
 pub use ies::{IesError, IesFile, IesVersion};
+pub use source::Luminaire;
 
 use std::path::Path;
 use thiserror::Error;
