@@ -13,6 +13,7 @@ pub mod bvh;
 pub mod camera;
 pub mod colour;
 pub mod geo;
+pub mod luminaire;
 pub mod photo;
 pub mod photogrammetry;
 pub mod scene;

@@ -1,6 +1,7 @@
 //! The `photomontage` command-line tool.
 
 mod info;
+mod luminaire;
 mod report;
 mod resect;
 mod sky;
@@ -34,6 +35,8 @@ enum Command {
     Sun(sun::SunArgs),
     /// CIE standard sky: E_h/L_z and a fisheye luminance map.
     Sky(sky::SkyArgs),
+    /// Read an IES LM-63 or EULUMDAT file: format, flux, max intensity, symmetry, plot.
+    Luminaire(luminaire::LuminaireArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -44,5 +47,6 @@ fn main() -> anyhow::Result<()> {
         Command::Resect(args) => resect::run(&args),
         Command::Sun(args) => sun::run(&args),
         Command::Sky(args) => sky::run(&args),
+        Command::Luminaire(args) => luminaire::run(&args),
     }
 }
