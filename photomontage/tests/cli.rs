@@ -1,4 +1,5 @@
 //! The `photomontage` command line on the bundled sample site: JSON fields, exit codes, errors.
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use std::path::PathBuf;
 use std::process::Command;

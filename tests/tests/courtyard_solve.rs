@@ -1,4 +1,5 @@
 //! End to end: solve the bundled courtyard sample site and compare with the generator's truth.
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use nalgebra::{Matrix3, Rotation3};
 use photomontage::site::{SiteDocument, apply_solution, solve_site, stored_camera};
@@ -51,7 +52,7 @@ fn courtyard_cameras_match_truth_within_reported_sigma() {
             .as_array()
             .unwrap()
             .iter()
-            .flat_map(|r| vec3(r))
+            .flat_map(vec3)
             .collect();
         let r_true = Rotation3::from_matrix(&Matrix3::from_row_slice(&rows));
         let angle_deg = (r_true.inverse() * s.camera.pose.rotation_world_from_camera)

@@ -1,5 +1,6 @@
 //! EXIF and orientation on real camera JPEGs none of us wrote (`../shared/data/real/exif/`,
 //! expected values read with exiftool, see SOURCES.md there).
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use photomontage::photo::{self, FocalSource};
 use photomontage_tests::shared_file;

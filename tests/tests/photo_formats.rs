@@ -1,4 +1,5 @@
 //! Every photo format the site accepts decodes to float RGB as displayed.
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use photomontage::photo::{self, Transfer};
 use photomontage_tests::shared_file;

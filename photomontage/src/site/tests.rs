@@ -63,6 +63,7 @@ fn parse(text: &str) -> Result<Site, SiteError> {
 }
 
 #[test]
+#[allow(clippy::float_cmp)] // the default is this exact literal
 fn example_parses_with_defaults() {
     let site = parse(EXAMPLE).unwrap();
     assert_eq!(site.photos.len(), 2);
