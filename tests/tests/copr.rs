@@ -11,11 +11,10 @@ use photomontage::camera::Intrinsics;
 use photomontage::photogrammetry::control_io::parse_odm_gcp_list;
 use photomontage::photogrammetry::{PhotogrammetryError, ResectionOptions, resect};
 
-/// Canon EOS 450D: 22.2 mm sensor width over 4272 px; EF 28-80 at 30 mm (EXIF). Until the
-/// `photo::exif` module lands these constants stand in for the EXIF reader.
-const FOCAL_MM: f64 = 30.0;
-const SENSOR_WIDTH_MM: f64 = 22.2;
-const IMAGE_SIZE_PX: [u32; 2] = [4272, 2848];
+/// Canon EOS 450D with the EF 28-80 at 30 mm: EXIF FocalPlaneXResolution 4865.6 px/inch gives
+/// f ≈ 5747 px (textbook_examples.md §4); the EXIF reader must agree to 0.1 %.
+const EXPECTED_FOCAL_PX: f64 = 30.0 * 4865.6 / 25.4;
+const FOCAL_TOLERANCE: f64 = 1e-3;
 /// Hand-picked GCP centres in ODM lists are good to a few pixels.
 const SIGMA_PX: f64 = 2.0;
 /// Averaged handheld-GPS targets: decimetre class.
@@ -27,7 +26,7 @@ fn copr_gcp_list_parses_and_the_mislabelled_point_is_named() {
     else {
         return;
     };
-    let text = std::fs::read_to_string(path).expect("readable");
+    let text = std::fs::read_to_string(&path).expect("readable");
     let list = parse_odm_gcp_list(&text).expect("valid ODM list");
     assert!(list.crs.starts_with("+proj=utm +zone=11"));
     assert_eq!(list.rows.len(), 27);
@@ -38,8 +37,19 @@ fn copr_gcp_list_parses_and_the_mislabelled_point_is_named() {
     assert_eq!(control.len(), 10);
     assert!(control.iter().all(|c| c.point_in_world.z == 0.0));
 
-    let focal_px = FOCAL_MM * f64::from(IMAGE_SIZE_PX[0]) / SENSOR_WIDTH_MM;
-    let options = ResectionOptions::new(Intrinsics::centred(focal_px, IMAGE_SIZE_PX));
+    // The initial focal length comes from the photo's own EXIF, as `solve` does it.
+    let photo_path = path.with_file_name("IMG_0031.jpg");
+    let size = photomontage::photo::size_px(&photo_path).expect("photo readable");
+    assert_eq!(size, [4272, 2848]);
+    let exif = photomontage::photo::read_exif(&photo_path).expect("EXIF readable");
+    let focal_px = photomontage::photo::initial_focal_px(&exif, size)
+        .expect("EXIF focal length")
+        .focal_px;
+    assert!(
+        (focal_px / EXPECTED_FOCAL_PX - 1.0).abs() < FOCAL_TOLERANCE,
+        "{focal_px}"
+    );
+    let options = ResectionOptions::new(Intrinsics::centred(focal_px, size));
 
     let obs31 = list.observations("IMG_0031.jpg", SIGMA_PX);
     assert_eq!(obs31.len(), 3);
