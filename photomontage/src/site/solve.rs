@@ -20,8 +20,8 @@ use super::{Exterior, Interior, Site, SiteDocument, TiePoint};
 use crate::camera::{Camera, Intrinsics};
 use crate::photo::{self, FocalSource};
 use crate::photogrammetry::{
-    self as pg, BundleOptions, BundlePhoto, ControlPoint, ImageObservation, ObservationResidual,
-    PhotogrammetryError, ResectionOptions, SelfCalibration,
+    self as pg, BundleOptions, BundlePhoto, BundlePointReport, ControlPoint, ImageObservation,
+    ObservationResidual, PhotogrammetryError, ResectionOptions, SelfCalibration,
 };
 
 /// Why a photo could not be solved.
@@ -83,23 +83,13 @@ pub struct PhotoFailure {
     pub error: String,
 }
 
-/// A point estimated from the photos.
-#[derive(Debug, Clone, Serialize)]
-pub struct PointSolution {
-    pub id: String,
-    pub point_in_world: Point3<f64>,
-    pub sigma_m: [f64; 3],
-    pub rms_px: f64,
-    pub is_control: bool,
-    pub rays: usize,
-}
-
 /// Everything a solve found.
 #[derive(Debug, Clone, Serialize)]
 pub struct SiteSolution {
     pub photos: Vec<PhotoSolution>,
     pub failures: Vec<PhotoFailure>,
-    pub points: Vec<PointSolution>,
+    /// Control and tie points as the bundle adjustment estimated them.
+    pub points: Vec<BundlePointReport>,
     /// RMS of the bundle adjustment over all observations, when it ran.
     pub bundle_rms_px: Option<f64>,
     pub warnings: Vec<String>,
@@ -348,18 +338,7 @@ pub fn solve_site(doc: &SiteDocument) -> SiteSolution {
                         };
                     }
                 }
-                points = report
-                    .points
-                    .into_iter()
-                    .map(|p| PointSolution {
-                        id: p.id,
-                        point_in_world: p.point_in_world,
-                        sigma_m: p.sigma_m,
-                        rms_px: p.rms_px,
-                        is_control: p.is_control,
-                        rays: p.rays,
-                    })
-                    .collect();
+                points = report.points;
             }
             Err(e) => warnings.push(format!(
                 "bundle adjustment failed, keeping the single-photo resections: {e}"

@@ -25,7 +25,7 @@ pub struct Args {
 struct Output<'a> {
     photos: Vec<PhotoRecord<'a>>,
     failures: &'a [photomontage::site::solve::PhotoFailure],
-    tie_points: Vec<&'a photomontage::site::solve::PointSolution>,
+    tie_points: Vec<&'a photomontage::photogrammetry::BundlePointReport>,
     bundle_rms_px: Option<f64>,
     warnings: &'a [String],
     written_to: Option<String>,
