@@ -67,6 +67,11 @@ pub struct Lighting {
     pub artificial_lights: Vec<PointLight>,
     /// Schachter atmosphere (eq. 2); `None` for a clear atmosphere.
     pub atmosphere: Option<SchachterAtmosphere>,
+    /// Light reflected by the photographed surroundings onto artificial objects (one diffuse
+    /// bounce gathered over these facets and their mirror images below the horizon): a gather
+    /// ray that hits a natural object brings the photo's radiance of that point (its true colour,
+    /// darkened where the sun is blocked by an artificial object only). `None` disables it.
+    pub photo_bounce_dome: Option<crate::sky_dome::SkyDome>,
     /// Horizon colour L∞ returned by case B (when there is no atmosphere, the sky colour seen in
     /// mirrors).
     pub horizon_rgb: Rgb,
@@ -374,10 +379,13 @@ impl<'a> DifferentialTracer<'a> {
                 f64::INFINITY,
             )
         });
-        let e = add(
+        let mut e = add(
             e_natural,
             self.artificial_light_irradiance(&origin, &normal).0,
         );
+        if depth < self.max_depth {
+            e = add(e, self.photo_bounce_irradiance(&origin, &normal));
+        }
         let mut l0 = diffuse_radiance_rgb(rho, e);
         if let Some(m) = material {
             if let Some(emission) = m.emission_rgb_w_m2_sr {
@@ -463,7 +471,9 @@ impl<'a> DifferentialTracer<'a> {
         for &i in &sky_d3 {
             e_d3 = add(e_d3, daylight.sky[i].irradiance_rgb(&normal));
         }
-        let delta = diffuse_radiance_rgb(rho, add(e_d1, scale(e_d3, -1.0)));
+        // D1 for the light the artificial objects reflect onto the point.
+        let e_reflected = self.artificial_bounce_irradiance(&origin, &normal);
+        let delta = diffuse_radiance_rgb(rho, add(add(e_d1, e_reflected), scale(e_d3, -1.0)));
         self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m)
     }
 
@@ -510,6 +520,150 @@ impl<'a> DifferentialTracer<'a> {
         }
     }
 
+    /// Irradiance at an artificial point from natural surfaces, their radiance taken from the
+    /// photo (see [`Lighting::photo_bounce_dome`]).
+    fn photo_bounce_irradiance(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
+        let Some(dome) = &self.lighting.photo_bounce_dome else {
+            return [0.0; 3];
+        };
+        let mut e = [0.0; 3];
+        for facet in &dome.facets {
+            let up = facet.centre_dir_in_world;
+            let down = Vector3::new(up.x, up.y, -up.z);
+            for dir in [up, down] {
+                let cos = dir.dot(normal);
+                if cos <= 0.0 {
+                    continue;
+                }
+                let ray = self.all.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
+                let Some(hit) = self.all.closest_hit(&ray) else {
+                    continue;
+                };
+                if hit.kind != ObjectKind::Natural {
+                    continue;
+                }
+                let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
+                let l = self.natural_radiance_for_bounce(&hit, &point, &dir, f64::from(hit.hit.t));
+                e = add(e, scale(l, cos * facet.solid_angle_sr));
+            }
+        }
+        e
+    }
+
+    /// Irradiance at a natural point from light reflected by artificial objects, gathered over
+    /// the facets of [`Lighting::photo_bounce_dome`] (upper and mirrored lower hemisphere).
+    fn artificial_bounce_irradiance(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
+        let Some(dome) = &self.lighting.photo_bounce_dome else {
+            return [0.0; 3];
+        };
+        let mut e = [0.0; 3];
+        for facet in &dome.facets {
+            let up = facet.centre_dir_in_world;
+            let down = Vector3::new(up.x, up.y, -up.z);
+            for dir in [up, down] {
+                let cos = dir.dot(normal);
+                if cos <= 0.0 || !self.may_hit_artificial(origin, &dir, f64::INFINITY) {
+                    continue;
+                }
+                let ray = self.all.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
+                let Some(hit) = self.all.closest_hit(&ray) else {
+                    continue;
+                };
+                if hit.kind != ObjectKind::Artificial {
+                    continue;
+                }
+                let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
+                let l =
+                    self.artificial_radiance_for_bounce(&hit, &point, &dir, f64::from(hit.hit.t));
+                e = add(e, scale(l, cos * facet.solid_angle_sr));
+            }
+        }
+        e
+    }
+
+    /// Radiance leaving an artificial point towards a gather ray: eq. 6 with the sun's
+    /// visibility traced and the sky facets facing the surface taken as visible (one bounce
+    /// only: no further gather), then eq. 2 over `distance_m`.
+    fn artificial_radiance_for_bounce(
+        &self,
+        hit: &SceneHit,
+        point: &Point3<f64>,
+        dir_in_world: &Vector3<f64>,
+        distance_m: f64,
+    ) -> Rgb {
+        let normal = self.normal_facing(hit, dir_in_world);
+        let origin = point + normal * SURFACE_OFFSET_M;
+        let daylight = &self.lighting.daylight;
+        let rho = self
+            .scene
+            .materials()
+            .get(hit.material.0 as usize)
+            .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
+        let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
+            s.dir_in_world.dot(&normal) > 0.0
+                && !Self::blocked_by(&self.all, &origin, &s.dir_in_world, f64::INFINITY)
+        });
+        let e = natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true);
+        self.apparent(diffuse_radiance_rgb(rho, e), distance_m)
+    }
+
+    /// Radiance leaving a natural point towards a gather ray: the photo's true colour, with the
+    /// sun removed where only an artificial object blocks it (case D3 for the sun; sky
+    /// visibility at the point is taken as unobstructed for the inversion), then eq. 2 over
+    /// `distance_m`. Points not seen in the photo are shaded by their library material.
+    fn natural_radiance_for_bounce(
+        &self,
+        hit: &SceneHit,
+        point: &Point3<f64>,
+        dir_in_world: &Vector3<f64>,
+        distance_m: f64,
+    ) -> Rgb {
+        let normal = self.normal_facing(hit, dir_in_world);
+        let origin = point + normal * SURFACE_OFFSET_M;
+        let daylight = &self.lighting.daylight;
+        let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
+            s.dir_in_world.dot(&normal) > 0.0
+                && !self.natural_blocks(&origin, &s.dir_in_world, f64::INFINITY)
+        });
+        let e_natural = natural_irradiance_rgb(daylight, &normal, sun_natural, |_| true);
+        let l0 = match self.photo_colour_of(point) {
+            Some((photo_rgb, photo_distance_m)) => {
+                let l0 = self.true_colour(photo_rgb, photo_distance_m);
+                let sun_d3 = sun_natural
+                    && daylight.sun.as_ref().is_some_and(|s| {
+                        self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
+                    });
+                match (sun_d3, &daylight.sun) {
+                    (true, Some(s)) => {
+                        diffuse_reflectance_from_true_colour(l0, e_natural).map_or(l0, |rho| {
+                            add(
+                                l0,
+                                scale(diffuse_radiance_rgb(rho, s.irradiance_rgb(&normal)), -1.0),
+                            )
+                        })
+                    }
+                    _ => l0,
+                }
+            }
+            None => {
+                let rho = self
+                    .scene
+                    .materials()
+                    .get(hit.material.0 as usize)
+                    .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
+                let sun_visible = sun_natural
+                    && daylight.sun.as_ref().is_some_and(|s| {
+                        !self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
+                    });
+                diffuse_radiance_rgb(
+                    rho,
+                    natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true),
+                )
+            }
+        };
+        self.apparent(l0, distance_m)
+    }
+
     /// The photo's colour (bilinear) at a world point and its distance from the camera, when the
     /// point is seen in the photo (projects inside and is not hidden by other geometry).
     fn photo_colour_of(&self, point: &Point3<f64>) -> Option<(Rgb, f64)> {
@@ -520,13 +674,11 @@ impl<'a> DifferentialTracer<'a> {
         let centre = self.camera.pose.camera_center_in_world;
         let to_point = point - centre;
         let dist = to_point.norm();
-        let ray = self
-            .all
-            .ray_from_world(&centre, &to_point, 0.0, f32::INFINITY);
-        let hit = self.all.closest_hit(&ray)?;
-        if hit.kind != ObjectKind::Natural
-            || (f64::from(hit.hit.t) - dist).abs() > 1e-3 * dist.max(1.0)
-        {
+        // The photo shows no artificial object: visibility against the natural geometry only.
+        let natural = self.natural.as_ref()?;
+        let ray = natural.ray_from_world(&centre, &to_point, 0.0, f32::INFINITY);
+        let hit = natural.closest_hit(&ray)?;
+        if (f64::from(hit.hit.t) - dist).abs() > 1e-3 * dist.max(1.0) {
             return None;
         }
         Some((bilinear(self.photo_linear, pixel), dist))
