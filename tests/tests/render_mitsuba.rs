@@ -19,36 +19,43 @@ use photomontage::sky_dome::durisch_facets::durisch_dome;
 use photomontage_tests::shared_file;
 use serde_json::Value;
 
-/// Downscale factor of the test.
-const SCALE: u32 = 4;
+/// Downscale factor of the test (`RENDER_MITSUBA_SCALE` overrides it, e.g. 1 for full size).
+const DEFAULT_SCALE: u32 = 4;
+
+fn scale() -> u32 {
+    std::env::var("RENDER_MITSUBA_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&s| s > 0)
+        .unwrap_or(DEFAULT_SCALE)
+}
 
 /// Box pixels: the issue's acceptance goal (3 %); measured 2.0 %. Our model has sun, sky facets and
-/// light reflected from the photographed ground (one gather bounce over a Durisch m_h = 6 dome);
-/// Mitsuba also has two further bounces.
+/// light reflected from the photographed ground (one gather over a Durisch m_h = 6 dome, and an
+/// m_h = 2 gather for the box's light reaching the shadow); Mitsuba's paths have up to 3 bounces.
 const BOX_MEAN_REL_TOL: f64 = 0.03;
-/// Shadow pixels: measured 4.8 % (goal 3 %). The light the box reflects onto the shadowed ground is
-/// gathered once, with the box's own radiance approximated (sky facets taken as visible, no
-/// ground bounce onto the box), and sky visibility is quantised to the facet centres (m_h = 8);
-/// the tolerance admits these approximations, not more (without the box bounce it is 11 %).
-const SHADOW_MEAN_REL_TOL: f64 = 0.06;
+/// Shadow pixels: the issue's acceptance goal (3 %); measured 2.0 % (4.8 % without the nested
+/// bounce that lights the box walls facing the shadow, 11 % without any bounce from the box).
+const SHADOW_MEAN_REL_TOL: f64 = 0.03;
 
 fn vec3(v: &Value) -> [f64; 3] {
     [0, 1, 2].map(|k| v[k].as_f64().unwrap())
 }
 
 fn downscale(img: &image::Rgb32FImage) -> image::Rgb32FImage {
-    let (w, h) = (img.width() / SCALE, img.height() / SCALE);
+    let scale = scale();
+    let (w, h) = (img.width() / scale, img.height() / scale);
     image::Rgb32FImage::from_fn(w, h, |x, y| {
         let mut s = [0.0_f64; 3];
-        for dy in 0..SCALE {
-            for dx in 0..SCALE {
-                let p = img.get_pixel(x * SCALE + dx, y * SCALE + dy).0;
+        for dy in 0..scale {
+            for dx in 0..scale {
+                let p = img.get_pixel(x * scale + dx, y * scale + dy).0;
                 for k in 0..3 {
                     s[k] += f64::from(p[k]);
                 }
             }
         }
-        let n = f64::from(SCALE * SCALE);
+        let n = f64::from(scale * scale);
         #[allow(clippy::cast_possible_truncation)]
         image::Rgb(s.map(|v| (v / n) as f32))
     })
@@ -161,6 +168,7 @@ fn box_and_shadow_match_mitsuba_1024spp() {
             sky: Daylight::uniform_sky_lights(&dome, vec3(&spec["sky"]["radiance_rgb"])),
         },
         photo_bounce_dome: Some(durisch_dome(6).unwrap()),
+        photo_bounce_nested_dome: Some(durisch_dome(2).unwrap()),
         horizon_rgb: vec3(&spec["sky"]["radiance_rgb"]),
         ..Lighting::default()
     };
@@ -193,6 +201,7 @@ fn box_and_shadow_match_mitsuba_1024spp() {
         .unwrap();
     }
     let (mut box_err, mut box_n, mut shadow_err, mut shadow_n, mut sq) = (0.0, 0, 0.0, 0, 0.0);
+    let (mut box_bias, mut shadow_bias) = (0.0, 0.0);
     for y in 0..h {
         for x in 0..w {
             let ours = out.rgba[(y * w + x) as usize];
@@ -205,12 +214,18 @@ fn box_and_shadow_match_mitsuba_1024spp() {
             sq += (0..3)
                 .map(|k| (f64::from(ours[k]) - f64::from(t[k])).powi(2))
                 .sum::<f64>();
+            let signed = (0..3)
+                .map(|k| (f64::from(ours[k]) - f64::from(t[k])) / f64::from(t[k]).max(1e-3))
+                .sum::<f64>()
+                / 3.0;
             let lum = |v: [f32; 3]| v.iter().map(|&c| f64::from(c)).sum::<f64>();
             if ours[3] >= 1.0 {
                 box_err += rel;
+                box_bias += signed;
                 box_n += 1;
             } else if ours[3] <= 0.0 && lum(t) < 0.8 * lum(p) {
                 shadow_err += rel;
+                shadow_bias += signed;
                 shadow_n += 1;
             }
         }
@@ -220,7 +235,9 @@ fn box_and_shadow_match_mitsuba_1024spp() {
     let rmse = (sq / f64::from(3 * w * h)).sqrt();
     println!(
         "mitsuba {w}x{h}: box pixels {box_n} mean rel err {box_mre:.4}; shadow pixels {shadow_n} \
-         mean rel err {shadow_mre:.4}; RMSE {rmse:.5}; changed pixels {}; rays/pixel {:.2}",
+         mean rel err {shadow_mre:.4}; signed: box {:+.4}, shadow {:+.4}; RMSE {rmse:.5}; changed pixels {}; rays/pixel {:.2}",
+        box_bias / f64::from(box_n),
+        shadow_bias / f64::from(shadow_n),
         out.changed_pixels,
         out.primary_rays as f64 / f64::from(w * h)
     );

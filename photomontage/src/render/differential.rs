@@ -19,6 +19,12 @@
 //! the artificial BVH are first culled by its bounding box, so the cost of proving that a pixel is
 //! unchanged is one closest hit plus a slab test per light.
 //!
+//! **Interreflection** (one bounce, when [`Lighting::photo_bounce_dome`] is set): an artificial
+//! point gathers the radiance of the natural surfaces around it from the photo (Durisch's
+//! secondary ray in case D, the photo standing for their true colour), and a changed natural
+//! point gathers the light the artificial objects reflect onto it (added like D1), those objects
+//! lit in turn by the photo over [`Lighting::photo_bounce_nested_dome`].
+//!
 //! Because eq. 2 is affine in L₀, the apparent colour of a changed natural point is computed as
 //! `L_photo + τ(d)·ΔL₀`: an unchanged point returns the photo value unaltered, bit for bit.
 //!
@@ -26,8 +32,13 @@
 //! Secondary rays that hit natural objects take their apparent colour from the current photo only
 //! (not from the polygon's image attribute photo), when the point is visible in it; otherwise the
 //! library material is shaded by eq. 6. Only ideal mirror reflection is recursed (no refraction,
-//! no glossy lobes). Light reflected by the new building onto natural surfaces (a diffuse bounce)
-//! is not added. Below-horizon secondary misses return black.
+//! no glossy lobes). The gather is one bounce on a fixed facet set (deterministic, so it has
+//! quantisation error rather than noise); the artificial radiance a natural point gathers takes sky
+//! facets as visible and gets its own photo bounce only from the coarser nested dome; natural surfaces blocked from the photo's view
+//! fall back to their library material; the light a natural surface no longer receives from
+//! other natural surfaces hidden by the building is not removed, and the bounce onto natural
+//! points is only added where a natural light is already changed (D1/D3). Below-horizon
+//! secondary misses return black.
 
 use image::Rgb32FImage;
 use nalgebra::{Point2, Point3, Vector3};
@@ -72,6 +83,10 @@ pub struct Lighting {
     /// ray that hits a natural object brings the photo's radiance of that point (its true colour,
     /// darkened where the sun is blocked by an artificial object only). `None` disables it.
     pub photo_bounce_dome: Option<crate::sky_dome::SkyDome>,
+    /// Facets of the second, coarser gather that gives the artificial surfaces seen by a natural
+    /// point's gather their own light from the photographed surroundings (a second bounce,
+    /// artificial → natural). `None` skips it.
+    pub photo_bounce_nested_dome: Option<crate::sky_dome::SkyDome>,
     /// Horizon colour L∞ returned by case B (when there is no atmosphere, the sky colour seen in
     /// mirrors).
     pub horizon_rgb: Rgb,
@@ -384,7 +399,14 @@ impl<'a> DifferentialTracer<'a> {
             self.artificial_light_irradiance(&origin, &normal).0,
         );
         if depth < self.max_depth {
-            e = add(e, self.photo_bounce_irradiance(&origin, &normal));
+            e = add(
+                e,
+                self.photo_bounce_irradiance(
+                    self.lighting.photo_bounce_dome.as_ref(),
+                    &origin,
+                    &normal,
+                ),
+            );
         }
         let mut l0 = diffuse_radiance_rgb(rho, e);
         if let Some(m) = material {
@@ -522,8 +544,13 @@ impl<'a> DifferentialTracer<'a> {
 
     /// Irradiance at an artificial point from natural surfaces, their radiance taken from the
     /// photo (see [`Lighting::photo_bounce_dome`]).
-    fn photo_bounce_irradiance(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
-        let Some(dome) = &self.lighting.photo_bounce_dome else {
+    fn photo_bounce_irradiance(
+        &self,
+        dome: Option<&crate::sky_dome::SkyDome>,
+        origin: &Point3<f64>,
+        normal: &Vector3<f64>,
+    ) -> Rgb {
+        let Some(dome) = dome else {
             return [0.0; 3];
         };
         let mut e = [0.0; 3];
@@ -603,7 +630,14 @@ impl<'a> DifferentialTracer<'a> {
             s.dir_in_world.dot(&normal) > 0.0
                 && !Self::blocked_by(&self.all, &origin, &s.dir_in_world, f64::INFINITY)
         });
-        let e = natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true);
+        let e = add(
+            natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true),
+            self.photo_bounce_irradiance(
+                self.lighting.photo_bounce_nested_dome.as_ref(),
+                &origin,
+                &normal,
+            ),
+        );
         self.apparent(diffuse_radiance_rgb(rho, e), distance_m)
     }
 
