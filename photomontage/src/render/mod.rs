@@ -1,6 +1,7 @@
 //! The differential renderer (Durisch 1992 §6): the planned building rendered into the current
 //! photo by a ray tracer that adds and subtracts light ([`differential`]) with the illumination
-//! model of §3.4 ([`illumination`]).
+//! model of §3.4 ([`illumination`]), optionally with one gathered bounce between the building and
+//! its photographed surroundings ([`Lighting::photo_bounce_dome`]).
 //!
 //! [`render_view`] cuts the image into square tiles processed in parallel with rayon. Each tile
 //! draws its random numbers from ChaCha8 seeded with the render seed and the tile index as the
