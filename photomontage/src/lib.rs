@@ -16,6 +16,7 @@ pub mod geo;
 pub mod luminaire;
 pub mod photo;
 pub mod photogrammetry;
+pub mod render;
 pub mod scene;
 pub mod site;
 pub mod sky;

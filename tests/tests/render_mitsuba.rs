@@ -1,0 +1,256 @@
+//! The differential renderer against Mitsuba 3 (issue 4 acceptance, "differential accuracy"):
+//! the 1024-spp `without_box` render is the photo, the box is rendered into it and compared with
+//! the 1024-spp `with_box` truth over the box pixels and the shadow pixels.
+//!
+//! The images are box-filtered 4 × 4 down to 320 × 180 (the camera's focal length and principal
+//! point scaled to match) to keep the test within seconds in the dev profile.
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
+use photomontage::camera::{BrownConrady, Camera, Intrinsics, Pose};
+use photomontage::render::{
+    Daylight, DifferentialTracer, DistantLight, Lighting, RenderSettings, render_view,
+};
+use photomontage::scene::{Material, ObjectKind, Scene, SceneObject};
+use photomontage::sky_dome::durisch_facets::durisch_dome;
+use photomontage_tests::shared_file;
+use serde_json::Value;
+
+/// Downscale factor of the test (`RENDER_MITSUBA_SCALE` overrides it, e.g. 1 for full size).
+const DEFAULT_SCALE: u32 = 4;
+
+fn scale() -> u32 {
+    std::env::var("RENDER_MITSUBA_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&s| s > 0)
+        .unwrap_or(DEFAULT_SCALE)
+}
+
+/// Box pixels: the issue's acceptance goal (3 %); measured 2.0 %. Our model has sun, sky facets and
+/// light reflected from the photographed ground (one gather over a Durisch m_h = 6 dome, and an
+/// m_h = 2 gather for the box's light reaching the shadow); Mitsuba's paths have up to 3 bounces.
+const BOX_MEAN_REL_TOL: f64 = 0.03;
+/// Shadow pixels: the issue's acceptance goal (3 %); measured 2.0 % (4.8 % without the nested
+/// bounce that lights the box walls facing the shadow, 11 % without any bounce from the box).
+const SHADOW_MEAN_REL_TOL: f64 = 0.03;
+
+fn vec3(v: &Value) -> [f64; 3] {
+    [0, 1, 2].map(|k| v[k].as_f64().unwrap())
+}
+
+fn downscale(img: &image::Rgb32FImage) -> image::Rgb32FImage {
+    let scale = scale();
+    let (w, h) = (img.width() / scale, img.height() / scale);
+    image::Rgb32FImage::from_fn(w, h, |x, y| {
+        let mut s = [0.0_f64; 3];
+        for dy in 0..scale {
+            for dx in 0..scale {
+                let p = img.get_pixel(x * scale + dx, y * scale + dy).0;
+                for k in 0..3 {
+                    s[k] += f64::from(p[k]);
+                }
+            }
+        }
+        let n = f64::from(scale * scale);
+        #[allow(clippy::cast_possible_truncation)]
+        image::Rgb(s.map(|v| (v / n) as f32))
+    })
+}
+
+fn load(path: &Path) -> image::Rgb32FImage {
+    photomontage::photo::load(path).unwrap().pixels
+}
+
+#[test]
+fn box_and_shadow_match_mitsuba_1024spp() {
+    let (Some(json), Some(photo_path), Some(truth_path)) = (
+        shared_file("bench/data/mitsuba/scene.json"),
+        shared_file("bench/data/mitsuba/llvm_ad_rgb_1024spp_without_box.exr"),
+        shared_file("bench/data/mitsuba/llvm_ad_rgb_1024spp_with_box.exr"),
+    ) else {
+        return;
+    };
+    let spec: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let photo = downscale(&load(&photo_path));
+    let truth = downscale(&load(&truth_path));
+
+    // Camera: Mitsuba's look-at with a vertical field of view.
+    let cam = &spec["camera"];
+    let eye = Point3::from(vec3(&cam["position"]));
+    let target = Point3::from(vec3(&cam["target"]));
+    let f = (target - eye).normalize();
+    let r = f.cross(&Vector3::from(vec3(&cam["up"]))).normalize();
+    let d = f.cross(&r);
+    let (w, h) = (photo.width(), photo.height());
+    let vfov = cam["vfov_deg"].as_f64().unwrap().to_radians();
+    let camera = Camera {
+        intrinsics: Intrinsics {
+            distortion: BrownConrady::default(),
+            ..Intrinsics::centred(f64::from(h) / 2.0 / (vfov / 2.0).tan(), [w, h])
+        },
+        pose: Pose {
+            rotation_world_from_camera: Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
+                r, d, f,
+            ])),
+            camera_center_in_world: eye,
+        },
+    };
+
+    // Scene: the natural ground and the artificial box.
+    let mut scene = Scene::new();
+    let add = |scene: &mut Scene, name: &str, kind, albedo: [f64; 3], faces: Vec<Vec<[f64; 3]>>| {
+        let m = scene.add_material(Material::diffuse(name, albedo)).unwrap();
+        let o = scene
+            .add_object(SceneObject {
+                name: name.into(),
+                kind,
+                image_attribute: None,
+            })
+            .unwrap();
+        for face in faces {
+            let poly: Vec<Point3<f64>> = face.into_iter().map(Point3::from).collect();
+            scene.add_polygon(&poly, m, o).unwrap();
+        }
+    };
+    let ground = &spec["ground"];
+    let corners: Vec<[f64; 3]> = ground["corners"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(vec3)
+        .collect();
+    add(
+        &mut scene,
+        "ground",
+        ObjectKind::Natural,
+        vec3(&ground["albedo_rgb"]),
+        vec![corners],
+    );
+    let building = &spec["building"];
+    let c: Vec<[f64; 3]> = building["corners"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(vec3)
+        .collect();
+    let faces = [
+        [0, 1, 3, 2],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [1, 3, 7, 5],
+        [3, 2, 6, 7],
+        [2, 0, 4, 6],
+    ]
+    .iter()
+    .map(|f| f.iter().map(|&i| c[i]).collect())
+    .collect();
+    add(
+        &mut scene,
+        "box",
+        ObjectKind::Artificial,
+        vec3(&building["albedo_rgb"]),
+        faces,
+    );
+
+    // Lights: directional sun, uniform sky on a Durisch dome (m_h = 8, 256 facets).
+    let dome = durisch_dome(8).unwrap();
+    let lighting = Lighting {
+        daylight: Daylight {
+            sun: Some(DistantLight {
+                dir_in_world: Vector3::from(vec3(&spec["sun"]["direction_to_sun"])).normalize(),
+                normal_irradiance_rgb: vec3(&spec["sun"]["irradiance_rgb"]),
+            }),
+            ambient_radiance_rgb: [0.0; 3],
+            sky: Daylight::uniform_sky_lights(&dome, vec3(&spec["sky"]["radiance_rgb"])),
+        },
+        photo_bounce_dome: Some(durisch_dome(6).unwrap()),
+        photo_bounce_nested_dome: Some(durisch_dome(2).unwrap()),
+        horizon_rgb: vec3(&spec["sky"]["radiance_rgb"]),
+        ..Lighting::default()
+    };
+    let tracer = DifferentialTracer::new(&scene, &lighting, &camera, &photo, 1).unwrap();
+    let out = render_view(
+        &tracer,
+        &RenderSettings::default(),
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+
+    if let Some(dir) = std::env::var_os("RENDER_MITSUBA_DUMP") {
+        let dir = Path::new(&dir);
+        out.write_png(
+            &dir.join("ours.png"),
+            &photomontage::colour::ToneMap::clamp(),
+        )
+        .unwrap();
+        let t = photomontage::render::RenderedImage {
+            size_px: [w, h],
+            rgba: truth.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+            changed_pixels: 0,
+            primary_rays: 0,
+        };
+        t.write_png(
+            &dir.join("truth.png"),
+            &photomontage::colour::ToneMap::clamp(),
+        )
+        .unwrap();
+    }
+    let (mut box_err, mut box_n, mut shadow_err, mut shadow_n, mut sq) = (0.0, 0, 0.0, 0, 0.0);
+    let (mut box_bias, mut shadow_bias) = (0.0, 0.0);
+    for y in 0..h {
+        for x in 0..w {
+            let ours = out.rgba[(y * w + x) as usize];
+            let t = truth.get_pixel(x, y).0;
+            let p = photo.get_pixel(x, y).0;
+            let rel = (0..3)
+                .map(|k| (f64::from(ours[k]) - f64::from(t[k])).abs() / f64::from(t[k]).max(1e-3))
+                .sum::<f64>()
+                / 3.0;
+            sq += (0..3)
+                .map(|k| (f64::from(ours[k]) - f64::from(t[k])).powi(2))
+                .sum::<f64>();
+            let signed = (0..3)
+                .map(|k| (f64::from(ours[k]) - f64::from(t[k])) / f64::from(t[k]).max(1e-3))
+                .sum::<f64>()
+                / 3.0;
+            let lum = |v: [f32; 3]| v.iter().map(|&c| f64::from(c)).sum::<f64>();
+            if ours[3] >= 1.0 {
+                box_err += rel;
+                box_bias += signed;
+                box_n += 1;
+            } else if ours[3] <= 0.0 && lum(t) < 0.8 * lum(p) {
+                shadow_err += rel;
+                shadow_bias += signed;
+                shadow_n += 1;
+            }
+        }
+    }
+    let box_mre = box_err / f64::from(box_n);
+    let shadow_mre = shadow_err / f64::from(shadow_n);
+    let rmse = (sq / f64::from(3 * w * h)).sqrt();
+    println!(
+        "mitsuba {w}x{h}: box pixels {box_n} mean rel err {box_mre:.4}; shadow pixels {shadow_n} \
+         mean rel err {shadow_mre:.4}; signed: box {:+.4}, shadow {:+.4}; RMSE {rmse:.5}; changed pixels {}; rays/pixel {:.2}",
+        box_bias / f64::from(box_n),
+        shadow_bias / f64::from(shadow_n),
+        out.changed_pixels,
+        out.primary_rays as f64 / f64::from(w * h)
+    );
+    assert!(
+        box_n > 1000 && shadow_n > 300,
+        "masks: {box_n} box, {shadow_n} shadow"
+    );
+    assert!(
+        box_mre <= BOX_MEAN_REL_TOL,
+        "box mean relative error {box_mre}"
+    );
+    assert!(
+        shadow_mre <= SHADOW_MEAN_REL_TOL,
+        "shadow mean relative error {shadow_mre}"
+    );
+}
