@@ -112,19 +112,7 @@ mod tests {
                     (e / want - 1.0).abs()
                 })
                 .collect();
-            eprintln!(
-                "{}: relative E_h errors by level {:?}",
-                module_path!(),
-                errors
-                    .iter()
-                    .map(|e| format!("{e:.2e}"))
-                    .collect::<Vec<_>>()
-            );
-            for w in errors.windows(2) {
-                assert!(w[1] < w[0], "not decreasing: {errors:?}");
-            }
-            let finest = errors.last().copied().unwrap_or(f64::INFINITY);
-            assert!(finest < tol, "{errors:?}");
+            test_support::assert_converges(module_path!(), &errors, tol);
         }
     }
 }

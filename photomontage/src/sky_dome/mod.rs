@@ -123,6 +123,18 @@ pub(crate) mod test_support {
     };
     use nalgebra::Vector3;
 
+    /// Prints the relative errors of a refinement sequence, then asserts that they fall at every
+    /// level and that the finest is below `tol`.
+    pub fn assert_converges(label: &str, errors: &[f64], tol: f64) {
+        let shown: Vec<String> = errors.iter().map(|e| format!("{e:.2e}")).collect();
+        eprintln!("{label}: relative E_h errors by level {shown:?}");
+        for w in errors.windows(2) {
+            assert!(w[1] < w[0], "not decreasing: {errors:?}");
+        }
+        let finest = errors.last().copied().unwrap_or(f64::INFINITY);
+        assert!(finest < tol, "{errors:?}");
+    }
+
     /// CIE overcast sky with L_z = 1: analytic E_h = 7π/9.
     pub fn overcast() -> (NormalisedSky, f64) {
         let sky = NormalisedSky::new(
