@@ -553,24 +553,46 @@ impl<'a> DifferentialTracer<'a> {
         let Some(dome) = dome else {
             return [0.0; 3];
         };
+        self.gather_over_dome(
+            dome,
+            origin,
+            normal,
+            ObjectKind::Natural,
+            |_| true,
+            |hit, point, dir, t| self.natural_radiance_for_bounce(hit, point, dir, t),
+        )
+    }
+
+    /// Irradiance at `origin` gathered over the facets of `dome` and their mirror images below
+    /// the horizon: each direction with a positive cosine that `worth_tracing` admits is traced,
+    /// and the first hit, if it is of `kind`, contributes `radiance · cos · solid angle`.
+    fn gather_over_dome(
+        &self,
+        dome: &crate::sky_dome::SkyDome,
+        origin: &Point3<f64>,
+        normal: &Vector3<f64>,
+        kind: ObjectKind,
+        worth_tracing: impl Fn(&Vector3<f64>) -> bool,
+        radiance: impl Fn(&SceneHit, &Point3<f64>, &Vector3<f64>, f64) -> Rgb,
+    ) -> Rgb {
         let mut e = [0.0; 3];
         for facet in &dome.facets {
             let up = facet.centre_dir_in_world;
             let down = Vector3::new(up.x, up.y, -up.z);
             for dir in [up, down] {
                 let cos = dir.dot(normal);
-                if cos <= 0.0 {
+                if cos <= 0.0 || !worth_tracing(&dir) {
                     continue;
                 }
                 let ray = self.all.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
                 let Some(hit) = self.all.closest_hit(&ray) else {
                     continue;
                 };
-                if hit.kind != ObjectKind::Natural {
+                if hit.kind != kind {
                     continue;
                 }
                 let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
-                let l = self.natural_radiance_for_bounce(&hit, &point, &dir, f64::from(hit.hit.t));
+                let l = radiance(&hit, &point, &dir, f64::from(hit.hit.t));
                 e = add(e, scale(l, cos * facet.solid_angle_sr));
             }
         }
@@ -583,29 +605,14 @@ impl<'a> DifferentialTracer<'a> {
         let Some(dome) = &self.lighting.photo_bounce_dome else {
             return [0.0; 3];
         };
-        let mut e = [0.0; 3];
-        for facet in &dome.facets {
-            let up = facet.centre_dir_in_world;
-            let down = Vector3::new(up.x, up.y, -up.z);
-            for dir in [up, down] {
-                let cos = dir.dot(normal);
-                if cos <= 0.0 || !self.may_hit_artificial(origin, &dir, f64::INFINITY) {
-                    continue;
-                }
-                let ray = self.all.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
-                let Some(hit) = self.all.closest_hit(&ray) else {
-                    continue;
-                };
-                if hit.kind != ObjectKind::Artificial {
-                    continue;
-                }
-                let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
-                let l =
-                    self.artificial_radiance_for_bounce(&hit, &point, &dir, f64::from(hit.hit.t));
-                e = add(e, scale(l, cos * facet.solid_angle_sr));
-            }
-        }
-        e
+        self.gather_over_dome(
+            dome,
+            origin,
+            normal,
+            ObjectKind::Artificial,
+            |dir| self.may_hit_artificial(origin, dir, f64::INFINITY),
+            |hit, point, dir, t| self.artificial_radiance_for_bounce(hit, point, dir, t),
+        )
     }
 
     /// Radiance leaving an artificial point towards a gather ray: eq. 6 with the sun's
