@@ -154,7 +154,9 @@ fn run_headless(mut studio: Studio) -> anyhow::Result<()> {
             time: Some(start.elapsed().as_secs_f64()),
             ..Default::default()
         };
-        let _ = ctx.run_ui(input, |ui| studio.ui(ui));
+        let mut output = ctx.run_ui(input, |ui| studio.ui(ui));
+        // No renderer: the texture uploads are dropped on purpose.
+        output.textures_delta.clear();
         std::thread::sleep(std::time::Duration::from_millis(16));
     }
 }
