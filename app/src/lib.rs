@@ -85,6 +85,7 @@ pub struct Studio {
     tab: SideTab,
     import_path: String,
     open_path: String,
+    new_point_id: String,
     pending: Vec<(Command, Option<String>)>,
 }
 
@@ -117,6 +118,7 @@ impl Studio {
             tab: SideTab::Points,
             import_path: String::new(),
             open_path: String::new(),
+            new_point_id: String::new(),
             pending: Vec::new(),
         };
         s.open(&options.site_path);
@@ -585,7 +587,7 @@ impl Studio {
     fn side_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut self.tab, SideTab::Points, "Points");
-            ui.selectable_value(&mut self.tab, SideTab::Solve, "Solve");
+            ui.selectable_value(&mut self.tab, SideTab::Solve, "Results");
         });
         ui.separator();
         match self.tab {
@@ -604,6 +606,38 @@ impl Studio {
             points::name_widget(ui, &r, "import path");
             if ui.button("Import").clicked() {
                 self.import();
+            }
+        });
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.new_point_id)
+                    .hint_text("tie point id (no survey)")
+                    .desired_width(160.0),
+            );
+            points::name_widget(ui, &r, "point id");
+            let id = self.new_point_id.trim();
+            if ui.button("Pick id").clicked() && !id.is_empty() {
+                self.selected_point = Some(id.to_owned());
+            }
+            // Points observed but not surveyed (tie points) are listed for picking too.
+            if let Some(doc) = self.doc.as_ref() {
+                let mut ties: Vec<&str> = doc
+                    .site
+                    .observations
+                    .iter()
+                    .map(|o| o.point.as_str())
+                    .filter(|p| !doc.site.control_points.iter().any(|c| c.id == *p))
+                    .collect();
+                ties.sort_unstable();
+                ties.dedup();
+                for t in ties {
+                    let sel = self.selected_point.as_deref() == Some(t);
+                    let r = ui.selectable_label(sel, t);
+                    points::name_widget(ui, &r, &format!("tie {t}"));
+                    if r.clicked() {
+                        self.selected_point = Some(t.to_owned());
+                    }
+                }
             }
         });
         let sel = self.selected_point.clone().unwrap_or_else(|| "none".into());
@@ -655,7 +689,7 @@ impl Studio {
             let r = ui.checkbox(&mut self.ui_state.show_residuals, "residual vectors");
             points::name_widget(ui, &r, "residual vectors");
             let r = ui.add(
-                egui::Slider::new(&mut self.ui_state.residual_exaggeration, 1.0..=500.0)
+                egui::Slider::new(&mut self.ui_state.residual_exaggeration, 1.0..=5000.0)
                     .logarithmic(true)
                     .text("×"),
             );

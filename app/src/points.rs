@@ -225,7 +225,7 @@ pub fn table_ui(
                                     None,
                                 ));
                             }
-                            if ui.small_button("✖").on_hover_text("remove").clicked() {
+                            if ui.small_button("del").on_hover_text("remove this observation").clicked() {
                                 commands.push((
                                     Command::RemoveObservation {
                                         photo: o.photo.clone(),

@@ -34,7 +34,7 @@ impl Default for UiState {
         Self {
             recent_sites: Vec::new(),
             show_residuals: true,
-            residual_exaggeration: 20.0,
+            residual_exaggeration: 200.0,
             loupe: true,
             loupe_zoom: 8.0,
         }
