@@ -56,7 +56,10 @@ fn main() {
     std::fs::create_dir(dir.path().join("photos")).expect("mkdir");
     let t = Instant::now();
     generate(&dir.path().join("photos/big.png"));
-    println!("generated {WIDTH_PX}×{HEIGHT_PX} PNG in {:.1} s", t.elapsed().as_secs_f64());
+    println!(
+        "generated {WIDTH_PX}×{HEIGHT_PX} PNG in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
     let site = Site {
         name: "frame-time bench".into(),
         photos: vec![Photo {
@@ -103,11 +106,7 @@ fn main() {
         stats("frame while decoding", frames_while_decoding);
     }
 
-    let rect = h
-        .state()
-        .view_transform()
-        .expect("photo view drawn")
-        .rect;
+    let rect = h.state().view_transform().expect("photo view drawn").rect;
     let (mut step_t, mut render_t, mut total_t) = (Vec::new(), Vec::new(), Vec::new());
     // Zoom in from fit to 16:1 over the first half, back out over the second, about a point
     // that wanders over the view, with a small pan every frame.
@@ -118,7 +117,11 @@ fn main() {
         let anchor = rect.center() + egui::vec2(phase.cos(), phase.sin()) * rect.size() * 0.3;
         {
             let v = h.state_mut().viewport_mut();
-            let factor = if i < FRAMES / 2 { per_frame } else { 1.0 / per_frame };
+            let factor = if i < FRAMES / 2 {
+                per_frame
+            } else {
+                1.0 / per_frame
+            };
             v.zoom_about(rect, anchor, factor);
             v.pan(egui::vec2(3.0 * phase.sin(), 2.0 * phase.cos()));
         }
@@ -131,8 +134,30 @@ fn main() {
         render_t.push(c - b);
         total_t.push(c - a);
     }
-    println!("{FRAMES} frames, window {}×{} points, zoom fit ({fit:.3}) → 16 → fit", WINDOW[0], WINDOW[1]);
+    println!(
+        "{FRAMES} frames, window {}×{} points, zoom fit ({fit:.3}) → 16 → fit",
+        WINDOW[0], WINDOW[1]
+    );
     stats("studio pass (step)", step_t);
     stats("render + read-back", render_t);
     stats("frame (sum)", total_t);
+
+    // Baseline: the same renderer and window with one label and no photo, to separate the
+    // renderer's own cost (lavapipe rasterising and reading back the window) from the photo's.
+    let mut base = Harness::builder()
+        .with_size(egui::vec2(WINDOW[0], WINDOW[1]))
+        .wgpu()
+        .build_ui(|ui| {
+            ui.label("baseline");
+        });
+    let mut base_t = Vec::new();
+    for _ in 0..BASELINE_FRAMES {
+        base.step();
+        let a = Instant::now();
+        base.render().expect("render");
+        base_t.push(a.elapsed());
+    }
+    stats("baseline render + read-back", base_t);
 }
+
+const BASELINE_FRAMES: usize = 30;

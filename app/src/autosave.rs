@@ -225,10 +225,7 @@ mod tests {
         site.name = "after".into();
         assert!(!a.tick(t0, 1, &site, &site_path).expect("tick"), "too soon");
         assert!(a.is_dirty(1));
-        assert!(
-            a.tick(t0 + DEBOUNCE, 1, &site, &site_path)
-                .expect("tick")
-        );
+        assert!(a.tick(t0 + DEBOUNCE, 1, &site, &site_path).expect("tick"));
         assert!(!a.is_dirty(1));
         let (doc, recovery) = open_with_recovery(&site_path).expect("open");
         assert_eq!(recovery, Recovery::Restored);
@@ -262,6 +259,9 @@ mod tests {
             wrote |= a.tick(t, revision, &site, &site_path).expect("tick");
             t += step;
         }
-        assert!(wrote, "continuous editing must not postpone the autosave forever");
+        assert!(
+            wrote,
+            "continuous editing must not postpone the autosave forever"
+        );
     }
 }

@@ -33,11 +33,17 @@ pub enum CommandError {
 pub enum Command {
     /// Inserts the observation of (photo, point), or replaces the existing one in place.
     /// `at` is the index for an insertion (end when `None` or past the end).
-    PutObservation { observation: Observation, at: Option<usize> },
+    PutObservation {
+        observation: Observation,
+        at: Option<usize>,
+    },
     /// Removes the observation of `point` in `photo`.
     RemoveObservation { photo: String, point: String },
     /// Inserts the control point, or replaces the one with the same id in place.
-    PutControlPoint { point: ControlPoint, at: Option<usize> },
+    PutControlPoint {
+        point: ControlPoint,
+        at: Option<usize>,
+    },
     /// Removes a control point (its observations stay; they refer to it by id).
     RemoveControlPoint { id: String },
     /// Sets a photo's interior and exterior orientation (a solve result).
@@ -97,9 +103,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
                         photo: observation.photo.clone(),
                         point: observation.point.clone(),
                     };
-                    let i = at.map_or(site.observations.len(), |i| {
-                        i.min(site.observations.len())
-                    });
+                    let i = at.map_or(site.observations.len(), |i| i.min(site.observations.len()));
                     site.observations.insert(i, observation);
                     inverse
                 }
@@ -427,8 +431,10 @@ mod tests {
     fn script_lines_parse_and_reject_garbage() {
         let s = site();
         let c = parse_script_line(&s, "place P1 Q 1.5 2.5").expect("valid");
-        assert!(matches!(c, Some(Command::PutObservation { ref observation, .. })
-            if observation.point == "Q" && (observation.x_px - 1.5).abs() < 1e-12));
+        assert!(
+            matches!(c, Some(Command::PutObservation { ref observation, .. })
+            if observation.point == "Q" && (observation.x_px - 1.5).abs() < 1e-12)
+        );
         assert_eq!(parse_script_line(&s, "  # note").expect("comment"), None);
         assert!(parse_script_line(&s, "place P1 Q x 2").is_err());
         assert!(parse_script_line(&s, "disable P1 Z").is_err());

@@ -528,7 +528,10 @@ impl Studio {
                 .selected_text("sites")
                 .show_ui(ui, |ui| {
                     for p in &recent {
-                        if ui.selectable_label(false, p.display().to_string()).clicked() {
+                        if ui
+                            .selectable_label(false, p.display().to_string())
+                            .clicked()
+                        {
                             chosen = Some(p.clone());
                         }
                     }
@@ -810,7 +813,11 @@ impl Studio {
             }
             let loupe = egui::Rect::from_min_size(min, egui::vec2(side, side));
             let at = t.photo_from_screen(hover);
-            let zoom = self.ui_state.loupe_zoom.max(self.viewport.zoom * 4.0).min(64.0);
+            let zoom = self
+                .ui_state
+                .loupe_zoom
+                .max(self.viewport.zoom * 4.0)
+                .min(64.0);
             viewport::paint_loupe(&ctx, &painter, photo, loupe, at, zoom);
             painter.text(
                 loupe.left_bottom() + egui::vec2(4.0, -4.0),

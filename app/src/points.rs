@@ -113,19 +113,21 @@ pub fn import_file(
             }
         })
         .collect();
-    batch.extend(observations.into_iter().map(|(photo, o)| {
-        Command::PutObservation {
-            observation: Observation {
-                photo,
-                point: o.point_id,
-                x_px: o.pixel.x,
-                y_px: o.pixel.y,
-                sigma_px: o.sigma_px,
-                enabled: true,
-            },
-            at: None,
-        }
-    }));
+    batch.extend(
+        observations
+            .into_iter()
+            .map(|(photo, o)| Command::PutObservation {
+                observation: Observation {
+                    photo,
+                    point: o.point_id,
+                    x_px: o.pixel.x,
+                    y_px: o.pixel.y,
+                    sigma_px: o.sigma_px,
+                    enabled: true,
+                },
+                at: None,
+            }),
+    );
     Ok(Command::Batch(batch))
 }
 
@@ -180,11 +182,8 @@ pub fn table_ui(
                     for axis in 0..3 {
                         row.col(|ui| {
                             let mut v = cp.xyz[axis];
-                            let r = ui.add(
-                                egui::DragValue::new(&mut v)
-                                    .speed(0.001)
-                                    .fixed_decimals(3),
-                            );
+                            let r =
+                                ui.add(egui::DragValue::new(&mut v).speed(0.001).fixed_decimals(3));
                             name_widget(ui, &r, &format!("{} {}", ["X", "Y", "Z"][axis], cp.id));
                             if r.changed() && v.is_finite() {
                                 let mut p = cp.clone();
@@ -225,7 +224,11 @@ pub fn table_ui(
                                     None,
                                 ));
                             }
-                            if ui.small_button("del").on_hover_text("remove this observation").clicked() {
+                            if ui
+                                .small_button("del")
+                                .on_hover_text("remove this observation")
+                                .clicked()
+                            {
                                 commands.push((
                                     Command::RemoveObservation {
                                         photo: o.photo.clone(),
@@ -274,12 +277,19 @@ mod tests {
         assert!(matches!(&b[1], Command::PutObservation { observation, .. }
             if observation.photo == "P1" && (observation.x_px - 10.5).abs() < 1e-12));
         let gcp = dir.path().join("gcp_list.txt");
-        std::fs::write(&gcp, "EPSG:2056\n1 2 3 40 50 IMG_1.jpg g1\n1 2 3 4 5 other.jpg g1\n")
-            .expect("write");
+        std::fs::write(
+            &gcp,
+            "EPSG:2056\n1 2 3 40 50 IMG_1.jpg g1\n1 2 3 4 5 other.jpg g1\n",
+        )
+        .expect("write");
         let Command::Batch(b) = import_file(&site, &gcp, None).expect("import") else {
             panic!("a batch");
         };
-        assert_eq!(b.len(), 2, "one point, one observation (other.jpg is not in the site)");
+        assert_eq!(
+            b.len(),
+            2,
+            "one point, one observation (other.jpg is not in the site)"
+        );
         let bad = dir.path().join("bad.csv");
         std::fs::write(&bad, "A,1,2\n").expect("write");
         let e = import_file(&site, &bad, Some("P1")).expect_err("bad");

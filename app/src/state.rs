@@ -93,7 +93,11 @@ mod tests {
     fn round_trip_and_recent_order() {
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("cfg/state.toml");
-        assert_eq!(UiState::load(&path), UiState::default(), "absent → defaults");
+        assert_eq!(
+            UiState::load(&path),
+            UiState::default(),
+            "absent → defaults"
+        );
         let mut s = UiState::default();
         for i in 0..12 {
             s.remember(Path::new(&format!("/nonexistent/{i}.toml")));
@@ -106,6 +110,10 @@ mod tests {
         s.save(&path).expect("save");
         assert_eq!(UiState::load(&path), s);
         std::fs::write(&path, "loupe = [").expect("write");
-        assert_eq!(UiState::load(&path), UiState::default(), "garbage → defaults");
+        assert_eq!(
+            UiState::load(&path),
+            UiState::default(),
+            "garbage → defaults"
+        );
     }
 }

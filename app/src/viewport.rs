@@ -70,7 +70,10 @@ impl ViewTransform {
     /// Screen rectangle of a photo pixel rectangle given by its pixel-edge corners.
     #[must_use]
     pub fn screen_rect(&self, min_px: [f64; 2], max_px: [f64; 2]) -> Rect {
-        Rect::from_min_max(self.screen_from_photo(min_px), self.screen_from_photo(max_px))
+        Rect::from_min_max(
+            self.screen_from_photo(min_px),
+            self.screen_from_photo(max_px),
+        )
     }
 }
 
@@ -261,7 +264,12 @@ impl DecodedPhoto {
 
     /// Draws the photo with `t` into `painter` (clipped to its clip rect), uploading the mip and
     /// up to [`UPLOADS_PER_FRAME`] visible tiles. Returns whether uploads remain (repaint).
-    pub fn paint(&mut self, ctx: &egui::Context, painter: &egui::Painter, t: &ViewTransform) -> bool {
+    pub fn paint(
+        &mut self,
+        ctx: &egui::Context,
+        painter: &egui::Painter,
+        t: &ViewTransform,
+    ) -> bool {
         let clip = painter.clip_rect();
         if let Some(img) = self.mip_image.take() {
             self.mip_texture = Some(ctx.load_texture("photo-mip", img, TEXTURE_OPTIONS));
@@ -270,50 +278,56 @@ impl DecodedPhoto {
         let full = t.screen_rect([-0.5, -0.5], [f64::from(w) - 0.5, f64::from(h) - 0.5]);
         // The mip is enough while one mip pixel covers at most one screen point.
         let mip_sharp = t.zoom * f64::from(self.mip_factor) <= 1.0;
-        if let Some(mip) = &self.mip_texture {
-            let mip_w = f64::from(w.div_ceil(self.mip_factor) * self.mip_factor);
-            let mip_h = f64::from(h.div_ceil(self.mip_factor) * self.mip_factor);
-            let r = t.screen_rect([-0.5, -0.5], [mip_w - 0.5, mip_h - 0.5]);
-            painter.image(
-                mip.id(),
-                r,
-                Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
-                Color32::WHITE,
-            );
-        } else {
-            painter.rect_filled(full, 0.0, Color32::from_gray(40));
-        }
-        if mip_sharp {
-            return false;
-        }
+        // Visible tiles, uploading up to UPLOADS_PER_FRAME of those still on the CPU.
+        let mut visible = Vec::new();
         let mut uploads = 0;
         let mut pending = false;
-        for (i, tile) in self.tiles.iter_mut().enumerate() {
-            let [x0, y0] = tile.origin_px.map(f64::from);
-            let [tw, th] = tile.size_px.map(f64::from);
-            let r = t.screen_rect([x0 - 0.5, y0 - 0.5], [x0 + tw - 0.5, y0 + th - 0.5]);
-            if !r.intersects(clip) {
-                continue;
-            }
-            if tile.texture.is_none() {
-                if uploads < UPLOADS_PER_FRAME
-                    && let Some(img) = tile.image.take()
-                {
-                    tile.texture = Some(ctx.load_texture(format!("photo-tile-{i}"), img, TEXTURE_OPTIONS));
-                    uploads += 1;
-                } else {
-                    pending = true;
+        if !mip_sharp {
+            for (i, tile) in self.tiles.iter_mut().enumerate() {
+                let [x0, y0] = tile.origin_px.map(f64::from);
+                let [tw, th] = tile.size_px.map(f64::from);
+                let r = t.screen_rect([x0 - 0.5, y0 - 0.5], [x0 + tw - 0.5, y0 + th - 0.5]);
+                if !r.intersects(clip) {
                     continue;
                 }
+                if tile.texture.is_none()
+                    && uploads < UPLOADS_PER_FRAME
+                    && let Some(img) = tile.image.take()
+                {
+                    tile.texture =
+                        Some(ctx.load_texture(format!("photo-tile-{i}"), img, TEXTURE_OPTIONS));
+                    uploads += 1;
+                }
+                match &tile.texture {
+                    Some(tex) => visible.push((tex.id(), r)),
+                    None => pending = true,
+                }
             }
-            if let Some(tex) = &tile.texture {
+        }
+        // The mip is drawn when it is sharp enough, or under tiles not uploaded yet (drawing it
+        // under a complete set of tiles would only cost fill rate).
+        if mip_sharp || pending {
+            if let Some(mip) = &self.mip_texture {
+                let mip_w = f64::from(w.div_ceil(self.mip_factor) * self.mip_factor);
+                let mip_h = f64::from(h.div_ceil(self.mip_factor) * self.mip_factor);
+                let r = t.screen_rect([-0.5, -0.5], [mip_w - 0.5, mip_h - 0.5]);
                 painter.image(
-                    tex.id(),
+                    mip.id(),
                     r,
                     Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
                     Color32::WHITE,
                 );
+            } else {
+                painter.rect_filled(full, 0.0, Color32::from_gray(40));
             }
+        }
+        for (id, r) in visible {
+            painter.image(
+                id,
+                r,
+                Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+                Color32::WHITE,
+            );
         }
         pending
     }
@@ -335,7 +349,11 @@ pub struct PhotoLoader {
 impl Default for PhotoLoader {
     fn default() -> Self {
         let (tx, rx) = mpsc::channel();
-        Self { tx, rx, in_flight: 0 }
+        Self {
+            tx,
+            rx,
+            in_flight: 0,
+        }
     }
 }
 
@@ -393,10 +411,28 @@ pub fn paint_loupe(
     let _ = photo.paint(ctx, &p, &t);
     let c = loupe_rect.center();
     let stroke = egui::Stroke::new(1.0, Color32::from_rgb(255, 60, 60));
-    p.line_segment([Pos2::new(loupe_rect.left(), c.y), Pos2::new(c.x - 4.0, c.y)], stroke);
-    p.line_segment([Pos2::new(c.x + 4.0, c.y), Pos2::new(loupe_rect.right(), c.y)], stroke);
-    p.line_segment([Pos2::new(c.x, loupe_rect.top()), Pos2::new(c.x, c.y - 4.0)], stroke);
-    p.line_segment([Pos2::new(c.x, c.y + 4.0), Pos2::new(c.x, loupe_rect.bottom())], stroke);
+    p.line_segment(
+        [Pos2::new(loupe_rect.left(), c.y), Pos2::new(c.x - 4.0, c.y)],
+        stroke,
+    );
+    p.line_segment(
+        [
+            Pos2::new(c.x + 4.0, c.y),
+            Pos2::new(loupe_rect.right(), c.y),
+        ],
+        stroke,
+    );
+    p.line_segment(
+        [Pos2::new(c.x, loupe_rect.top()), Pos2::new(c.x, c.y - 4.0)],
+        stroke,
+    );
+    p.line_segment(
+        [
+            Pos2::new(c.x, c.y + 4.0),
+            Pos2::new(c.x, loupe_rect.bottom()),
+        ],
+        stroke,
+    );
     painter.rect_stroke(
         loupe_rect,
         0.0,
@@ -457,7 +493,11 @@ mod tests {
             .map(|t| u64::from(t.size_px[0]) * u64::from(t.size_px[1]))
             .sum();
         assert_eq!(area, u64::from(w) * u64::from(h));
-        assert!(d.tiles.iter().all(|t| t.size_px[0] <= TILE_PX && t.size_px[1] <= TILE_PX));
+        assert!(
+            d.tiles
+                .iter()
+                .all(|t| t.size_px[0] <= TILE_PX && t.size_px[1] <= TILE_PX)
+        );
         assert_eq!(d.mip_factor, 2, "2500 px → 1250 ≤ 2048");
         let mip = d.mip_image.as_ref().expect("mip");
         assert_eq!(mip.size, [1250, 550]);

@@ -71,7 +71,10 @@ fn sigkill_after_autosave_loses_nothing() {
 
     // The site file itself was never saved; the edits live in the sidecar.
     let on_disk = photomontage::site::SiteDocument::load(&site_path).expect("loads");
-    assert_eq!(on_disk.site, before.site, "the kill did not touch the site file");
+    assert_eq!(
+        on_disk.site, before.site,
+        "the kill did not touch the site file"
+    );
 
     // Open it again the way the studio does.
     let studio = Studio::new(StudioOptions {
@@ -79,7 +82,10 @@ fn sigkill_after_autosave_loses_nothing() {
         state_path: None,
     });
     assert!(
-        studio.messages().iter().any(|m| m.text.contains("restored")),
+        studio
+            .messages()
+            .iter()
+            .any(|m| m.text.contains("restored")),
         "the user is told: {:?}",
         studio.messages()
     );
@@ -89,7 +95,11 @@ fn sigkill_after_autosave_loses_nothing() {
         .iter()
         .find(|o| o.photo == "P3" && o.point == moved.point)
         .expect("moved observation");
-    assert_eq!((o.x_px, o.y_px), (x, y), "moved exactly (TOML floats round-trip)");
+    assert_eq!(
+        (o.x_px, o.y_px),
+        (x, y),
+        "moved exactly (TOML floats round-trip)"
+    );
     assert!(
         !site
             .observations

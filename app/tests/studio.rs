@@ -34,7 +34,10 @@ fn wait_for_solution(h: &mut egui_kittest::Harness<'static, photomontage_studio:
     while h.state().solution().is_none() || !h.state().is_idle() {
         h.step();
         std::thread::sleep(Duration::from_millis(20));
-        assert!(start.elapsed() < Duration::from_secs(300), "solve did not finish");
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "solve did not finish"
+        );
     }
     h.run();
 }
@@ -86,8 +89,18 @@ fn place_undo_redo_solve_and_the_residual_table_shows_the_cli_numbers() {
             .cloned()
     };
     let p = placed(&h).expect("placed by clicking");
-    assert!((p.x_px - target.x_px).abs() < CLICK_TOL_PX, "{} vs {}", p.x_px, target.x_px);
-    assert!((p.y_px - target.y_px).abs() < CLICK_TOL_PX, "{} vs {}", p.y_px, target.y_px);
+    assert!(
+        (p.x_px - target.x_px).abs() < CLICK_TOL_PX,
+        "{} vs {}",
+        p.x_px,
+        target.x_px
+    );
+    assert!(
+        (p.y_px - target.y_px).abs() < CLICK_TOL_PX,
+        "{} vs {}",
+        p.y_px,
+        target.y_px
+    );
 
     // Undo the placement, undo the deletion: the site is the original, bit for bit.
     h.get_by_label("Undo").click();
@@ -145,7 +158,11 @@ fn place_undo_redo_solve_and_the_residual_table_shows_the_cli_numbers() {
         .iter()
         .flat_map(|p| p.outliers.iter().map(String::as_str))
         .collect();
-    assert_eq!(outliers.len(), 1, "the sample has one mislabelled observation");
+    assert_eq!(
+        outliers.len(),
+        1,
+        "the sample has one mislabelled observation"
+    );
     if p2.outliers.is_empty() {
         assert!(h.query_by_label("OUTLIER").is_none());
     } else {
@@ -196,13 +213,19 @@ fn calibrating_the_sample_in_the_studio_matches_the_cli_cameras() {
     for photo in &original.site.photos {
         h.get_by_label(&format!("photo {}", photo.id)).click();
         wait_idle(&mut h);
-        for o in original.site.observations.iter().filter(|o| o.photo == photo.id) {
+        for o in original
+            .site
+            .observations
+            .iter()
+            .filter(|o| o.photo == photo.id)
+        {
             let surveyed = original.site.control_points.iter().any(|c| c.id == o.point);
             if surveyed {
                 h.get_by_label(&o.point).click();
             } else {
                 // A tie point: type its id and pick it.
-                h.get_by_label("point id").set_text_value_accesskit(&o.point);
+                h.get_by_label("point id")
+                    .set_text_value_accesskit(&o.point);
                 h.run();
                 h.get_by_label("Pick id").click();
             }
@@ -230,8 +253,8 @@ fn calibrating_the_sample_in_the_studio_matches_the_cli_cameras() {
             .iter()
             .find(|s| s.id == c.id)
             .expect("same photos solved");
-        let dc = (s.camera.pose.camera_center_in_world - c.camera.pose.camera_center_in_world)
-            .norm();
+        let dc =
+            (s.camera.pose.camera_center_in_world - c.camera.pose.camera_center_in_world).norm();
         // ‖R₁ − R₂‖_F = 2√2·sin(θ/2) ≈ √2·θ; `angle_to` takes acos of a value that rounds
         // past 1 for nearly equal rotations (NaN).
         let dr = (s.camera.pose.rotation_world_from_camera.matrix()
@@ -239,9 +262,20 @@ fn calibrating_the_sample_in_the_studio_matches_the_cli_cameras() {
         .norm()
             / std::f64::consts::SQRT_2;
         let df = (s.camera.intrinsics.focal_px - c.camera.intrinsics.focal_px).abs();
-        eprintln!("{}: Δcentre {dc:.3e} m, Δrotation {dr:.3e} rad, Δfocal {df:.3e} px", c.id);
-        assert!(dc < CAMERA_CENTRE_TOL_M, "{}: centre differs by {dc} m", c.id);
-        assert!(dr < CAMERA_ROTATION_TOL_RAD, "{}: rotation differs by {dr} rad", c.id);
+        eprintln!(
+            "{}: Δcentre {dc:.3e} m, Δrotation {dr:.3e} rad, Δfocal {df:.3e} px",
+            c.id
+        );
+        assert!(
+            dc < CAMERA_CENTRE_TOL_M,
+            "{}: centre differs by {dc} m",
+            c.id
+        );
+        assert!(
+            dr < CAMERA_ROTATION_TOL_RAD,
+            "{}: rotation differs by {dr} rad",
+            c.id
+        );
         assert!(df < FOCAL_TOL_PX, "{}: focal differs by {df} px", c.id);
         assert_eq!(s.outliers, c.outliers);
     }

@@ -382,16 +382,25 @@ mod tests {
     #[test]
     fn control_points_csv_errors_name_the_line() {
         let bad_count = parse_control_points_csv("A1,1,2\n", [0.01; 3]);
-        assert!(matches!(bad_count, Err(ControlIoError::Parse { line: 1, .. })));
+        assert!(matches!(
+            bad_count,
+            Err(ControlIoError::Parse { line: 1, .. })
+        ));
         let bad_number = parse_control_points_csv("id,X,Y,Z\nA1,1,2,x\n", [0.01; 3]);
-        assert!(matches!(bad_number, Err(ControlIoError::Parse { line: 2, .. })));
+        assert!(matches!(
+            bad_number,
+            Err(ControlIoError::Parse { line: 2, .. })
+        ));
         let conflict = parse_control_points_csv("A1,1,2,3\nA1,1,2,4\n", [0.01; 3]);
         assert!(matches!(
             conflict,
             Err(ControlIoError::ConflictingCoordinates { line: 2, .. })
         ));
         let negative = parse_control_points_csv("A1,1,2,3,-1\n", [0.01; 3]);
-        assert!(matches!(negative, Err(ControlIoError::Parse { line: 1, .. })));
+        assert!(matches!(
+            negative,
+            Err(ControlIoError::Parse { line: 1, .. })
+        ));
     }
 
     #[test]
