@@ -15,6 +15,8 @@ use std::time::{Duration, Instant};
 const AUTOSAVE_WAIT: Duration = Duration::from_secs(60);
 
 #[test]
+// Exact comparisons on purpose: the site file writes floats with round-trip precision.
+#[allow(clippy::float_cmp)]
 fn sigkill_after_autosave_loses_nothing() {
     let (dir, site_path) = common::copy_sample();
     let before = photomontage::site::SiteDocument::load(&site_path).expect("loads");
