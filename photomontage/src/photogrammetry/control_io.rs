@@ -369,6 +369,8 @@ mod tests {
     use super::*;
 
     #[test]
+    // Parsed decimal literals must equal the same literals exactly.
+    #[allow(clippy::float_cmp)]
     fn control_points_csv_with_header_sigma_and_duplicates() {
         let text = "id,X,Y,Z\n# comment\nA1,1.5,2,3\nB2, 10, 20, 30, 0.05\nA1,1.5,2,3\n\n";
         let pts = parse_control_points_csv(text, [0.01; 3]).expect("valid");
