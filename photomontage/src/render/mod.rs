@@ -16,7 +16,9 @@
 //!
 //! Output: linear RGBA with alpha = coverage of artificial objects (fraction of rays whose first
 //! hit is artificial), written as EXR ([`RenderedImage::write_exr`]) or sRGB PNG through
-//! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]).
+//! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]); [`render_view_with_layers`] also
+//! fills depth, object-id and shadow-change layers, and [`output`] writes them as a multi-channel
+//! EXR or 8-bit sRGB PNG/JPEG/TIFF.
 //!
 //! # Known limitations
 //! The "unchanged" decision uses the first 4 rays of a pixel: an artificial sliver thinner than
@@ -26,6 +28,7 @@
 
 pub mod differential;
 pub mod illumination;
+pub mod output;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -36,8 +39,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-pub use differential::{DifferentialError, DifferentialTracer, Lighting, RaySample};
+pub use differential::{DifferentialError, DifferentialTracer, Lighting, PrimaryHit, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
+pub use output::{LayerSet, OutputError, OutputFormat, OutputLayers};
 
 use crate::colour::ToneMap;
 
@@ -172,6 +176,7 @@ impl RenderedImage {
 
 struct TileOut {
     rgba: Vec<[f32; 4]>,
+    layers: OutputLayers,
     changed: usize,
     rays: u64,
 }
@@ -188,6 +193,22 @@ pub fn render_view(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderError> {
+    render_view_with_layers(tracer, settings, LayerSet::default(), on_tile, cancel)
+        .map(|(image, _)| image)
+}
+
+/// [`render_view`] that also fills the auxiliary output layers chosen in `layers` (see
+/// [`output`] for their definitions).
+///
+/// # Errors
+/// As [`render_view`].
+pub fn render_view_with_layers(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+    layers: LayerSet,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<(RenderedImage, OutputLayers), RenderError> {
     let photo = tracer.photo();
     let camera = tracer.camera();
     let photo_px = [photo.width(), photo.height()];
@@ -224,7 +245,7 @@ pub fn render_view(
             let i = index as u32;
             let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
             let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
-            let out = render_tile(tracer, settings, index, origin_px, size_px);
+            let out = render_tile(tracer, settings, layers, index, origin_px, size_px);
             on_tile(TileProgress {
                 tile_index: index,
                 tile_count,
@@ -235,6 +256,7 @@ pub fn render_view(
         })
         .collect();
     let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
+    let mut out_layers = OutputLayers::new(layers, (w * h) as usize);
     let (mut changed_pixels, mut primary_rays) = (0, 0);
     for (index, tile) in tiles.into_iter().enumerate() {
         let Some(tile) = tile else {
@@ -247,7 +269,9 @@ pub fn render_view(
         for (k, p) in tile.rgba.iter().enumerate() {
             #[allow(clippy::cast_possible_truncation)]
             let k = k as u32;
-            rgba[((y0 + k / tw) * w + x0 + k % tw) as usize] = *p;
+            let to = ((y0 + k / tw) * w + x0 + k % tw) as usize;
+            rgba[to] = *p;
+            out_layers.copy_pixel(&tile.layers, k as usize, to);
         }
         changed_pixels += tile.changed;
         primary_rays += tile.rays;
@@ -255,17 +279,21 @@ pub fn render_view(
     if cancel.load(Ordering::Relaxed) {
         return Err(RenderError::Cancelled);
     }
-    Ok(RenderedImage {
-        size_px: [w, h],
-        rgba,
-        changed_pixels,
-        primary_rays,
-    })
+    Ok((
+        RenderedImage {
+            size_px: [w, h],
+            rgba,
+            changed_pixels,
+            primary_rays,
+        },
+        out_layers,
+    ))
 }
 
 fn render_tile(
     tracer: &DifferentialTracer<'_>,
     settings: &RenderSettings,
+    layers: LayerSet,
     tile_index: usize,
     origin_px: [u32; 2],
     size_px: [u32; 2],
@@ -276,6 +304,7 @@ fn render_tile(
     let camera = tracer.camera();
     let mut out = TileOut {
         rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),
+        layers: OutputLayers::new(layers, 0),
         changed: 0,
         rays: 0,
     };
@@ -285,6 +314,8 @@ fn render_tile(
             let photo_rgb = photo_f32.map(f64::from);
             let mut sum = [0.0_f64; 3];
             let mut sum_sq = [0.0_f64; 3];
+            let mut natural_change = [0.0_f64; 3];
+            let mut first_hit = None;
             let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
             loop {
                 for s in 0..4 {
@@ -295,6 +326,14 @@ fn render_tile(
                         f64::from(y) - 0.5 + (sy + v) / 2.0,
                     );
                     let sample = tracer.trace_primary(&camera.ray_dir_in_world(pixel), photo_rgb);
+                    if n == 0 && s == 0 {
+                        first_hit = Some(sample.first_hit);
+                    }
+                    if !sample.hit_artificial {
+                        for k in 0..3 {
+                            natural_change[k] += sample.radiance_rgb[k] - photo_rgb[k];
+                        }
+                    }
                     changed |= sample.changed;
                     covered += u32::from(sample.hit_artificial);
                     for k in 0..3 {
@@ -317,6 +356,8 @@ fn render_tile(
                 }
             }
             out.rays += u64::from(n);
+            out.layers
+                .push_pixel(first_hit.flatten(), natural_change, changed, n);
             if changed {
                 out.changed += 1;
                 let nf = f64::from(n);
