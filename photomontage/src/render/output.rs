@@ -412,7 +412,7 @@ mod tests {
                 .channel_data
                 .list
                 .iter()
-                .find(|c| c.name == Text::from(name))
+                .find(|c| c.name.eq(name))
                 .unwrap();
             c.sample_data.values_as_f32().collect()
         };
