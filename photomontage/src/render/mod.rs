@@ -25,7 +25,12 @@
 //! limitations.
 
 pub mod differential;
+pub mod glass;
 pub mod illumination;
+pub mod luminaire_light;
+pub mod spectral;
+pub mod specular;
+pub mod water;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -38,6 +43,8 @@ use rayon::prelude::*;
 
 pub use differential::{DifferentialError, DifferentialTracer, Lighting, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
+pub use luminaire_light::{ArtificialLight, LuminaireLight};
+pub use spectral::{SpectralError, render_view_spectral};
 
 use crate::colour::ToneMap;
 
@@ -188,29 +195,9 @@ pub fn render_view(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderError> {
+    check_view(tracer, settings)?;
     let photo = tracer.photo();
-    let camera = tracer.camera();
-    let photo_px = [photo.width(), photo.height()];
-    if photo_px != camera.intrinsics.image_size_px {
-        return Err(RenderError::SizeMismatch {
-            photo_px,
-            camera_px: camera.intrinsics.image_size_px,
-        });
-    }
-    if settings.tile_size_px == 0 {
-        return Err(RenderError::InvalidSetting {
-            name: "tile_size_px",
-            reason: "must be positive",
-        });
-    }
-    let (lo, hi) = (settings.min_rays_per_pixel, settings.max_rays_per_pixel);
-    if lo == 0 || lo % 4 != 0 || hi % 4 != 0 || hi < lo || hi > 64 {
-        return Err(RenderError::InvalidSetting {
-            name: "rays_per_pixel",
-            reason: "min and max must be multiples of 4 with 4 ≤ min ≤ max ≤ 64",
-        });
-    }
-    let [w, h] = photo_px;
+    let [w, h] = [photo.width(), photo.height()];
     let ts = settings.tile_size_px;
     let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
     let tile_count = (tiles_x * tiles_y) as usize;
@@ -261,6 +248,36 @@ pub fn render_view(
         changed_pixels,
         primary_rays,
     })
+}
+
+/// Checks that the photo is the camera's size and the settings are valid.
+fn check_view(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+) -> Result<(), RenderError> {
+    let photo = tracer.photo();
+    let camera = tracer.camera();
+    let photo_px = [photo.width(), photo.height()];
+    if photo_px != camera.intrinsics.image_size_px {
+        return Err(RenderError::SizeMismatch {
+            photo_px,
+            camera_px: camera.intrinsics.image_size_px,
+        });
+    }
+    if settings.tile_size_px == 0 {
+        return Err(RenderError::InvalidSetting {
+            name: "tile_size_px",
+            reason: "must be positive",
+        });
+    }
+    let (lo, hi) = (settings.min_rays_per_pixel, settings.max_rays_per_pixel);
+    if lo == 0 || lo % 4 != 0 || hi % 4 != 0 || hi < lo || hi > 64 {
+        return Err(RenderError::InvalidSetting {
+            name: "rays_per_pixel",
+            reason: "min and max must be multiples of 4 with 4 ≤ min ≤ max ≤ 64",
+        });
+    }
+    Ok(())
 }
 
 fn render_tile(
@@ -354,5 +371,7 @@ pub fn linear_photo(photo: &crate::photo::PhotoImage) -> Rgb32FImage {
     }
 }
 
+#[cfg(test)]
+mod physics_tests;
 #[cfg(test)]
 mod tests;
