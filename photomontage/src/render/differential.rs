@@ -6,7 +6,9 @@
 //!   the horizon colour L∞ if it points above the horizon.
 //! - **Case C** ([`DifferentialTracer::case_c_artificial_hit`]): an artificial object → eq. 6 with
 //!   the natural lights (sun, ambient, sky facets, visibility by any-hit against the whole scene)
-//!   and the artificial point lights, mirror reflection recursively, then the atmosphere (eq. 2).
+//!   and the artificial lights (points or luminaires), the GGX lobe ([`super::specular`]), mirror
+//!   and thin-glass reflection and transmission recursively ([`super::glass`]), water-wave
+//!   shading normals ([`super::water`]), then the atmosphere (eq. 2).
 //! - **Case D** ([`DifferentialTracer::case_d_natural_hit`]): a natural object → its apparent
 //!   colour from the photo, its true colour L₀ by the atmosphere's second inversion (eq. 8), its
 //!   albedo ρ_d by the illumination model's second inversion (eq. 10), then
@@ -31,8 +33,9 @@
 //! # Known limitations
 //! Secondary rays that hit natural objects take their apparent colour from the current photo only
 //! (not from the polygon's image attribute photo), when the point is visible in it; otherwise the
-//! library material is shaded by eq. 6. Only ideal mirror reflection is recursed (no refraction,
-//! no glossy lobes). The gather is one bounce on a fixed facet set (deterministic, so it has
+//! library material is shaded by eq. 6. Glass is a thin pane (no refraction through solids) and
+//! opaque to shadow rays; the glossy lobe is sampled with few rays (see [`super::specular`]).
+//! The gather is one bounce on a fixed facet set (deterministic, so it has
 //! quantisation error rather than noise); the artificial radiance a natural point gathers takes sky
 //! facets as visible and gets its own photo bounce only from the coarser nested dome; natural surfaces blocked from the photo's view
 //! fall back to their library material; the light a natural surface no longer receives from

@@ -14,6 +14,11 @@
 //! object (no artificial hit, no natural light blocked only by an artificial object, no
 //! artificial light), the pixel keeps the photo's value bit for bit and alpha 0.
 //!
+//! Materials: diffuse (eq. 6), GGX specular ([`specular`]), mirror, thin glass panes
+//! ([`glass`]), emission and water-wave normals ([`water`]); artificial lights are points or
+//! luminaires with photometric webs ([`luminaire_light`]). [`render_view_spectral`] runs the same
+//! tracer on spectral samples ([`spectral`], Durisch §7 and Appendix A).
+//!
 //! Output: linear RGBA with alpha = coverage of artificial objects (fraction of rays whose first
 //! hit is artificial), written as EXR ([`RenderedImage::write_exr`]) or sRGB PNG through
 //! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]).
@@ -21,8 +26,8 @@
 //! # Known limitations
 //! The "unchanged" decision uses the first 4 rays of a pixel: an artificial sliver thinner than
 //! the gaps between them can be missed at the pixel level (as any 4-sample renderer would).
-//! Box filter only; RGB only (no spectral mode yet). See [`differential`] for the per-ray
-//! limitations.
+//! Box filter only. See [`differential`] for the per-ray limitations and [`glass`],
+//! [`specular`], [`water`], [`luminaire_light`], [`spectral`] for those of each physical model.
 
 pub mod differential;
 pub mod glass;
