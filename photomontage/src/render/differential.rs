@@ -390,11 +390,13 @@ impl<'a> DifferentialTracer<'a> {
             .is_some_and(|n| Self::blocked_by(n, origin, dir, t_max))
     }
 
-    /// The artificial lights that reach `origin` (in front of the geometric `normal`, shadow
-    /// ray by any-hit against everything): unit direction towards each and its irradiance on a
-    /// surface facing it, `I(−dir)/d²` (inverse-square law).
+    /// The artificial lights that reach the surface point `point` (in front of the geometric
+    /// `normal`; shadow ray from the offset point `origin` by any-hit against everything): unit
+    /// direction towards each and its irradiance at `point` on a surface facing it, `I(−dir)/d²`
+    /// (inverse-square law).
     pub(super) fn visible_artificial_lights(
         &self,
+        point: &Point3<f64>,
         origin: &Point3<f64>,
         normal: &Vector3<f64>,
     ) -> Vec<(Vector3<f64>, Rgb)> {
@@ -407,7 +409,9 @@ impl<'a> DifferentialTracer<'a> {
             }
             let dir = to_light / dist;
             if !Self::blocked_by(&self.all, origin, &dir, dist - SURFACE_OFFSET_M) {
-                out.push((dir, light.normal_irradiance_rgb(origin)));
+                let to_light_from_point = light.position_in_world_m() - point;
+                let dir_from_point = to_light_from_point.try_normalize(0.0).unwrap_or(dir);
+                out.push((dir_from_point, light.normal_irradiance_rgb(point)));
             }
         }
         out
@@ -502,7 +506,7 @@ impl<'a> DifferentialTracer<'a> {
                 f64::INFINITY,
             )
         });
-        let lights = self.visible_artificial_lights(&origin, &normal);
+        let lights = self.visible_artificial_lights(point, &origin, &normal);
         let mut e = add(
             e_natural,
             Self::artificial_light_irradiance(&lights, &shading_normal).0,
@@ -595,7 +599,7 @@ impl<'a> DifferentialTracer<'a> {
             .collect();
         // D1: artificial lights add.
         let (e_d1, lit_d1) = Self::artificial_light_irradiance(
-            &self.visible_artificial_lights(&origin, &normal),
+            &self.visible_artificial_lights(point, &origin, &normal),
             &normal,
         );
         let unchanged = !sun_d3 && sky_d3.is_empty() && !lit_d1;

@@ -304,10 +304,17 @@ fn a_luminaire_adds_its_tabulated_candela_by_the_inverse_square_cosine_law_case_
         for (x, y) in [(31, 23), (32, 23), (31, 24), (32, 24)] {
             let px = out.rgba[(y * SIZE_PX[0] + x) as usize];
             for k in 0..3 {
-                // Second inversion: ρ = π·L₀/(π k_u); D1 adds ρ/π·E.
+                // Second inversion: ρ = π·L₀/(π k_u); D1 adds ρ/π·E. Compare the change itself
+                // (the photo's f32 value taken off in f64).
                 let rho = photo_rgb[k] / k_u[k];
-                let expected = photo_rgb[k] + rho / PI * scale[k] * e_lx;
-                assert_rel(px[k], expected, NARROW_VIEW_REL_TOL, "luminaire D1");
+                let expected = rho / PI * scale[k] * e_lx;
+                #[allow(clippy::cast_possible_truncation)]
+                let photo_f32 = f64::from(photo_rgb[k] as f32);
+                let delta = f64::from(px[k]) - photo_f32;
+                assert!(
+                    (delta - expected).abs() < NARROW_VIEW_REL_TOL * expected,
+                    "luminaire D1: change {delta}, expected {expected}"
+                );
             }
             assert_eq!(px[3].to_bits(), 0.0_f32.to_bits(), "ground, not covered");
         }
@@ -416,4 +423,57 @@ fn spectral_mode_renders_a_grey_scene_as_rgb_mode_and_keeps_untouched_pixels() {
         .filter(|(m, p)| [m[0], m[1], m[2]].map(f32::to_bits) == p.0.map(f32::to_bits))
         .count();
     assert!(untouched >= rgb.rgba.len() - rgb.changed_pixels);
+}
+
+#[test]
+fn a_luminaire_lights_an_artificial_surface_case_c_and_aiming_turns_it_away() {
+    let ies = "IESNA:LM-63-2002\n[TEST] x\nTILT=NONE\n1 -1 1 7 1 1 2 0.2 0.2 0.1\n\
+               1.0 1.0 20\n0 30 60 90 120 150 180\n0\n1000 800 400 0 0 0 0\n";
+    let web = IesFile::parse(ies.as_bytes())
+        .unwrap()
+        .distribution()
+        .unwrap();
+    let rho = [0.6, 0.5, 0.4];
+    let scale = [1e-3, 1e-3, 2e-3];
+    let mut scene = Scene::new();
+    add_quad(
+        &mut scene,
+        50.0,
+        0.0,
+        Material::diffuse("plaza", rho),
+        ObjectKind::Artificial,
+    );
+    let render_with = |luminaire: Luminaire| {
+        let lighting = Lighting {
+            artificial_lights: vec![ArtificialLight::from(LuminaireLight {
+                luminaire,
+                rgb_per_cd: scale,
+            })],
+            ..Lighting::default()
+        };
+        let cam = looking_down(Point3::origin(), 20.0, 200_000.0);
+        let photo = uniform_photo([0.5; 3]);
+        let tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 2).unwrap();
+        render(&tracer, &RenderSettings::default())
+    };
+    // 1000 cd straight down from 5 m: E = 40 lx × scale, L = ρ/π·E.
+    let down = render_with(Luminaire::new(web.clone(), Point3::new(0.0, 0.0, 5.0)));
+    let px = down.rgba[(24 * SIZE_PX[0] + 32) as usize];
+    for k in 0..3 {
+        assert_rel(
+            px[k],
+            rho[k] / PI * scale[k] * 40.0,
+            NARROW_VIEW_REL_TOL,
+            "case C",
+        );
+    }
+    // Aimed at the sky (rotated 180° about x): the plaza is dark.
+    let mut up = Luminaire::new(web, Point3::new(0.0, 0.0, 5.0));
+    up.world_from_luminaire = Rotation3::from_axis_angle(&Vector3::x_axis(), PI);
+    let dark = render_with(up);
+    assert!(
+        dark.rgba
+            .iter()
+            .all(|p| p[0].abs() < 1e-12 && p[2].abs() < 1e-12)
+    );
 }
