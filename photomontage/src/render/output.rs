@@ -214,7 +214,8 @@ fn write_error(path: &Path, e: &dyn std::fmt::Display) -> OutputError {
 }
 
 /// Writes a one-part EXR with `R G B A` and the channels of the present layers (see the module
-/// documentation), all 32-bit float, lossless.
+/// documentation), all 32-bit float, ZIP-compressed scan lines in increasing order (lossless and
+/// byte-for-byte reproducible).
 ///
 /// # Errors
 /// [`OutputError::Write`].
@@ -250,7 +251,9 @@ pub fn write_exr(
     let layer = Layer::new(
         (w as usize, h as usize),
         LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
+        // ZIP over scan lines in increasing order: lossless, and the block order (so the file's
+        // bytes) does not depend on which compression thread finishes first.
+        Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     Image::from_layer(layer)
