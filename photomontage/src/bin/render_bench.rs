@@ -5,9 +5,10 @@
 //! the scene, camera and lights of [`photomontage::peer_scene::mitsuba_pair_scene`] (the same as
 //! the accuracy test) for each rays-per-pixel setting (adaptive `min–max` and fixed `n–n`) and
 //! thread count. Printed per setting: the median wall time of `--reps` renders (the tracer's BVH
-//! setup timed separately), the rays per pixel actually traced, the pixels changed, and the RMSE
-//! against the 1024-spp `with_box` truth. Then the peers' render times and RMSE of the same scene
-//! read from `peers/results/{mitsuba,blender}_*.json`.
+//! setup timed separately), the median CPU seconds of a render (all threads; on a shared machine
+//! CPU s / threads is what the wall clock would show on idle cores), the rays per pixel traced,
+//! the pixels changed, and the RMSE against the 1024-spp `with_box` truth. Then the peers' render
+//! times and RMSE of the same scene read from `peers/results/{mitsuba,blender}_*.json`.
 //!
 //! Usage: `render_bench [BENCH_DIR] [--reps N] [--threads 1,2] [--spp 4-4,4-8,...]`.
 //! `BENCH_DIR` (or `PHOTOMONTAGE_BENCH_DATA`) is the shared bench folder holding
@@ -44,6 +45,18 @@ struct Args {
     /// Folder with the peers' results JSON (default: BENCH_DIR/peers/results).
     #[arg(long)]
     peer_results: Option<PathBuf>,
+}
+
+/// CPU seconds used by this process so far (all threads; user + system), from `/proc/self/stat`
+/// at the kernel's 100 Hz tick (as in `bvh_bench`). `None` where that file does not exist.
+fn process_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -183,8 +196,8 @@ fn main() -> Result<()> {
         )
     );
     println!(
-        "{:>7} {:>7} {:>9} {:>10} {:>9} {:>11} {:>9}",
-        "threads", "spp", "setup s", "render s", "rays/px", "changed px", "RMSE"
+        "{:>7} {:>7} {:>9} {:>10} {:>12} {:>9} {:>11} {:>9}",
+        "threads", "spp", "setup s", "render s", "render CPU s", "rays/px", "changed px", "RMSE"
     );
     for &threads in &args.threads {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -197,9 +210,11 @@ fn main() -> Result<()> {
                 max_depth: MAX_DEPTH,
                 ..RenderSettings::default()
             };
-            let (mut setup_s, mut render_s, mut last) = (Vec::new(), Vec::new(), None);
+            let (mut setup_s, mut render_s, mut cpu_s, mut last) =
+                (Vec::new(), Vec::new(), Vec::new(), None);
             for _ in 0..args.reps {
                 let t0 = Instant::now();
+                let mut cpu0 = None;
                 let out = pool.install(|| -> Result<_> {
                     let tracer = DifferentialTracer::new(
                         &peer.scene,
@@ -209,12 +224,16 @@ fn main() -> Result<()> {
                         MAX_DEPTH,
                     )?;
                     let t1 = Instant::now();
+                    cpu0 = process_cpu_s();
                     let out = render_view(&tracer, &settings, &|_| {}, &AtomicBool::new(false))?;
                     Ok((t1, out))
                 })?;
                 let (t1, image) = out;
                 setup_s.push((t1 - t0).as_secs_f64());
                 render_s.push(t1.elapsed().as_secs_f64());
+                if let (Some(a), Some(b)) = (cpu0, process_cpu_s()) {
+                    cpu_s.push(b - a);
+                }
                 last = Some(image);
             }
             let Some(image) = last else { continue };
@@ -222,10 +241,15 @@ fn main() -> Result<()> {
             let rays_per_px =
                 image.primary_rays as f64 / (f64::from(size_px[0]) * f64::from(size_px[1]));
             println!(
-                "{threads:>7} {:>7} {:>9.3} {:>10.3} {rays_per_px:>9.2} {:>11} {:>9.5}",
+                "{threads:>7} {:>7} {:>9.3} {:>10.3} {:>12} {rays_per_px:>9.2} {:>11} {:>9.5}",
                 format!("{min}-{max}"),
                 median(setup_s),
                 median(render_s),
+                if cpu_s.is_empty() {
+                    "-".to_owned()
+                } else {
+                    format!("{:.3}", median(cpu_s))
+                },
                 image.changed_pixels,
                 rmse(&image.rgba, &truth)
             );
