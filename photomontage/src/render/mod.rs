@@ -14,18 +14,31 @@
 //! object (no artificial hit, no natural light blocked only by an artificial object, no
 //! artificial light), the pixel keeps the photo's value bit for bit and alpha 0.
 //!
+//! Materials: diffuse (eq. 6), GGX specular ([`specular`]), mirror, thin glass panes
+//! ([`glass`]), emission and water-wave normals ([`water`]); artificial lights are points or
+//! luminaires with photometric webs ([`luminaire_light`]). [`render_view_spectral`] runs the same
+//! tracer on spectral samples ([`spectral`], Durisch §7 and Appendix A).
+//!
 //! Output: linear RGBA with alpha = coverage of artificial objects (fraction of rays whose first
 //! hit is artificial), written as EXR ([`RenderedImage::write_exr`]) or sRGB PNG through
-//! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]).
+//! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]); [`render_view_with_layers`] also
+//! fills depth, object-id and shadow-change layers, and [`output`] writes them as a multi-channel
+//! EXR or 8-bit sRGB PNG/JPEG/TIFF.
 //!
 //! # Known limitations
 //! The "unchanged" decision uses the first 4 rays of a pixel: an artificial sliver thinner than
 //! the gaps between them can be missed at the pixel level (as any 4-sample renderer would).
-//! Box filter only; RGB only (no spectral mode yet). See [`differential`] for the per-ray
-//! limitations.
+//! Box filter only. See [`differential`] for the per-ray limitations and [`glass`],
+//! [`specular`], [`water`], [`luminaire_light`], [`spectral`] for those of each physical model.
 
 pub mod differential;
+pub mod glass;
 pub mod illumination;
+pub mod luminaire_light;
+pub mod output;
+pub mod spectral;
+pub mod specular;
+pub mod water;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -36,8 +49,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-pub use differential::{DifferentialError, DifferentialTracer, Lighting, RaySample};
+pub use differential::{DifferentialError, DifferentialTracer, Lighting, PrimaryHit, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
+pub use luminaire_light::{ArtificialLight, LuminaireLight};
+pub use output::{LayerSet, OutputError, OutputFormat, OutputLayers};
+pub use spectral::{SpectralError, render_view_spectral};
 
 use crate::colour::ToneMap;
 
@@ -172,6 +188,7 @@ impl RenderedImage {
 
 struct TileOut {
     rgba: Vec<[f32; 4]>,
+    layers: OutputLayers,
     changed: usize,
     rays: u64,
 }
@@ -188,6 +205,88 @@ pub fn render_view(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderError> {
+    render_view_with_layers(tracer, settings, LayerSet::default(), on_tile, cancel)
+        .map(|(image, _)| image)
+}
+
+/// [`render_view`] that also fills the auxiliary output layers chosen in `layers` (see
+/// [`output`] for their definitions).
+///
+/// # Errors
+/// As [`render_view`].
+pub fn render_view_with_layers(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+    layers: LayerSet,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<(RenderedImage, OutputLayers), RenderError> {
+    check_view(tracer, settings)?;
+    let photo = tracer.photo();
+    let [w, h] = [photo.width(), photo.height()];
+    let ts = settings.tile_size_px;
+    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
+    let tile_count = (tiles_x * tiles_y) as usize;
+    let tiles: Vec<Option<TileOut>> = (0..tile_count)
+        .into_par_iter()
+        .map(|index| {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            #[allow(clippy::cast_possible_truncation)]
+            let i = index as u32;
+            let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
+            let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
+            let out = render_tile(tracer, settings, layers, index, origin_px, size_px);
+            on_tile(TileProgress {
+                tile_index: index,
+                tile_count,
+                origin_px,
+                size_px,
+            });
+            Some(out)
+        })
+        .collect();
+    let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
+    let mut out_layers = OutputLayers::new(layers, (w * h) as usize);
+    let (mut changed_pixels, mut primary_rays) = (0, 0);
+    for (index, tile) in tiles.into_iter().enumerate() {
+        let Some(tile) = tile else {
+            return Err(RenderError::Cancelled);
+        };
+        #[allow(clippy::cast_possible_truncation)]
+        let i = index as u32;
+        let (x0, y0) = ((i % tiles_x) * ts, (i / tiles_x) * ts);
+        let tw = ts.min(w - x0);
+        for (k, p) in tile.rgba.iter().enumerate() {
+            #[allow(clippy::cast_possible_truncation)]
+            let k = k as u32;
+            let to = ((y0 + k / tw) * w + x0 + k % tw) as usize;
+            rgba[to] = *p;
+            out_layers.copy_pixel(&tile.layers, k as usize, to);
+        }
+        changed_pixels += tile.changed;
+        primary_rays += tile.rays;
+    }
+    if cancel.load(Ordering::Relaxed) {
+        return Err(RenderError::Cancelled);
+    }
+    Ok((
+        RenderedImage {
+            size_px: [w, h],
+            rgba,
+            changed_pixels,
+            primary_rays,
+        },
+        out_layers,
+    ))
+}
+
+/// Checks that the photo is the camera's size and the settings are valid.
+fn check_view(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+) -> Result<(), RenderError> {
     let photo = tracer.photo();
     let camera = tracer.camera();
     let photo_px = [photo.width(), photo.height()];
@@ -210,62 +309,13 @@ pub fn render_view(
             reason: "min and max must be multiples of 4 with 4 ≤ min ≤ max ≤ 64",
         });
     }
-    let [w, h] = photo_px;
-    let ts = settings.tile_size_px;
-    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
-    let tile_count = (tiles_x * tiles_y) as usize;
-    let tiles: Vec<Option<TileOut>> = (0..tile_count)
-        .into_par_iter()
-        .map(|index| {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            #[allow(clippy::cast_possible_truncation)]
-            let i = index as u32;
-            let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
-            let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
-            let out = render_tile(tracer, settings, index, origin_px, size_px);
-            on_tile(TileProgress {
-                tile_index: index,
-                tile_count,
-                origin_px,
-                size_px,
-            });
-            Some(out)
-        })
-        .collect();
-    let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
-    let (mut changed_pixels, mut primary_rays) = (0, 0);
-    for (index, tile) in tiles.into_iter().enumerate() {
-        let Some(tile) = tile else {
-            return Err(RenderError::Cancelled);
-        };
-        #[allow(clippy::cast_possible_truncation)]
-        let i = index as u32;
-        let (x0, y0) = ((i % tiles_x) * ts, (i / tiles_x) * ts);
-        let tw = ts.min(w - x0);
-        for (k, p) in tile.rgba.iter().enumerate() {
-            #[allow(clippy::cast_possible_truncation)]
-            let k = k as u32;
-            rgba[((y0 + k / tw) * w + x0 + k % tw) as usize] = *p;
-        }
-        changed_pixels += tile.changed;
-        primary_rays += tile.rays;
-    }
-    if cancel.load(Ordering::Relaxed) {
-        return Err(RenderError::Cancelled);
-    }
-    Ok(RenderedImage {
-        size_px: [w, h],
-        rgba,
-        changed_pixels,
-        primary_rays,
-    })
+    Ok(())
 }
 
 fn render_tile(
     tracer: &DifferentialTracer<'_>,
     settings: &RenderSettings,
+    layers: LayerSet,
     tile_index: usize,
     origin_px: [u32; 2],
     size_px: [u32; 2],
@@ -276,6 +326,7 @@ fn render_tile(
     let camera = tracer.camera();
     let mut out = TileOut {
         rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),
+        layers: OutputLayers::new(layers, 0),
         changed: 0,
         rays: 0,
     };
@@ -285,6 +336,8 @@ fn render_tile(
             let photo_rgb = photo_f32.map(f64::from);
             let mut sum = [0.0_f64; 3];
             let mut sum_sq = [0.0_f64; 3];
+            let mut natural_change = [0.0_f64; 3];
+            let mut first_hit = None;
             let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
             loop {
                 for s in 0..4 {
@@ -295,6 +348,14 @@ fn render_tile(
                         f64::from(y) - 0.5 + (sy + v) / 2.0,
                     );
                     let sample = tracer.trace_primary(&camera.ray_dir_in_world(pixel), photo_rgb);
+                    if n == 0 && s == 0 {
+                        first_hit = Some(sample.first_hit);
+                    }
+                    if !sample.hit_artificial {
+                        for k in 0..3 {
+                            natural_change[k] += sample.radiance_rgb[k] - photo_rgb[k];
+                        }
+                    }
                     changed |= sample.changed;
                     covered += u32::from(sample.hit_artificial);
                     for k in 0..3 {
@@ -317,6 +378,8 @@ fn render_tile(
                 }
             }
             out.rays += u64::from(n);
+            out.layers
+                .push_pixel(first_hit.flatten(), natural_change, changed, n);
             if changed {
                 out.changed += 1;
                 let nf = f64::from(n);
@@ -354,5 +417,7 @@ pub fn linear_photo(photo: &crate::photo::PhotoImage) -> Rgb32FImage {
     }
 }
 
+#[cfg(test)]
+mod physics_tests;
 #[cfg(test)]
 mod tests;
