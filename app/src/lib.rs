@@ -7,13 +7,13 @@
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
 //!
 //! # Known limitations
-//! Scene building (intersection, polygons), CAD placement and the render preview are not in
-//! this release. Files are chosen by typing a path; there is no native file dialog.
+//! Scene building (intersection, polygons) and CAD placement are not in this release. Files are chosen by typing a path; there is no native file dialog.
 
 pub mod autosave;
 pub mod commands;
 mod photo_view;
 pub mod points;
+pub mod render_panel;
 pub mod solve;
 pub mod state;
 pub mod viewport;
@@ -62,6 +62,7 @@ pub struct Message {
 enum SideTab {
     Points,
     Solve,
+    Render,
 }
 
 /// The studio app.
@@ -88,6 +89,7 @@ pub struct Studio {
     open_path: String,
     new_point_id: String,
     pending: Vec<(Command, Option<String>)>,
+    render: render_panel::RenderPanel,
 }
 
 impl Studio {
@@ -121,6 +123,7 @@ impl Studio {
             open_path: String::new(),
             new_point_id: String::new(),
             pending: Vec::new(),
+            render: render_panel::RenderPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -231,7 +234,7 @@ impl Studio {
             Some(PhotoView::Loading) => false,
             None => self.current_photo.is_none(),
         };
-        photo_ready && !self.solver.busy() && !self.loader.busy()
+        photo_ready && !self.solver.busy() && !self.loader.busy() && !self.render.busy()
     }
 
     /// Whether edits are not yet in the autosave sidecar.
@@ -383,6 +386,7 @@ impl Studio {
         if let Some(r) = self.solver.poll() {
             self.finish_solve(r);
         }
+        self.poll_render(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)
@@ -592,11 +596,13 @@ impl Studio {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut self.tab, SideTab::Points, "Points");
             ui.selectable_value(&mut self.tab, SideTab::Solve, "Results");
+            ui.selectable_value(&mut self.tab, SideTab::Render, "Render");
         });
         ui.separator();
         match self.tab {
             SideTab::Points => self.points_tab_ui(ui),
             SideTab::Solve => self.solve_tab_ui(ui),
+            SideTab::Render => self.render_tab_ui(ui),
         }
     }
 

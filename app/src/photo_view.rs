@@ -74,6 +74,11 @@ impl Studio {
         {
             ctx.request_repaint();
         }
+        if let Some(doc) = self.doc.as_ref() {
+            let tone_map = crate::render_panel::site_tone_map(doc);
+            self.render
+                .paint(&ctx, &painter, &t, &id, size_px, &tone_map);
+        }
         self.paint_marks(&painter, &t, &id);
         if self.ui_state.show_residuals
             && let (Some(sol), Some(doc)) = (&self.solution, &self.doc)
