@@ -138,7 +138,12 @@ fn render_preview_matches_the_library_and_exports() {
         if name.ends_with("exr") {
             let back = back.to_rgba32f();
             for (a, b) in back.pixels().zip(&montage.rgba) {
-                assert!(a.0 == *b, "{:?} vs {b:?}", a.0);
+                assert_eq!(
+                    a.0.map(f32::to_bits),
+                    b.map(f32::to_bits),
+                    "{:?} vs {b:?}",
+                    a.0
+                );
             }
         } else {
             let back = back.to_rgb8();
