@@ -11,7 +11,9 @@
 //! The history lives in memory only; it is not part of the autosave sidecar, so after a crash
 //! the restored edits are kept but can no longer be undone one by one.
 
-use photomontage::site::{ControlPoint, Exterior, Interior, Observation, Site, TiePoint};
+use photomontage::site::{
+    ControlPoint, Exterior, Interior, Observation, Placement, Site, TiePoint,
+};
 
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -22,6 +24,8 @@ pub enum CommandError {
     NoSuchControlPoint { id: String },
     #[error("no photo `{id}`")]
     NoSuchPhoto { id: String },
+    #[error("no CAD model `{id}`")]
+    NoSuchModel { id: String },
     #[error("nothing to undo")]
     NothingToUndo,
     #[error("nothing to redo")]
@@ -54,6 +58,8 @@ pub enum Command {
     },
     /// Replaces the tie points.
     SetTiePoints(Vec<TiePoint>),
+    /// Sets a CAD model's placement (translation, rotation about Z, scale).
+    SetModelPlacement { model: String, placement: Placement },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
 }
@@ -71,6 +77,7 @@ impl Command {
             Self::RemoveControlPoint { id } => format!("remove control point {id}"),
             Self::SetOrientation { photo, .. } => format!("orientation of {photo}"),
             Self::SetTiePoints(t) => format!("{} tie points", t.len()),
+            Self::SetModelPlacement { model, .. } => format!("place model {model}"),
             Self::Batch(c) => format!("{} edits", c.len()),
         }
     }
@@ -171,6 +178,18 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
         }
         Command::SetTiePoints(ties) => {
             Command::SetTiePoints(std::mem::replace(&mut site.tie_points, ties))
+        }
+        Command::SetModelPlacement { model, placement } => {
+            let m = site
+                .models
+                .iter_mut()
+                .find(|m| m.id == model)
+                .ok_or(CommandError::NoSuchModel { id: model.clone() })?;
+            let old = std::mem::replace(&mut m.placement, placement);
+            Command::SetModelPlacement {
+                model,
+                placement: old,
+            }
         }
         Command::Batch(commands) => {
             let mut inverses = Vec::with_capacity(commands.len());

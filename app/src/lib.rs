@@ -7,10 +7,11 @@
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
 //!
 //! # Known limitations
-//! Scene building (intersection, polygons) and CAD placement are not in this release. Files are chosen by typing a path; there is no native file dialog.
+//! Scene building (intersection, polygons) is not in this release. Files are chosen by typing a path; there is no native file dialog.
 
 pub mod autosave;
 pub mod commands;
+pub mod models_panel;
 mod photo_view;
 pub mod points;
 pub mod render_panel;
@@ -63,6 +64,7 @@ enum SideTab {
     Points,
     Solve,
     Render,
+    Models,
 }
 
 /// The studio app.
@@ -90,6 +92,7 @@ pub struct Studio {
     new_point_id: String,
     pending: Vec<(Command, Option<String>)>,
     render: render_panel::RenderPanel,
+    models: models_panel::ModelsPanel,
 }
 
 impl Studio {
@@ -124,6 +127,7 @@ impl Studio {
             new_point_id: String::new(),
             pending: Vec::new(),
             render: render_panel::RenderPanel::default(),
+            models: models_panel::ModelsPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -597,12 +601,14 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Points, "Points");
             ui.selectable_value(&mut self.tab, SideTab::Solve, "Results");
             ui.selectable_value(&mut self.tab, SideTab::Render, "Render");
+            ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
         });
         ui.separator();
         match self.tab {
             SideTab::Points => self.points_tab_ui(ui),
             SideTab::Solve => self.solve_tab_ui(ui),
             SideTab::Render => self.render_tab_ui(ui),
+            SideTab::Models => self.models_tab_ui(ui),
         }
     }
 

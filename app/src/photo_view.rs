@@ -79,6 +79,7 @@ impl Studio {
             self.render
                 .paint(&ctx, &painter, &t, &id, size_px, &tone_map);
         }
+        self.paint_wireframes(&painter, &t, &id);
         self.paint_marks(&painter, &t, &id);
         if self.ui_state.show_residuals
             && let (Some(sol), Some(doc)) = (&self.solution, &self.doc)

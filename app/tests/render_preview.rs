@@ -7,52 +7,21 @@
 
 mod common;
 
-use common::{WINDOW, copy_sample, harness};
+use common::{WINDOW, add_box_model, copy_sample, harness, step_until};
 use egui_kittest::kittest::Queryable;
 use photomontage::colour::encode_srgb8;
 use photomontage::render::{DifferentialTracer, render_view};
 use photomontage::site::render::prepare_view;
 use std::sync::atomic::AtomicBool;
-use std::time::{Duration, Instant};
-
-/// A 2 m cube, corner at the origin (z up), as OBJ.
-const BOX_OBJ: &str = "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 2\nv 2 0 2\nv 2 2 2\nv 0 2 2\n\
-f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
-
-/// The box stands 25 m in front of camera P1 (true centre 2683005, 1246978, 401.6, looking
-/// towards azimuth ≈ 21°), so it covers about 120 px of the 1600 × 1200 photo.
-const BOX_MODEL: &str = "\n[[models]]\nid = \"box\"\nfile = \"box.obj\"\nunits = \"m\"\n\
-up_axis = \"z\"\n\n[models.placement]\ntranslation = [2683014.0, 1247001.0, 400.0]\n\
-rotation_z_deg = 0.0\nscale = 1.0\n";
 
 /// Screen positions are f32; the split line is compared to the transform of the same photo
 /// column, so only f32 rounding separates them.
 const SCREEN_TOL: f32 = 1e-3;
 
-fn step_until(
-    h: &mut egui_kittest::Harness<'static, photomontage_studio::Studio>,
-    what: &str,
-    done: impl Fn(&photomontage_studio::Studio) -> bool,
-) {
-    let start = Instant::now();
-    while !done(h.state()) {
-        h.step();
-        std::thread::sleep(Duration::from_millis(20));
-        assert!(
-            start.elapsed() < Duration::from_secs(300),
-            "{what} did not finish"
-        );
-    }
-    h.run();
-}
-
 #[test]
 fn render_preview_matches_the_library_and_exports() {
     let (dir, site) = copy_sample();
-    std::fs::write(dir.path().join("box.obj"), BOX_OBJ).unwrap();
-    let mut text = std::fs::read_to_string(&site).unwrap();
-    text.push_str(BOX_MODEL);
-    std::fs::write(&site, text).unwrap();
+    add_box_model(&site);
 
     let mut h = harness(&site, WINDOW);
     h.get_by_label("Render").click();
