@@ -12,7 +12,7 @@
 //! the restored edits are kept but can no longer be undone one by one.
 
 use photomontage::site::{
-    ControlPoint, Exterior, Interior, Observation, Placement, Site, TiePoint,
+    ControlPoint, Exterior, Interior, Observation, Placement, Polygon, Site, TiePoint,
 };
 
 /// What can go wrong applying a command.
@@ -26,6 +26,8 @@ pub enum CommandError {
     NoSuchPhoto { id: String },
     #[error("no CAD model `{id}`")]
     NoSuchModel { id: String },
+    #[error("no polygon `{id}`")]
+    NoSuchPolygon { id: String },
     #[error("nothing to undo")]
     NothingToUndo,
     #[error("nothing to redo")]
@@ -58,6 +60,10 @@ pub enum Command {
     },
     /// Replaces the tie points.
     SetTiePoints(Vec<TiePoint>),
+    /// Inserts the scene polygon, or replaces the one with the same id in place.
+    PutPolygon { polygon: Polygon, at: Option<usize> },
+    /// Removes a scene polygon.
+    RemovePolygon { id: String },
     /// Sets a CAD model's placement (translation, rotation about Z, scale).
     SetModelPlacement { model: String, placement: Placement },
     /// Several commands applied in order, undone as one.
@@ -78,6 +84,8 @@ impl Command {
             Self::SetOrientation { photo, .. } => format!("orientation of {photo}"),
             Self::SetTiePoints(t) => format!("{} tie points", t.len()),
             Self::SetModelPlacement { model, .. } => format!("place model {model}"),
+            Self::PutPolygon { polygon, .. } => format!("polygon {}", polygon.id),
+            Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
         }
     }
@@ -178,6 +186,33 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
         }
         Command::SetTiePoints(ties) => {
             Command::SetTiePoints(std::mem::replace(&mut site.tie_points, ties))
+        }
+        Command::PutPolygon { polygon, at } => {
+            match site.polygons.iter().position(|p| p.id == polygon.id) {
+                Some(i) => Command::PutPolygon {
+                    polygon: std::mem::replace(&mut site.polygons[i], polygon),
+                    at: Some(i),
+                },
+                None => {
+                    let inverse = Command::RemovePolygon {
+                        id: polygon.id.clone(),
+                    };
+                    let i = at.map_or(site.polygons.len(), |i| i.min(site.polygons.len()));
+                    site.polygons.insert(i, polygon);
+                    inverse
+                }
+            }
+        }
+        Command::RemovePolygon { id } => {
+            let i = site
+                .polygons
+                .iter()
+                .position(|p| p.id == id)
+                .ok_or(CommandError::NoSuchPolygon { id })?;
+            Command::PutPolygon {
+                polygon: site.polygons.remove(i),
+                at: Some(i),
+            }
         }
         Command::SetModelPlacement { model, placement } => {
             let m = site

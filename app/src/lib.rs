@@ -7,7 +7,7 @@
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
 //!
 //! # Known limitations
-//! Scene building (intersection, polygons) is not in this release. Files are chosen by typing a path; there is no native file dialog.
+//! Polygons are not drawn over the photo. Files are chosen by typing a path; there is no native file dialog.
 
 pub mod autosave;
 pub mod commands;
@@ -15,6 +15,7 @@ pub mod models_panel;
 mod photo_view;
 pub mod points;
 pub mod render_panel;
+pub mod scene_panel;
 pub mod solve;
 pub mod state;
 pub mod viewport;
@@ -65,6 +66,7 @@ enum SideTab {
     Solve,
     Render,
     Models,
+    Scene,
 }
 
 /// The studio app.
@@ -93,6 +95,7 @@ pub struct Studio {
     pending: Vec<(Command, Option<String>)>,
     render: render_panel::RenderPanel,
     models: models_panel::ModelsPanel,
+    scene: scene_panel::ScenePanel,
 }
 
 impl Studio {
@@ -128,6 +131,7 @@ impl Studio {
             pending: Vec::new(),
             render: render_panel::RenderPanel::default(),
             models: models_panel::ModelsPanel::default(),
+            scene: scene_panel::ScenePanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -602,6 +606,7 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Solve, "Results");
             ui.selectable_value(&mut self.tab, SideTab::Render, "Render");
             ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
+            ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
         });
         ui.separator();
         match self.tab {
@@ -609,6 +614,7 @@ impl Studio {
             SideTab::Solve => self.solve_tab_ui(ui),
             SideTab::Render => self.render_tab_ui(ui),
             SideTab::Models => self.models_tab_ui(ui),
+            SideTab::Scene => self.scene_tab_ui(ui),
         }
     }
 
