@@ -480,7 +480,11 @@ impl Studio {
         egui::Panel::right("side")
             .default_size(560.0)
             .show(ui, |ui| self.side_ui(ui));
-        egui::CentralPanel::default().show(ui, |ui| self.photo_view_ui(ui));
+        // No panel fill: the photo view paints its own background around the photo only (each
+        // full-window fill layer costs ~0.2 s per frame on a CPU rasteriser; docs/benchmarks.md).
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE)
+            .show(ui, |ui| self.photo_view_ui(ui));
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
         }
