@@ -1,13 +1,16 @@
 //! The photomontage studio: view state and wiring over the `photomontage` library (which does
 //! all computation). [`Studio`] is the whole app, testable headless with egui_kittest: it
 //! opens a site (restoring an autosave sidecar newer than it), shows a photo strip, the photo
-//! view with zoom/pan/loupe, the control-point table, and solves on a worker thread.
+//! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
+//! montage preview ([`render_panel`]), places CAD models with a wireframe overlay
+//! ([`models_panel`]) and builds scene geometry ([`scene_panel`]).
 //!
 //! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
 //!
 //! # Known limitations
-//! Polygons are not drawn over the photo. Files are chosen by typing a path; there is no native file dialog.
+//! Polygons are not drawn over the photo. Files are chosen by typing a path; there is no native
+//! file dialog.
 
 pub mod autosave;
 pub mod commands;
