@@ -485,8 +485,9 @@ impl Studio {
             .show(ui, |ui| self.side_ui(ui));
         // No panel fill: the photo view paints its own background around the photo only (each
         // full-window fill layer costs ~0.2 s per frame on a CPU rasteriser; docs/benchmarks.md).
+        let frame = egui::Frame::central_panel(ui.style()).fill(Color32::TRANSPARENT);
         egui::CentralPanel::default()
-            .frame(egui::Frame::NONE)
+            .frame(frame)
             .show(ui, |ui| self.photo_view_ui(ui));
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);

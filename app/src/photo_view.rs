@@ -14,6 +14,9 @@ use crate::commands::Command;
 use crate::viewport::{self, ViewTransform};
 use crate::{PhotoView, Studio, points, solve};
 
+/// Inner margin of the central panel's frame (`egui::Frame::central_panel`).
+const CENTRAL_MARGIN: f32 = 8.0;
+
 /// Colour around the photo.
 const BACKGROUND: Color32 = Color32::from_gray(20);
 
@@ -24,6 +27,13 @@ impl Studio {
             return;
         };
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        // The central panel has no fill (see `Studio::ui`): paint its margin ring here.
+        let panel = rect.expand(CENTRAL_MARGIN);
+        for band in viewport::outside(panel, rect) {
+            ui.painter()
+                .with_clip_rect(panel)
+                .rect_filled(band, 0.0, ui.visuals().panel_fill);
+        }
         if !matches!(self.photos.get(&id), Some(PhotoView::Ready(_))) {
             ui.painter().rect_filled(rect, 0.0, BACKGROUND);
         }
