@@ -152,8 +152,9 @@ fn channel(path: &Path, name: &str) -> Vec<f32> {
 fn a_site_luminaire_adds_rho_over_pi_times_i_scale_over_h2_below_and_nothing_outside() {
     let dir = tempfile::tempdir().unwrap();
     let site = make_site(dir.path(), "downlight.ies");
-    let photo =
-        photomontage::render::linear_photo(&photomontage::photo::load(&dir.path().join("p.png")).unwrap());
+    let photo = photomontage::render::linear_photo(
+        &photomontage::photo::load(&dir.path().join("p.png")).unwrap(),
+    );
     let below = dir.path().join("below.exr");
     let o = render(&site, "below", &below);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -180,7 +181,11 @@ fn a_site_luminaire_adds_rho_over_pi_times_i_scale_over_h2_below_and_nothing_out
     let rgb = ["R", "G", "B"].map(|c| channel(&outside, c));
     for (i, p) in photo.pixels().enumerate() {
         for k in 0..3 {
-            assert_eq!(rgb[k][i].to_bits(), p.0[k].to_bits(), "pixel {i} channel {k}");
+            assert_eq!(
+                rgb[k][i].to_bits(),
+                p.0[k].to_bits(),
+                "pixel {i} channel {k}"
+            );
         }
     }
 }
@@ -193,7 +198,10 @@ fn a_missing_luminaire_file_names_the_luminaire_and_the_file() {
     let o = render(&site, "below", &out);
     assert!(!o.status.success());
     let e = stderr(&o);
-    assert!(e.contains("luminaire `porch`") && e.contains("gone.ies"), "{e}");
+    assert!(
+        e.contains("luminaire `porch`") && e.contains("gone.ies"),
+        "{e}"
+    );
     assert!(!out.exists());
 }
 
@@ -217,7 +225,15 @@ fn ctrl_c_cancels_a_render_without_writing_a_file() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_photomontage"))
         .arg("render")
         .arg(&site)
-        .args(["--view", "below", "--spp-min", "64", "--spp-max", "64", "--out"])
+        .args([
+            "--view",
+            "below",
+            "--spp-min",
+            "64",
+            "--spp-max",
+            "64",
+            "--out",
+        ])
         .arg(&out)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())

@@ -43,7 +43,10 @@ fn light_of(doc: &SiteDocument, entry: &SiteLuminaire) -> Result<ArtificialLight
         reason: reason.to_owned(),
     };
     if !entry.position_m.iter().all(|v| v.is_finite()) {
-        return Err(setting("position_m", "must be finite (not NaN or infinite)"));
+        return Err(setting(
+            "position_m",
+            "must be finite (not NaN or infinite)",
+        ));
     }
     if !(entry.rotation_z_deg.is_finite() && entry.tilt_deg.is_finite()) {
         return Err(setting("rotation_z_deg/tilt_deg", "must be finite"));

@@ -77,7 +77,10 @@ fn tilt_swings_the_nadir_towards_c0_and_rotation_turns_it_about_z() {
     let d = doc(dir.path(), vec![flood]);
     let light = &site_luminaire_lights(&d).unwrap()[0];
     let e = light.irradiance_rgb(&Point3::new(0.0, 4.0, 3.0), &-Vector3::y());
-    assert!(rel(e[0], NADIR_CD * 2e-3 / 16.0) < ROUND_OFF_REL_TOL, "{e:?}");
+    assert!(
+        rel(e[0], NADIR_CD * 2e-3 / 16.0) < ROUND_OFF_REL_TOL,
+        "{e:?}"
+    );
     let e = light.irradiance_rgb(&Point3::new(0.0, 0.0, 0.0), &Vector3::z());
     assert!(e[0].abs() < ROUND_OFF_REL_TOL * NADIR_CD, "{e:?}");
 }
@@ -90,14 +93,24 @@ fn bad_luminaires_are_errors_naming_the_entry_and_the_file() {
     let err = site_luminaire_lights(&doc(dir.path(), vec![missing])).unwrap_err();
     assert!(matches!(err, SiteRenderError::LuminaireFile { .. }));
     let text = err.to_string();
-    assert!(text.contains("`porch`") && text.contains("nope.ies"), "{text}");
+    assert!(
+        text.contains("`porch`") && text.contains("nope.ies"),
+        "{text}"
+    );
 
-    std::fs::write(dir.path().join("junk.ies"), "IESNA:LM-63-2002\nTILT=NONE\n1 2\n").unwrap();
+    std::fs::write(
+        dir.path().join("junk.ies"),
+        "IESNA:LM-63-2002\nTILT=NONE\n1 2\n",
+    )
+    .unwrap();
     let mut junk = entry("street", [0.0, 0.0, 2.0]);
     junk.file = "junk.ies".into();
     let err = site_luminaire_lights(&doc(dir.path(), vec![junk])).unwrap_err();
     let text = err.to_string();
-    assert!(text.contains("`street`") && text.contains("junk.ies"), "{text}");
+    assert!(
+        text.contains("`street`") && text.contains("junk.ies"),
+        "{text}"
+    );
 
     let nan = entry("nan", [f64::NAN, 0.0, 2.0]);
     let d = doc(dir.path(), vec![nan]);
@@ -137,5 +150,8 @@ fn luminaires_parse_from_toml_with_defaults_and_round_trip() {
     assert_eq!(again, site);
     let bad = text.replace("[1.0, 2.0, 4.5]", "[nan, 2.0, 4.5]");
     let err = Site::from_toml(&bad, Path::new("site.toml")).unwrap_err();
-    assert!(err.to_string().contains("luminaires[0].position_m"), "{err}");
+    assert!(
+        err.to_string().contains("luminaires[0].position_m"),
+        "{err}"
+    );
 }

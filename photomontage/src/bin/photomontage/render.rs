@@ -171,7 +171,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     bar.finish_and_clear();
     if CANCEL.load(Ordering::SeqCst) {
-        bail!("cancelled (Ctrl-C): nothing written to {}", args.out.display());
+        bail!(
+            "cancelled (Ctrl-C): nothing written to {}",
+            args.out.display()
+        );
     }
     let (image, out_layers) = result?;
     let elapsed_s = start.elapsed().as_secs_f64();
