@@ -14,6 +14,7 @@ pub mod camera;
 pub mod colour;
 pub mod geo;
 pub mod luminaire;
+pub mod peer_scene;
 pub mod photo;
 pub mod photogrammetry;
 pub mod render;
