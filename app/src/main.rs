@@ -1,75 +1,201 @@
-//! The photomontage studio. This first window opens a site (the argument, or the bundled
-//! courtyard sample) and shows its photos, points and solve state; calibration by clicking,
-//! scene building and the render preview come with the studio issue.
+//! `photomontage-studio [SITE] [--screenshot FILE --frames N] [--script FILE] [--headless] [--solve]`
+//!
+//! Opens SITE (default: the bundled courtyard sample) in the studio window.
+//! `--screenshot FILE --frames N`: run at least N frames (and until the photo is shown), save
+//! egui's screenshot of the window as PNG, exit. `--script FILE`: apply the edit commands in
+//! FILE (one per line: `place PHOTO POINT X Y`, `remove PHOTO POINT`, `control ID X Y Z`,
+//! `enable|disable PHOTO POINT`) through the studio's command path at start. `--headless`: run
+//! the studio's frames without a window (no display needed; autosave and workers run as usual)
+//! until killed — the crash-safety test uses it. `--solve`: start a solve on the first frame.
 
+use anyhow::{Context as _, bail};
 use eframe::egui;
-use photomontage::site::SiteDocument;
+use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state};
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 
-struct Studio {
-    path: PathBuf,
-    site: Result<SiteDocument, String>,
+struct Args {
+    site: PathBuf,
+    screenshot: Option<PathBuf>,
+    frames: u32,
+    script: Option<PathBuf>,
+    headless: bool,
+    solve: bool,
 }
 
-impl Studio {
-    fn open(path: PathBuf) -> Self {
-        let site = SiteDocument::load(&path).map_err(|e| e.to_string());
-        Self { path, site }
-    }
-}
+const USAGE: &str = "usage: photomontage-studio [SITE] [--screenshot FILE --frames N] [--script FILE] [--headless] [--solve]";
 
-impl eframe::App for Studio {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        egui::CentralPanel::default().show(ui, |ui| {
-            ui.heading("photomontage studio");
-            ui.label(format!("site: {}", self.path.display()));
-            match &self.site {
-                Err(e) => {
-                    ui.colored_label(egui::Color32::RED, e);
-                }
-                Ok(doc) => {
-                    let site = &doc.site;
-                    ui.label(format!("name: {}", site.name));
-                    ui.separator();
-                    ui.strong(format!("photos ({})", site.photos.len()));
-                    for p in &site.photos {
-                        let state = p.exterior.as_ref().map_or_else(
-                            || "not solved".to_string(),
-                            |e| format!("solved ({}), RMS {:.2} px", e.solved_by, e.rms_px),
-                        );
-                        ui.label(format!("{}  {}  {state}", p.id, p.file));
-                    }
-                    ui.separator();
-                    ui.label(format!(
-                        "control points: {}   tie points: {}   observations: {}   polygons: {}   models: {}",
-                        site.control_points.len(),
-                        site.tie_points.len(),
-                        site.observations.len(),
-                        site.polygons.len(),
-                        site.models.len()
-                    ));
+fn parse_args() -> anyhow::Result<Args> {
+    let mut args = Args {
+        site: default_site_path(),
+        screenshot: None,
+        frames: 10,
+        script: None,
+        headless: false,
+        solve: false,
+    };
+    let mut it = std::env::args_os().skip(1);
+    let mut site = None;
+    while let Some(a) = it.next() {
+        match a.to_str() {
+            Some("--screenshot") => {
+                args.screenshot = Some(it.next().context("--screenshot needs a file")?.into());
+            }
+            Some("--frames") => {
+                let n = it.next().context("--frames needs a number")?;
+                args.frames = n
+                    .to_str()
+                    .and_then(|s| s.parse().ok())
+                    .context("--frames needs a whole number")?;
+            }
+            Some("--script") => {
+                args.script = Some(it.next().context("--script needs a file")?.into());
+            }
+            Some("--headless") => args.headless = true,
+            Some("--solve") => args.solve = true,
+            Some("-h" | "--help") => {
+                println!("{USAGE}");
+                std::process::exit(0);
+            }
+            Some(s) if s.starts_with("--") => bail!("unknown option {s}\n{USAGE}"),
+            _ => {
+                if site.replace(PathBuf::from(a)).is_some() {
+                    bail!("only one SITE may be given\n{USAGE}");
                 }
             }
-        });
+        }
+    }
+    if let Some(s) = site {
+        args.site = s;
+    }
+    Ok(args)
+}
+
+fn apply_script(studio: &mut Studio, script: &PathBuf) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(script)
+        .with_context(|| format!("cannot read script {}", script.display()))?;
+    for (n, line) in text.lines().enumerate() {
+        let Some(doc) = studio.document() else {
+            bail!("no site is open");
+        };
+        match commands::parse_script_line(&doc.site, line) {
+            Ok(Some(c)) => studio.apply(c, None),
+            Ok(None) => {}
+            Err(e) => bail!("{}:{}: {e}", script.display(), n + 1),
+        }
+    }
+    Ok(())
+}
+
+/// The window: the studio plus the screenshot mode.
+struct Shell {
+    studio: Studio,
+    frames: u32,
+    screenshot: Option<PathBuf>,
+    shot: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
+    requested: bool,
+    solve_on_start: bool,
+}
+
+impl eframe::App for Shell {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        if std::mem::take(&mut self.solve_on_start) {
+            let ctx = ui.ctx().clone();
+            self.studio.start_solve(&ctx);
+        }
+        self.studio.ui(ui);
+        let Some(path) = self.screenshot.clone() else {
+            return;
+        };
+        let ctx = ui.ctx().clone();
+        self.frames = self.frames.saturating_sub(1);
+        let taken = self.shot.lock().ok().and_then(|mut s| s.take());
+        if let Some(img) = taken {
+            let [w, h] = img.size;
+            let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
+            let result = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
+                .context("screenshot has a wrong size")
+                .and_then(|i| {
+                    i.save(&path)
+                        .with_context(|| format!("cannot write {}", path.display()))
+                });
+            if let Err(e) = result {
+                eprintln!("{e:#}");
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        } else if !self.requested && self.frames == 0 && self.studio.is_idle() {
+            let shot = Arc::clone(&self.shot);
+            let wake = ctx.clone();
+            ctx.request_screenshot(move |img| {
+                if let Ok(mut s) = shot.lock() {
+                    *s = Some(img);
+                }
+                wake.request_repaint();
+            });
+            self.requested = true;
+        }
+        ctx.request_repaint();
+    }
+
+    fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
+        self.studio.on_exit();
     }
 }
 
-fn default_site() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../sample_sites/courtyard/site.toml")
+fn run_headless(mut studio: Studio) -> anyhow::Result<()> {
+    let ctx = egui::Context::default();
+    let start = std::time::Instant::now();
+    loop {
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(1280.0, 800.0),
+            )),
+            time: Some(start.elapsed().as_secs_f64()),
+            ..Default::default()
+        };
+        let mut output = ctx.run_ui(input, |ui| studio.ui(ui));
+        // No renderer: the texture uploads are dropped on purpose.
+        output.textures_delta.clear();
+        std::thread::sleep(std::time::Duration::from_millis(16));
+    }
 }
 
 fn main() -> anyhow::Result<()> {
-    let path = std::env::args_os()
-        .nth(1)
-        .map_or_else(default_site, PathBuf::from);
-    let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default().with_inner_size([900.0, 600.0]),
+    let args = parse_args()?;
+    let options = StudioOptions {
+        site_path: args.site.clone(),
+        state_path: if args.headless || args.screenshot.is_some() {
+            None
+        } else {
+            state::default_state_path()
+        },
+    };
+    let mut studio = Studio::new(options);
+    if let Some(script) = &args.script {
+        apply_script(&mut studio, script)?;
+    }
+    if args.headless {
+        return run_headless(studio);
+    }
+    let native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([1400.0, 860.0])
+            .with_title("photomontage studio"),
         ..Default::default()
+    };
+    let shell = Shell {
+        studio,
+        frames: args.frames.max(1),
+        screenshot: args.screenshot,
+        shot: Arc::new(Mutex::new(None)),
+        requested: false,
+        solve_on_start: args.solve,
     };
     eframe::run_native(
         "photomontage studio",
-        options,
-        Box::new(move |_cc| Ok(Box::new(Studio::open(path)))),
+        native,
+        Box::new(move |_cc| Ok(Box::new(shell))),
     )
     .map_err(|e| anyhow::anyhow!("cannot start the studio window: {e}"))
 }

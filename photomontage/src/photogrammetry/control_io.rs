@@ -1,9 +1,10 @@
 //! Readers for control-point files: OpenDroneMap's `gcp_list.txt` (format documented at
 //! <https://docs.opendronemap.org/gcp/>: a header line naming the coordinate reference system,
 //! then rows `geo_x geo_y geo_z im_x im_y image_name [gcp_name] [extras…]`, whitespace
-//! separated) and a plain CSV `id,X,Y,Z,x,y[,sigma_px]` with an optional header row.
+//! separated), a plain CSV `id,X,Y,Z,x,y[,sigma_px]` with an optional header row, and a
+//! control-point list `id,X,Y,Z[,sigma_m]` (world coordinates only).
 //!
-//! Both report the 1-based line of any error, never panic, and cap the number of rows.
+//! All three report the 1-based line of any error, never panic, and cap the number of rows.
 //!
 //! # Known limitations
 //! The CRS header is kept as text; no reprojection is done. ODM pixel coordinates are taken as
@@ -284,9 +285,125 @@ impl PointsCsv {
     }
 }
 
+/// Parses a control-point list `id,X,Y,Z[,sigma_m]` (world coordinates only, no pixels, as
+/// surveyors deliver them); a first row whose X is not a number is a header; blank lines and
+/// lines starting with `#` are skipped. Points without σ get `default_sigma_m` per axis; a
+/// σ column applies to all three axes.
+///
+/// # Errors
+/// `Parse` with the line for a wrong field count, a bad number, an empty id or σ < 0;
+/// `ConflictingCoordinates` when an id repeats with other coordinates; `TooManyRows`.
+pub fn parse_control_points_csv(
+    text: &str,
+    default_sigma_m: [f64; 3],
+) -> Result<Vec<ControlPoint>, ControlIoError> {
+    let mut points: Vec<ControlPoint> = Vec::new();
+    let mut first = true;
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        let t = raw.trim();
+        if t.is_empty() || t.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = t.split(',').map(str::trim).collect();
+        let is_first = std::mem::replace(&mut first, false);
+        if is_first && fields.get(1).is_some_and(|f| f.parse::<f64>().is_err()) {
+            continue; // header
+        }
+        if points.len() >= MAX_ROWS {
+            return Err(ControlIoError::TooManyRows { limit: MAX_ROWS });
+        }
+        if !(4..=5).contains(&fields.len()) {
+            return Err(ControlIoError::Parse {
+                line,
+                message: format!(
+                    "expected `id,X,Y,Z[,sigma_m]`, found {} fields",
+                    fields.len()
+                ),
+            });
+        }
+        if fields[0].is_empty() {
+            return Err(ControlIoError::Parse {
+                line,
+                message: "empty id".to_owned(),
+            });
+        }
+        let sigma_m = match fields.get(4) {
+            Some(s) if !s.is_empty() => {
+                let v = number(s, line, "sigma_m")?;
+                if v < 0.0 {
+                    return Err(ControlIoError::Parse {
+                        line,
+                        message: format!("sigma_m {v} must not be negative"),
+                    });
+                }
+                [v; 3]
+            }
+            _ => default_sigma_m,
+        };
+        let point_in_world = Point3::new(
+            number(fields[1], line, "X")?,
+            number(fields[2], line, "Y")?,
+            number(fields[3], line, "Z")?,
+        );
+        if let Some(earlier) = points.iter().find(|p| p.id == fields[0]) {
+            if earlier.point_in_world != point_in_world {
+                return Err(ControlIoError::ConflictingCoordinates {
+                    id: fields[0].to_owned(),
+                    line,
+                });
+            }
+            continue;
+        }
+        points.push(ControlPoint {
+            id: fields[0].to_owned(),
+            point_in_world,
+            sigma_m,
+        });
+    }
+    Ok(points)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    // Parsed decimal literals must equal the same literals exactly.
+    #[allow(clippy::float_cmp)]
+    fn control_points_csv_with_header_sigma_and_duplicates() {
+        let text = "id,X,Y,Z\n# comment\nA1,1.5,2,3\nB2, 10, 20, 30, 0.05\nA1,1.5,2,3\n\n";
+        let pts = parse_control_points_csv(text, [0.01; 3]).expect("valid");
+        assert_eq!(pts.len(), 2);
+        assert_eq!(pts[0].id, "A1");
+        assert_eq!(pts[0].point_in_world, Point3::new(1.5, 2.0, 3.0));
+        assert_eq!(pts[0].sigma_m, [0.01; 3]);
+        assert_eq!(pts[1].sigma_m, [0.05; 3]);
+    }
+
+    #[test]
+    fn control_points_csv_errors_name_the_line() {
+        let bad_count = parse_control_points_csv("A1,1,2\n", [0.01; 3]);
+        assert!(matches!(
+            bad_count,
+            Err(ControlIoError::Parse { line: 1, .. })
+        ));
+        let bad_number = parse_control_points_csv("id,X,Y,Z\nA1,1,2,x\n", [0.01; 3]);
+        assert!(matches!(
+            bad_number,
+            Err(ControlIoError::Parse { line: 2, .. })
+        ));
+        let conflict = parse_control_points_csv("A1,1,2,3\nA1,1,2,4\n", [0.01; 3]);
+        assert!(matches!(
+            conflict,
+            Err(ControlIoError::ConflictingCoordinates { line: 2, .. })
+        ));
+        let negative = parse_control_points_csv("A1,1,2,3,-1\n", [0.01; 3]);
+        assert!(matches!(
+            negative,
+            Err(ControlIoError::Parse { line: 1, .. })
+        ));
+    }
 
     #[test]
     fn odm_list_with_and_without_names() {

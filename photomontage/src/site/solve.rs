@@ -313,7 +313,7 @@ pub fn solve_site(doc: &SiteDocument) -> SiteSolution {
                                 if let (false, Some(c)) = (listed, known)
                                     && let Some(px) = pr.camera.project(&c.point_in_world)
                                 {
-                                    let v = [o.pixel.x - px.x, o.pixel.y - px.y];
+                                    let v = [px.x - o.pixel.x, px.y - o.pixel.y]; // projected − observed, as everywhere
                                     residuals.push(ObservationResidual {
                                         point_id: o.point_id.clone(),
                                         residual_px: v,

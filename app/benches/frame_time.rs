@@ -1,0 +1,163 @@
+//! Frame time of the studio with a 24 MP photo on screen (issue 6 acceptance).
+//!
+//! Generates a 6000×4000 photo (a seeded pattern with detail at every scale, written as PNG),
+//! opens it in the real [`Studio`] inside egui_kittest with its wgpu renderer, waits for the
+//! worker to decode it, then runs frames while zooming (fit … 16:1 … fit, about moving points)
+//! and panning. For each frame it times the studio's pass (layout, input, texture uploads:
+//! `Harness::step`) and the GPU render with read-back (`Harness::render`), and prints the
+//! median, 95th percentile and worst of each and of their sum.
+//!
+//! `cargo bench -p photomontage-studio --bench frame_time` (release profile). On a machine
+//! without a GPU wgpu runs on lavapipe (CPU), which makes the render column pessimistic.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use eframe::egui;
+use egui_kittest::Harness;
+use photomontage::site::{Interior, Photo, Site};
+use photomontage_studio::{Studio, StudioOptions};
+use std::time::{Duration, Instant};
+
+const WIDTH_PX: u32 = 6000;
+const HEIGHT_PX: u32 = 4000;
+const FRAMES: usize = 240;
+const WINDOW: [f32; 2] = [1600.0, 1000.0];
+
+fn generate(path: &std::path::Path) {
+    // Smooth gradients, a fine checker and a 100 px grid: compressible enough to write quickly,
+    // detailed enough that every zoom level shows something.
+    let img = image::RgbImage::from_fn(WIDTH_PX, HEIGHT_PX, |x, y| {
+        let grid = x % 100 == 0 || y % 100 == 0;
+        let checker = ((x / 4) + (y / 4)) % 2 == 0;
+        if grid {
+            image::Rgb([255, 255, 255])
+        } else {
+            image::Rgb([
+                (x * 255 / WIDTH_PX) as u8,
+                (y * 255 / HEIGHT_PX) as u8,
+                if checker { 160 } else { 90 },
+            ])
+        }
+    });
+    img.save(path).expect("write photo");
+}
+
+fn stats(name: &str, mut v: Vec<Duration>) {
+    v.sort();
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let median = ms(v[v.len() / 2]);
+    let p95 = ms(v[(v.len() * 95) / 100]);
+    let worst = ms(v[v.len() - 1]);
+    println!("{name:<26} median {median:7.2} ms   p95 {p95:7.2} ms   worst {worst:7.2} ms");
+}
+
+fn main() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    std::fs::create_dir(dir.path().join("photos")).expect("mkdir");
+    let t = Instant::now();
+    generate(&dir.path().join("photos/big.png"));
+    println!(
+        "generated {WIDTH_PX}×{HEIGHT_PX} PNG in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+    let site = Site {
+        name: "frame-time bench".into(),
+        photos: vec![Photo {
+            id: "BIG".into(),
+            file: "photos/big.png".into(),
+            taken_at: None,
+            interior: Some(Interior {
+                focal_px: 5000.0,
+                principal_point_px: None,
+                distortion: Default::default(),
+                image_size_px: Some([WIDTH_PX, HEIGHT_PX]),
+            }),
+            self_calibration: Default::default(),
+            exterior: None,
+        }],
+        ..Site::default()
+    };
+    let site_path = dir.path().join("site.toml");
+    site.save(&site_path).expect("site");
+
+    let studio = Studio::new(StudioOptions {
+        site_path,
+        state_path: None,
+    });
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(WINDOW[0], WINDOW[1]))
+        .wgpu()
+        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio);
+    let t = Instant::now();
+    let mut frames_while_decoding = Vec::new();
+    while !h.state().is_idle() {
+        let f = Instant::now();
+        h.step();
+        h.render().expect("render");
+        frames_while_decoding.push(f.elapsed());
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    println!(
+        "decoded and tiled on the worker in {:.2} s ({} frames meanwhile)",
+        t.elapsed().as_secs_f64(),
+        frames_while_decoding.len()
+    );
+    if !frames_while_decoding.is_empty() {
+        stats("frame while decoding", frames_while_decoding);
+    }
+
+    let rect = h.state().view_transform().expect("photo view drawn").rect;
+    let (mut step_t, mut render_t, mut total_t) = (Vec::new(), Vec::new(), Vec::new());
+    // Zoom in from fit to 16:1 over the first half, back out over the second, about a point
+    // that wanders over the view, with a small pan every frame.
+    let fit = h.state().view_transform().expect("drawn").zoom;
+    let per_frame = (16.0 / fit).powf(2.0 / FRAMES as f64);
+    for i in 0..FRAMES {
+        let phase = i as f32 / FRAMES as f32 * std::f32::consts::TAU;
+        let anchor = rect.center() + egui::vec2(phase.cos(), phase.sin()) * rect.size() * 0.3;
+        {
+            let v = h.state_mut().viewport_mut();
+            let factor = if i < FRAMES / 2 {
+                per_frame
+            } else {
+                1.0 / per_frame
+            };
+            v.zoom_about(rect, anchor, factor);
+            v.pan(egui::vec2(3.0 * phase.sin(), 2.0 * phase.cos()));
+        }
+        let a = Instant::now();
+        h.step();
+        let b = Instant::now();
+        h.render().expect("render");
+        let c = Instant::now();
+        step_t.push(b - a);
+        render_t.push(c - b);
+        total_t.push(c - a);
+    }
+    println!(
+        "{FRAMES} frames, window {}×{} points, zoom fit ({fit:.3}) → 16 → fit",
+        WINDOW[0], WINDOW[1]
+    );
+    stats("studio pass (step)", step_t);
+    stats("render + read-back", render_t);
+    stats("frame (sum)", total_t);
+
+    // Baseline: the same renderer and window with one label and no photo, to separate the
+    // renderer's own cost (lavapipe rasterising and reading back the window) from the photo's.
+    let mut base = Harness::builder()
+        .with_size(egui::vec2(WINDOW[0], WINDOW[1]))
+        .wgpu()
+        .build_ui(|ui| {
+            ui.label("baseline");
+        });
+    let mut base_t = Vec::new();
+    for _ in 0..BASELINE_FRAMES {
+        base.step();
+        let a = Instant::now();
+        base.render().expect("render");
+        base_t.push(a.elapsed());
+    }
+    stats("baseline render + read-back", base_t);
+}
+
+const BASELINE_FRAMES: usize = 30;

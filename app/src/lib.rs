@@ -1,0 +1,744 @@
+//! The photomontage studio: view state and wiring over the `photomontage` library (which does
+//! all computation). [`Studio`] is the whole app, testable headless with egui_kittest: it
+//! opens a site (restoring an autosave sidecar newer than it), shows a photo strip, the photo
+//! view with zoom/pan/loupe, the control-point table, and solves on a worker thread.
+//!
+//! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
+//! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
+//!
+//! # Known limitations
+//! Scene building (intersection, polygons), CAD placement and the render preview are not in
+//! this release. Files are chosen by typing a path; there is no native file dialog.
+
+pub mod autosave;
+pub mod commands;
+mod photo_view;
+pub mod points;
+pub mod solve;
+pub mod state;
+pub mod viewport;
+
+use eframe::egui::{self, Color32, Key, Pos2};
+use photomontage::site::{Observation, SiteDocument, SiteSolution};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use commands::{Command, History};
+use viewport::{DecodedPhoto, PhotoLoader, ViewTransform, Viewport};
+
+/// How the studio starts.
+#[derive(Debug, Clone)]
+pub struct StudioOptions {
+    /// Site to open.
+    pub site_path: PathBuf,
+    /// UI state file; `None` keeps the state in memory only (tests).
+    pub state_path: Option<PathBuf>,
+}
+
+/// The bundled sample site (path fixed at build time; `PHOTOMONTAGE_SAMPLE_SITE` overrides).
+#[must_use]
+pub fn default_site_path() -> PathBuf {
+    std::env::var_os("PHOTOMONTAGE_SAMPLE_SITE").map_or_else(
+        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../sample_sites/courtyard/site.toml"),
+        PathBuf::from,
+    )
+}
+
+enum PhotoView {
+    Loading,
+    Ready(Box<DecodedPhoto>),
+    Failed(String),
+}
+
+/// A line for the message area.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Message {
+    pub text: String,
+    pub is_error: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SideTab {
+    Points,
+    Solve,
+}
+
+/// The studio app.
+pub struct Studio {
+    options: StudioOptions,
+    doc: Option<SiteDocument>,
+    history: History,
+    autosave: autosave::Autosave,
+    /// Coalescing key of the last edit (consecutive drags of one value are one undo step).
+    last_merge_key: Option<String>,
+    ui_state: state::UiState,
+    current_photo: Option<String>,
+    photos: HashMap<String, PhotoView>,
+    loader: PhotoLoader,
+    viewport: Viewport,
+    last_transform: Option<ViewTransform>,
+    selected_point: Option<String>,
+    dragging: Option<(String, [f64; 2])>,
+    solver: solve::SolveWorker,
+    solution: Option<SiteSolution>,
+    messages: Vec<Message>,
+    tab: SideTab,
+    import_path: String,
+    open_path: String,
+    new_point_id: String,
+    pending: Vec<(Command, Option<String>)>,
+}
+
+impl Studio {
+    /// Creates the studio and opens `options.site_path` (errors become messages).
+    #[must_use]
+    pub fn new(options: StudioOptions) -> Self {
+        let ui_state = options
+            .state_path
+            .as_deref()
+            .map(state::UiState::load)
+            .unwrap_or_default();
+        let mut s = Self {
+            options: options.clone(),
+            doc: None,
+            history: History::default(),
+            autosave: autosave::Autosave::new(0),
+            last_merge_key: None,
+            ui_state,
+            current_photo: None,
+            photos: HashMap::new(),
+            loader: PhotoLoader::default(),
+            viewport: Viewport::default(),
+            last_transform: None,
+            selected_point: None,
+            dragging: None,
+            solver: solve::SolveWorker::default(),
+            solution: None,
+            messages: Vec::new(),
+            tab: SideTab::Points,
+            import_path: String::new(),
+            open_path: String::new(),
+            new_point_id: String::new(),
+            pending: Vec::new(),
+        };
+        s.open(&options.site_path);
+        s
+    }
+
+    fn say(&mut self, text: impl Into<String>, is_error: bool) {
+        self.messages.push(Message {
+            text: text.into(),
+            is_error,
+        });
+        if self.messages.len() > 50 {
+            self.messages.remove(0);
+        }
+    }
+
+    /// Opens a site, restoring a newer autosave sidecar (and saying so).
+    pub fn open(&mut self, path: &Path) {
+        match autosave::open_with_recovery(path) {
+            Ok((doc, recovery)) => {
+                match recovery {
+                    autosave::Recovery::Restored => self.say(
+                        format!(
+                            "restored unsaved edits from {} (save to keep them in the site file)",
+                            autosave::sidecar_path(path).display()
+                        ),
+                        false,
+                    ),
+                    autosave::Recovery::Unreadable(why) => self.say(why, true),
+                    autosave::Recovery::None => {}
+                }
+                self.say(format!("opened {}", path.display()), false);
+                self.history.clear();
+                self.autosave = autosave::Autosave::new(self.history.revision());
+                self.current_photo = doc.site.photos.first().map(|p| p.id.clone());
+                self.photos.clear();
+                self.solution = None;
+                self.selected_point = None;
+                self.viewport = Viewport::default();
+                self.doc = Some(doc);
+                self.ui_state.remember(path);
+                self.persist_ui_state();
+            }
+            Err(e) => self.say(e.to_string(), true),
+        }
+    }
+
+    fn persist_ui_state(&mut self) {
+        if let Some(p) = self.options.state_path.clone()
+            && let Err(e) = self.ui_state.save(&p)
+        {
+            self.say(e, true);
+        }
+    }
+
+    /// The open site.
+    #[must_use]
+    pub fn document(&self) -> Option<&SiteDocument> {
+        self.doc.as_ref()
+    }
+
+    /// Messages shown to the user, oldest first.
+    #[must_use]
+    pub fn messages(&self) -> &[Message] {
+        &self.messages
+    }
+
+    /// The last solve's result.
+    #[must_use]
+    pub fn solution(&self) -> Option<&SiteSolution> {
+        self.solution.as_ref()
+    }
+
+    /// The photo shown.
+    #[must_use]
+    pub fn current_photo(&self) -> Option<&str> {
+        self.current_photo.as_deref()
+    }
+
+    /// The point selected for placing.
+    #[must_use]
+    pub fn selected_point(&self) -> Option<&str> {
+        self.selected_point.as_deref()
+    }
+
+    /// Screen position of a photo pixel position in the last frame's view (tests use it to
+    /// click on the photo).
+    #[must_use]
+    pub fn photo_to_screen(&self, p_px: [f64; 2]) -> Option<Pos2> {
+        self.last_transform.map(|t| t.screen_from_photo(p_px))
+    }
+
+    /// The last frame's view transform.
+    #[must_use]
+    pub fn view_transform(&self) -> Option<ViewTransform> {
+        self.last_transform
+    }
+
+    /// Zoom and pan of the photo view (mutable: benches drive it).
+    pub fn viewport_mut(&mut self) -> &mut Viewport {
+        &mut self.viewport
+    }
+
+    /// Whether no worker is running and the current photo is fully decoded and uploaded.
+    #[must_use]
+    pub fn is_idle(&self) -> bool {
+        let photo_ready = match self.current_photo.as_ref().and_then(|p| self.photos.get(p)) {
+            Some(PhotoView::Ready(_) | PhotoView::Failed(_)) => true,
+            Some(PhotoView::Loading) => false,
+            None => self.current_photo.is_none(),
+        };
+        photo_ready && !self.solver.busy() && !self.loader.busy()
+    }
+
+    /// Whether edits are not yet in the autosave sidecar.
+    #[must_use]
+    pub fn autosave_pending(&self) -> bool {
+        self.autosave.is_dirty(self.history.revision())
+    }
+
+    /// Applies an edit through the undo history (the one path every edit takes). `merge_key`:
+    /// consecutive edits with the same key are one undo step.
+    pub fn apply(&mut self, command: Command, merge_key: Option<String>) {
+        let Some(doc) = self.doc.as_mut() else {
+            return;
+        };
+        let merge = merge_key.is_some() && merge_key == self.last_merge_key;
+        let result = if merge {
+            self.history.apply_merged(&mut doc.site, command)
+        } else {
+            self.history.apply(&mut doc.site, command)
+        };
+        match result {
+            Ok(()) => self.last_merge_key = merge_key,
+            Err(e) => self.say(e.to_string(), true),
+        }
+    }
+
+    /// Undoes the last edit.
+    pub fn undo(&mut self) {
+        self.last_merge_key = None;
+        if let Some(doc) = self.doc.as_mut()
+            && let Err(e) = self.history.undo(&mut doc.site)
+        {
+            self.say(e.to_string(), true);
+        }
+    }
+
+    /// Redoes the last undone edit.
+    pub fn redo(&mut self) {
+        self.last_merge_key = None;
+        if let Some(doc) = self.doc.as_mut()
+            && let Err(e) = self.history.redo(&mut doc.site)
+        {
+            self.say(e.to_string(), true);
+        }
+    }
+
+    /// Saves the site atomically and removes the autosave sidecar.
+    pub fn save(&mut self) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let path = doc.path.clone();
+        match doc.save() {
+            Ok(()) => {
+                if let Err(e) = self.autosave.saved(self.history.revision(), &path) {
+                    self.say(e.to_string(), true);
+                }
+                self.say(format!("saved {}", path.display()), false);
+            }
+            Err(e) => self.say(e.to_string(), true),
+        }
+    }
+
+    /// Writes the autosave sidecar now if edits are pending.
+    pub fn autosave_now(&mut self) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let revision = self.history.revision();
+        if self.autosave.is_dirty(revision)
+            && let Err(e) = self.autosave.write_now(revision, &doc.site, &doc.path)
+        {
+            self.say(e.to_string(), true);
+        }
+    }
+
+    /// Starts a solve of the site as it is now on the worker thread.
+    pub fn start_solve(&mut self, ctx: &egui::Context) {
+        let Some(doc) = self.doc.clone() else {
+            return;
+        };
+        if self.solver.start(doc, ctx.clone()) {
+            self.say("solving…", false);
+        } else {
+            self.say("a solve is already running", true);
+        }
+    }
+
+    /// Selects the photo shown.
+    pub fn select_photo(&mut self, id: &str) {
+        if self.current_photo.as_deref() != Some(id) {
+            self.current_photo = Some(id.to_owned());
+            self.viewport = Viewport::default();
+        }
+    }
+
+    fn finish_solve(&mut self, result: Result<SiteSolution, String>) {
+        match result {
+            Ok(solution) => {
+                for f in &solution.failures {
+                    self.say(format!("photo {} not solved: {}", f.id, f.error), true);
+                }
+                for w in &solution.warnings {
+                    self.say(format!("warning: {w}"), false);
+                }
+                if let Some(doc) = self.doc.as_ref() {
+                    let mut solved = doc.site.clone();
+                    photomontage::site::apply_solution(&mut solved, &solution);
+                    let mut batch: Vec<Command> = solved
+                        .photos
+                        .iter()
+                        .map(|p| Command::SetOrientation {
+                            photo: p.id.clone(),
+                            interior: p.interior.clone(),
+                            exterior: p.exterior.clone(),
+                        })
+                        .collect();
+                    batch.push(Command::SetTiePoints(solved.tie_points.clone()));
+                    self.apply(Command::Batch(batch), None);
+                }
+                let summary = solution.bundle_rms_px.map_or_else(
+                    || format!("solved {} photo(s)", solution.photos.len()),
+                    |r| {
+                        format!(
+                            "solved {} photo(s), bundle RMS {r:.3} px",
+                            solution.photos.len()
+                        )
+                    },
+                );
+                self.say(summary, false);
+                self.solution = Some(solution);
+                self.tab = SideTab::Solve;
+            }
+            Err(e) => self.say(e, true),
+        }
+    }
+
+    fn poll_workers(&mut self, ctx: &egui::Context) {
+        for d in self.loader.poll() {
+            let view = match d.result {
+                Ok(p) => PhotoView::Ready(Box::new(p)),
+                Err(e) => {
+                    self.say(e.clone(), true);
+                    PhotoView::Failed(e)
+                }
+            };
+            self.photos.insert(d.photo_id, view);
+        }
+        if let Some(r) = self.solver.poll() {
+            self.finish_solve(r);
+        }
+        // Start decoding the current photo.
+        if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
+            && !self.photos.contains_key(&id)
+            && let Some(p) = doc.site.photos.iter().find(|p| p.id == id)
+        {
+            let path = doc.resolve(&p.file);
+            self.photos.insert(id.clone(), PhotoView::Loading);
+            self.loader.request(id, path, ctx.clone());
+        }
+        if self.loader.busy() || self.solver.busy() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(50));
+        }
+    }
+
+    fn autosave_tick(&mut self, ctx: &egui::Context) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let now = Instant::now();
+        let revision = self.history.revision();
+        match self.autosave.tick(now, revision, &doc.site, &doc.path) {
+            Ok(_) => {}
+            Err(e) => self.say(e.to_string(), true),
+        }
+        if let Some(due) = self.autosave.due_in(now, revision) {
+            ctx.request_repaint_after(due.max(std::time::Duration::from_millis(20)));
+        }
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        let typing = ctx.text_edit_focused();
+        let (undo, redo, save, delete) = ctx.input_mut(|i| {
+            let cmd = egui::Modifiers::COMMAND;
+            let shift_cmd = egui::Modifiers::COMMAND | egui::Modifiers::SHIFT;
+            (
+                i.consume_key(cmd, Key::Z),
+                i.consume_key(shift_cmd, Key::Z) || i.consume_key(cmd, Key::Y),
+                i.consume_key(cmd, Key::S),
+                !typing && i.key_pressed(Key::Delete),
+            )
+        });
+        if undo && !typing {
+            self.undo();
+        }
+        if redo && !typing {
+            self.redo();
+        }
+        if save {
+            self.save();
+        }
+        if delete
+            && let (Some(photo), Some(point)) =
+                (self.current_photo.clone(), self.selected_point.clone())
+            && self.observation(&photo, &point).is_some()
+        {
+            self.apply(Command::RemoveObservation { photo, point }, None);
+        }
+    }
+
+    fn observation(&self, photo: &str, point: &str) -> Option<&Observation> {
+        self.doc
+            .as_ref()?
+            .site
+            .observations
+            .iter()
+            .find(|o| o.photo == photo && o.point == point)
+    }
+
+    /// Draws the whole studio into `ui` and handles its input (called by eframe every frame,
+    /// and by the tests).
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        self.poll_workers(&ctx);
+        self.shortcuts(&ctx);
+        egui::Panel::top("toolbar").show(ui, |ui| self.toolbar_ui(ui));
+        egui::Panel::bottom("messages")
+            .resizable(true)
+            .default_size(70.0)
+            .show(ui, |ui| self.messages_ui(ui));
+        egui::Panel::left("photos")
+            .default_size(150.0)
+            .show(ui, |ui| self.photo_strip_ui(ui));
+        egui::Panel::right("side")
+            .default_size(560.0)
+            .show(ui, |ui| self.side_ui(ui));
+        egui::CentralPanel::default().show(ui, |ui| self.photo_view_ui(ui));
+        for (c, key) in std::mem::take(&mut self.pending) {
+            self.apply(c, key);
+        }
+        self.autosave_tick(&ctx);
+    }
+
+    fn toolbar_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let name = self
+                .doc
+                .as_ref()
+                .map_or_else(|| "no site".into(), |d| d.site.name.clone());
+            ui.strong(name);
+            ui.separator();
+            if ui.button("Save").clicked() {
+                self.save();
+            }
+            if ui
+                .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
+                .clicked()
+            {
+                self.undo();
+            }
+            if ui
+                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
+                .clicked()
+            {
+                self.redo();
+            }
+            let solving = self.solver.busy();
+            if ui
+                .add_enabled(!solving, egui::Button::new("Solve"))
+                .clicked()
+            {
+                let ctx = ui.ctx().clone();
+                self.start_solve(&ctx);
+            }
+            if solving {
+                ui.spinner();
+            }
+            if ui.button("Fit").clicked() {
+                self.viewport.fitted = true;
+            }
+            ui.separator();
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.open_path)
+                    .hint_text("site file path")
+                    .desired_width(220.0),
+            );
+            points::name_widget(ui, &r, "site path");
+            if ui.button("Open").clicked() && !self.open_path.trim().is_empty() {
+                let p = PathBuf::from(self.open_path.trim());
+                self.open(&p);
+            }
+            let recent = self.ui_state.recent_sites.clone();
+            let mut chosen = None;
+            egui::ComboBox::from_label("Recent")
+                .selected_text("sites")
+                .show_ui(ui, |ui| {
+                    for p in &recent {
+                        if ui
+                            .selectable_label(false, p.display().to_string())
+                            .clicked()
+                        {
+                            chosen = Some(p.clone());
+                        }
+                    }
+                });
+            if let Some(p) = chosen {
+                self.open(&p);
+            }
+        });
+    }
+
+    fn messages_ui(&mut self, ui: &mut egui::Ui) {
+        egui::ScrollArea::vertical()
+            .stick_to_bottom(true)
+            .auto_shrink([false, false])
+            .show(ui, |ui| {
+                for m in &self.messages {
+                    if m.is_error {
+                        ui.colored_label(Color32::from_rgb(255, 90, 90), &m.text);
+                    } else {
+                        ui.label(&m.text);
+                    }
+                }
+            });
+    }
+
+    fn photo_strip_ui(&mut self, ui: &mut egui::Ui) {
+        ui.strong("Photos");
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let mut chosen = None;
+        for p in &doc.site.photos {
+            let solved = p.exterior.as_ref().map_or_else(
+                || "not solved".to_string(),
+                |e| format!("RMS {:.2} px", e.rms_px),
+            );
+            let n = doc
+                .site
+                .observations
+                .iter()
+                .filter(|o| o.photo == p.id)
+                .count();
+            let text = format!("{}\n{n} obs · {solved}", p.id);
+            let sel = self.current_photo.as_deref() == Some(p.id.as_str());
+            let r = ui.selectable_label(sel, text);
+            points::name_widget(ui, &r, &format!("photo {}", p.id));
+            if r.clicked() {
+                chosen = Some(p.id.clone());
+            }
+        }
+        if let Some(id) = chosen {
+            self.select_photo(&id);
+        }
+    }
+
+    fn side_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut self.tab, SideTab::Points, "Points");
+            ui.selectable_value(&mut self.tab, SideTab::Solve, "Results");
+        });
+        ui.separator();
+        match self.tab {
+            SideTab::Points => self.points_tab_ui(ui),
+            SideTab::Solve => self.solve_tab_ui(ui),
+        }
+    }
+
+    fn points_tab_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.import_path)
+                    .hint_text(points::IMPORT_HINT)
+                    .desired_width(330.0),
+            );
+            points::name_widget(ui, &r, "import path");
+            if ui.button("Import").clicked() {
+                self.import();
+            }
+        });
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.new_point_id)
+                    .hint_text("tie point id (no survey)")
+                    .desired_width(160.0),
+            );
+            points::name_widget(ui, &r, "point id");
+            let id = self.new_point_id.trim();
+            if ui.button("Pick id").clicked() && !id.is_empty() {
+                self.selected_point = Some(id.to_owned());
+            }
+            // Points observed but not surveyed (tie points) are listed for picking too.
+            if let Some(doc) = self.doc.as_ref() {
+                let mut ties: Vec<&str> = doc
+                    .site
+                    .observations
+                    .iter()
+                    .map(|o| o.point.as_str())
+                    .filter(|p| !doc.site.control_points.iter().any(|c| c.id == *p))
+                    .collect();
+                ties.sort_unstable();
+                ties.dedup();
+                for t in ties {
+                    let sel = self.selected_point.as_deref() == Some(t);
+                    let r = ui.selectable_label(sel, t);
+                    points::name_widget(ui, &r, &format!("tie {t}"));
+                    if r.clicked() {
+                        self.selected_point = Some(t.to_owned());
+                    }
+                }
+            }
+        });
+        let sel = self.selected_point.clone().unwrap_or_else(|| "none".into());
+        ui.label(format!(
+            "selected: {sel} — click the photo to place it, drag a mark to move, Delete removes"
+        ));
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let mut commands = Vec::new();
+        egui::ScrollArea::horizontal().show(ui, |ui| {
+            points::table_ui(
+                ui,
+                &doc.site,
+                self.current_photo.as_deref(),
+                &mut self.selected_point,
+                &mut commands,
+            );
+        });
+        self.pending.extend(commands);
+    }
+
+    /// Imports control points (and observations) from the file named in the import field.
+    pub fn import(&mut self) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let path = PathBuf::from(self.import_path.trim());
+        match points::import_file(&doc.site, &path, self.current_photo.as_deref()) {
+            Ok(Command::Batch(b)) if b.is_empty() => {
+                self.say(format!("{}: nothing to import", path.display()), true);
+            }
+            Ok(c) => {
+                let text = format!("imported {}", path.display());
+                self.apply(c, None);
+                self.say(text, false);
+            }
+            Err(e) => self.say(e.to_string(), true),
+        }
+    }
+
+    /// Sets the import field (what a user types).
+    pub fn set_import_path(&mut self, path: &str) {
+        path.clone_into(&mut self.import_path);
+    }
+
+    fn solve_tab_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let r = ui.checkbox(&mut self.ui_state.show_residuals, "residual vectors");
+            points::name_widget(ui, &r, "residual vectors");
+            let r = ui.add(
+                egui::Slider::new(&mut self.ui_state.residual_exaggeration, 1.0..=5000.0)
+                    .logarithmic(true)
+                    .text("×"),
+            );
+            points::name_widget(ui, &r, "residual exaggeration");
+        });
+        let Some(solution) = self.solution.as_ref() else {
+            ui.label("not solved yet: press Solve");
+            return;
+        };
+        if let Some(r) = solution.bundle_rms_px {
+            ui.strong(format!("bundle adjustment RMS {r:.3} px"));
+        }
+        for f in &solution.failures {
+            ui.colored_label(
+                Color32::from_rgb(255, 90, 90),
+                format!("{}: {}", f.id, f.error),
+            );
+        }
+        for w in &solution.warnings {
+            ui.colored_label(Color32::from_rgb(230, 160, 40), format!("warning: {w}"));
+        }
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            // The current photo first, then the others.
+            let current = self.current_photo.as_deref();
+            let mut order: Vec<_> = solution.photos.iter().collect();
+            order.sort_by_key(|p| Some(p.id.as_str()) != current);
+            for p in order {
+                ui.separator();
+                solve::photo_solution_ui(ui, p);
+            }
+        });
+    }
+
+    /// Writes the UI state (call on exit).
+    pub fn on_exit(&mut self) {
+        self.persist_ui_state();
+    }
+}
+
+impl eframe::App for Studio {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        Studio::ui(self, ui);
+    }
+
+    fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
+        Studio::on_exit(self);
+    }
+}

@@ -1,0 +1,241 @@
+//! The photo view of the studio: drawing the photo through [`crate::viewport`], zoom about the
+//! cursor, pan, the loupe, the observation marks, placing by click, moving by drag, and the
+//! residual vectors of the last solve ([`crate::solve::paint_residuals`]). Edits are queued as
+//! commands and applied by [`Studio::ui`] through the one command path.
+//!
+//! # Known limitations
+//! Marks are drawn for every observation of the photo each frame (fine for hundreds, not for
+//! tens of thousands of points); there is no snapping to image features.
+
+use eframe::egui::{self, Color32, Key, PointerButton, Sense};
+use photomontage::site::Observation;
+
+use crate::commands::Command;
+use crate::viewport::{self, ViewTransform};
+use crate::{PhotoView, Studio, points, solve};
+
+impl Studio {
+    pub(crate) fn photo_view_ui(&mut self, ui: &mut egui::Ui) {
+        let Some(id) = self.current_photo.clone() else {
+            ui.label("no photo");
+            return;
+        };
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        let size_px = match self.photos.get(&id) {
+            Some(PhotoView::Ready(p)) => p.size_px,
+            Some(PhotoView::Failed(e)) => {
+                ui.painter().text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    e,
+                    egui::FontId::proportional(14.0),
+                    Color32::from_rgb(255, 90, 90),
+                );
+                return;
+            }
+            _ => {
+                ui.painter().text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    format!("decoding {id}…"),
+                    egui::FontId::proportional(14.0),
+                    Color32::GRAY,
+                );
+                return;
+            }
+        };
+        if self.viewport.fitted {
+            self.viewport.fit(rect, size_px);
+        }
+        // Zoom about the cursor (wheel, ctrl+wheel, pinch).
+        if let Some(hover) = response.hover_pos() {
+            let (scroll, pinch) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+            let factor = f64::from(pinch) * (f64::from(scroll) * 0.0025).exp();
+            if (factor - 1.0).abs() > 1e-6 {
+                self.viewport.zoom_about(rect, hover, factor);
+            }
+        }
+        let space = ui.input(|i| i.key_down(Key::Space));
+        let panning = response.dragged_by(PointerButton::Middle)
+            || response.dragged_by(PointerButton::Secondary)
+            || (space && response.dragged_by(PointerButton::Primary));
+        if panning {
+            self.viewport.pan(response.drag_delta());
+        }
+        let t = self.viewport.transform(rect);
+        self.last_transform = Some(t);
+        self.observation_interaction(&response, &t, &id, space);
+
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(20));
+        let ctx = ui.ctx().clone();
+        if let Some(PhotoView::Ready(photo)) = self.photos.get_mut(&id)
+            && photo.paint(&ctx, &painter, &t)
+        {
+            ctx.request_repaint();
+        }
+        self.paint_marks(&painter, &t, &id);
+        if self.ui_state.show_residuals
+            && let (Some(sol), Some(doc)) = (&self.solution, &self.doc)
+            && let Some(ps) = sol.photos.iter().find(|p| p.id == id)
+        {
+            solve::paint_residuals(
+                &painter,
+                &t,
+                &doc.site,
+                ps,
+                self.ui_state.residual_exaggeration,
+            );
+        }
+        // Loupe for sub-pixel placing.
+        if self.ui_state.loupe
+            && let Some(hover) = response.hover_pos()
+            && let Some(PhotoView::Ready(photo)) = self.photos.get_mut(&id)
+        {
+            let side = 170.0;
+            let mut min = hover + egui::vec2(24.0, -side - 24.0);
+            if min.x + side > rect.right() {
+                min.x = hover.x - side - 24.0;
+            }
+            if min.y < rect.top() {
+                min.y = hover.y + 24.0;
+            }
+            let loupe = egui::Rect::from_min_size(min, egui::vec2(side, side));
+            let at = t.photo_from_screen(hover);
+            let zoom = self
+                .ui_state
+                .loupe_zoom
+                .max(self.viewport.zoom * 4.0)
+                .min(64.0);
+            viewport::paint_loupe(&ctx, &painter, photo, loupe, at, zoom);
+            painter.text(
+                loupe.left_bottom() + egui::vec2(4.0, -4.0),
+                egui::Align2::LEFT_BOTTOM,
+                format!("{:.2}, {:.2}", at[0], at[1]),
+                egui::FontId::monospace(11.0),
+                Color32::WHITE,
+            );
+        }
+        painter.text(
+            rect.right_top() + egui::vec2(-8.0, 8.0),
+            egui::Align2::RIGHT_TOP,
+            format!("{id} · zoom {:.3}", self.viewport.zoom),
+            egui::FontId::proportional(12.0),
+            Color32::WHITE,
+        );
+    }
+
+    fn observation_interaction(
+        &mut self,
+        response: &egui::Response,
+        t: &ViewTransform,
+        photo: &str,
+        space: bool,
+    ) {
+        const GRAB_RADIUS_POINTS: f32 = 8.0;
+        if space {
+            return;
+        }
+        if response.drag_started_by(PointerButton::Primary)
+            && let Some(press) = response.ctx.input(|i| i.pointer.press_origin())
+            && let Some(doc) = self.doc.as_ref()
+        {
+            let nearest = doc
+                .site
+                .observations
+                .iter()
+                .filter(|o| o.photo == photo)
+                .map(|o| (o, t.screen_from_photo([o.x_px, o.y_px]).distance(press)))
+                .filter(|(_, d)| *d <= GRAB_RADIUS_POINTS)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((o, _)) = nearest {
+                self.dragging = Some((o.point.clone(), [o.x_px, o.y_px]));
+                self.selected_point = Some(o.point.clone());
+            }
+        }
+        if let Some((_, pos)) = self.dragging.as_mut()
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            *pos = t.photo_from_screen(p);
+        }
+        if response.drag_stopped()
+            && let Some((point, pos)) = self.dragging.take()
+            && let Some(o) = self.observation(photo, &point)
+        {
+            let mut moved = o.clone();
+            moved.x_px = pos[0];
+            moved.y_px = pos[1];
+            self.pending.push((
+                Command::PutObservation {
+                    observation: moved,
+                    at: None,
+                },
+                None,
+            ));
+        }
+        if response.clicked_by(PointerButton::Primary)
+            && let (Some(point), Some(p)) =
+                (self.selected_point.clone(), response.interact_pointer_pos())
+        {
+            let [x_px, y_px] = t.photo_from_screen(p);
+            let old = self.observation(photo, &point);
+            let observation = Observation {
+                photo: photo.to_owned(),
+                point,
+                x_px,
+                y_px,
+                sigma_px: old.map_or(points::DEFAULT_SIGMA_PX, |o| o.sigma_px),
+                enabled: old.is_none_or(|o| o.enabled),
+            };
+            self.pending.push((
+                Command::PutObservation {
+                    observation,
+                    at: None,
+                },
+                None,
+            ));
+        }
+    }
+
+    fn paint_marks(&self, painter: &egui::Painter, t: &ViewTransform, photo: &str) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let outliers: Vec<&str> = self
+            .solution
+            .as_ref()
+            .and_then(|s| s.photos.iter().find(|p| p.id == photo))
+            .map(|p| p.outliers.iter().map(String::as_str).collect())
+            .unwrap_or_default();
+        for o in doc.site.observations.iter().filter(|o| o.photo == photo) {
+            let pos = match &self.dragging {
+                Some((p, at)) if *p == o.point => *at,
+                _ => [o.x_px, o.y_px],
+            };
+            let c = t.screen_from_photo(pos);
+            let selected = self.selected_point.as_deref() == Some(o.point.as_str());
+            let colour = if !o.enabled {
+                Color32::GRAY
+            } else if outliers.contains(&o.point.as_str()) {
+                Color32::from_rgb(255, 60, 60)
+            } else if selected {
+                Color32::from_rgb(255, 230, 0)
+            } else {
+                Color32::from_rgb(60, 255, 120)
+            };
+            let s = egui::Stroke::new(if selected { 2.0 } else { 1.5 }, colour);
+            painter.circle_stroke(c, 6.0, s);
+            painter.line_segment([c - egui::vec2(10.0, 0.0), c - egui::vec2(3.0, 0.0)], s);
+            painter.line_segment([c + egui::vec2(3.0, 0.0), c + egui::vec2(10.0, 0.0)], s);
+            painter.line_segment([c - egui::vec2(0.0, 10.0), c - egui::vec2(0.0, 3.0)], s);
+            painter.line_segment([c + egui::vec2(0.0, 3.0), c + egui::vec2(0.0, 10.0)], s);
+            painter.text(
+                c + egui::vec2(9.0, -9.0),
+                egui::Align2::LEFT_BOTTOM,
+                &o.point,
+                egui::FontId::proportional(12.0),
+                colour,
+            );
+        }
+    }
+}

@@ -1,0 +1,298 @@
+//! The control-point table (egui_extras `TableBuilder`): id, world X/Y/Z editable, σ, enabled,
+//! and the point's observation in the current photo (position, on/off, delete); plus importing
+//! control points from a CSV (`id,X,Y,Z[,σ]`, or `id,X,Y,Z,x,y[,σ_px]` with observations in the
+//! current photo) or an OpenDroneMap `gcp_list.txt` (observations matched to photos by file
+//! name). The table only emits [`Command`]s; `crate::Studio` applies them.
+//!
+//! File formats: `photomontage::photogrammetry::control_io` (ODM's documented GCP format).
+//!
+//! # Known limitations
+//! Files are chosen by typing a path (no native file dialog yet). ODM rows name images by file
+//! name only, so two photos with the same file name in different folders are ambiguous (the
+//! first is used).
+
+use eframe::egui;
+use egui_extras::{Column, TableBuilder};
+use photomontage::photogrammetry::control_io::{
+    ControlIoError, parse_control_points_csv, parse_odm_gcp_list, parse_points_csv,
+};
+use photomontage::site::{ControlPoint, Observation, Site};
+use std::path::Path;
+
+use crate::commands::Command;
+
+/// σ given to imported control points that carry none (1 cm per axis, the site default).
+pub const DEFAULT_SIGMA_M: [f64; 3] = [0.01; 3];
+/// σ given to imported observations that carry none (the site file's default).
+pub const DEFAULT_SIGMA_PX: f64 = 0.5;
+
+/// What can go wrong importing.
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}: {source}")]
+    Parse {
+        path: String,
+        source: ControlIoError,
+    },
+    #[error("{path}: observations need a photo; select one first")]
+    NoPhoto { path: String },
+}
+
+/// Control points (and observations) of a file, as one undoable batch.
+///
+/// # Errors
+/// [`ImportError`] naming the file and line.
+pub fn import_file(
+    site: &Site,
+    path: &Path,
+    current_photo: Option<&str>,
+) -> Result<Command, ImportError> {
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| ImportError::Read {
+        path: shown.clone(),
+        source,
+    })?;
+    let parse_err = |source| ImportError::Parse {
+        path: shown.clone(),
+        source,
+    };
+    let is_gcp_list = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("txt"));
+    let control;
+    let mut observations = Vec::new();
+    if is_gcp_list {
+        let list = parse_odm_gcp_list(&text).map_err(parse_err)?;
+        control = list.control_points(DEFAULT_SIGMA_M).map_err(parse_err)?;
+        for image in list.images() {
+            let photo = site.photos.iter().find(|p| {
+                Path::new(&p.file)
+                    .file_name()
+                    .is_some_and(|n| n.to_string_lossy() == image)
+            });
+            if let Some(photo) = photo {
+                for o in list.observations(&image, DEFAULT_SIGMA_PX) {
+                    observations.push((photo.id.clone(), o));
+                }
+            }
+        }
+    } else {
+        match parse_control_points_csv(&text, DEFAULT_SIGMA_M) {
+            Ok(c) => control = c,
+            Err(first_error) => {
+                // Six or seven columns: control points with their pixels in the current photo.
+                let csv = parse_points_csv(&text).map_err(|_| parse_err(first_error))?;
+                let photo = current_photo.ok_or_else(|| ImportError::NoPhoto {
+                    path: shown.clone(),
+                })?;
+                let (c, obs) = csv.split(DEFAULT_SIGMA_M, DEFAULT_SIGMA_PX);
+                control = c;
+                observations = obs.into_iter().map(|o| (photo.to_owned(), o)).collect();
+            }
+        }
+    }
+    let mut batch: Vec<Command> = control
+        .into_iter()
+        .map(|c| {
+            let existing = site.control_points.iter().find(|e| e.id == c.id);
+            Command::PutControlPoint {
+                point: ControlPoint {
+                    id: c.id,
+                    xyz: c.point_in_world.coords.into(),
+                    sigma_m: c.sigma_m,
+                    crs: existing.and_then(|e| e.crs.clone()),
+                    enabled: existing.is_none_or(|e| e.enabled),
+                },
+                at: None,
+            }
+        })
+        .collect();
+    batch.extend(
+        observations
+            .into_iter()
+            .map(|(photo, o)| Command::PutObservation {
+                observation: Observation {
+                    photo,
+                    point: o.point_id,
+                    x_px: o.pixel.x,
+                    y_px: o.pixel.y,
+                    sigma_px: o.sigma_px,
+                    enabled: true,
+                },
+                at: None,
+            }),
+    );
+    Ok(Command::Batch(batch))
+}
+
+/// Gives a widget an accessible name (for screen readers and the kittest tests).
+pub fn name_widget(ui: &egui::Ui, response: &egui::Response, name: &str) {
+    ui.ctx().accesskit_node_builder(response.id, |node| {
+        node.set_label(name.to_owned());
+    });
+}
+
+/// The table. `selected` is the selected point id; edits come back as commands.
+pub fn table_ui(
+    ui: &mut egui::Ui,
+    site: &Site,
+    current_photo: Option<&str>,
+    selected: &mut Option<String>,
+    commands: &mut Vec<(Command, Option<String>)>,
+) {
+    let observation_of = |id: &str| {
+        current_photo.and_then(|p| {
+            site.observations
+                .iter()
+                .find(|o| o.photo == p && o.point == id)
+        })
+    };
+    TableBuilder::new(ui)
+        .id_salt("control points")
+        .striped(true)
+        .column(Column::auto().at_least(46.0))
+        .columns(Column::auto().at_least(96.0), 3)
+        .column(Column::auto().at_least(44.0))
+        .column(Column::auto().at_least(28.0))
+        .column(Column::remainder().at_least(150.0))
+        .max_scroll_height(f32::INFINITY)
+        .header(20.0, |mut h| {
+            for t in ["id", "X m", "Y m", "Z m", "σ m", "on", "in this photo"] {
+                h.col(|ui| {
+                    ui.strong(t);
+                });
+            }
+        })
+        .body(|mut body| {
+            for cp in &site.control_points {
+                body.row(22.0, |mut row| {
+                    row.col(|ui| {
+                        let is_sel = selected.as_deref() == Some(cp.id.as_str());
+                        let r = ui.selectable_label(is_sel, &cp.id);
+                        if r.clicked() {
+                            *selected = Some(cp.id.clone());
+                        }
+                    });
+                    for axis in 0..3 {
+                        row.col(|ui| {
+                            let mut v = cp.xyz[axis];
+                            let r =
+                                ui.add(egui::DragValue::new(&mut v).speed(0.001).fixed_decimals(3));
+                            name_widget(ui, &r, &format!("{} {}", ["X", "Y", "Z"][axis], cp.id));
+                            if r.changed() && v.is_finite() {
+                                let mut p = cp.clone();
+                                p.xyz[axis] = v;
+                                commands.push((
+                                    Command::PutControlPoint { point: p, at: None },
+                                    Some(format!("xyz {}", cp.id)),
+                                ));
+                            }
+                        });
+                    }
+                    row.col(|ui| {
+                        ui.label(format!("{:.3}", cp.sigma_m[0]));
+                    });
+                    row.col(|ui| {
+                        let mut on = cp.enabled;
+                        let r = ui.checkbox(&mut on, "");
+                        name_widget(ui, &r, &format!("use {}", cp.id));
+                        if r.changed() {
+                            let mut p = cp.clone();
+                            p.enabled = on;
+                            commands.push((Command::PutControlPoint { point: p, at: None }, None));
+                        }
+                    });
+                    row.col(|ui| {
+                        if let Some(o) = observation_of(&cp.id) {
+                            let mut on = o.enabled;
+                            let r = ui.checkbox(&mut on, format!("{:.2}, {:.2}", o.x_px, o.y_px));
+                            name_widget(ui, &r, &format!("observation {}", cp.id));
+                            if r.changed() {
+                                let mut changed = o.clone();
+                                changed.enabled = on;
+                                commands.push((
+                                    Command::PutObservation {
+                                        observation: changed,
+                                        at: None,
+                                    },
+                                    None,
+                                ));
+                            }
+                            if ui
+                                .small_button("del")
+                                .on_hover_text("remove this observation")
+                                .clicked()
+                            {
+                                commands.push((
+                                    Command::RemoveObservation {
+                                        photo: o.photo.clone(),
+                                        point: o.point.clone(),
+                                    },
+                                    None,
+                                ));
+                            }
+                        }
+                    });
+                });
+            }
+        });
+}
+
+/// A hint for the status line naming the import formats.
+pub const IMPORT_HINT: &str =
+    "CSV id,X,Y,Z[,σ] or id,X,Y,Z,x,y[,σpx] (current photo), or ODM gcp_list.txt";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_with_pixels_goes_to_the_current_photo_and_gcp_list_by_file_name() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut site = Site::default();
+        site.photos.push(photomontage::site::Photo {
+            id: "P1".into(),
+            file: "photos/IMG_1.jpg".into(),
+            taken_at: None,
+            interior: None,
+            self_calibration: Default::default(),
+            exterior: None,
+        });
+        let csv = dir.path().join("pts.csv");
+        std::fs::write(&csv, "id,X,Y,Z,x,y\nA,1,2,3,10.5,20.5\n").expect("write");
+        assert!(matches!(
+            import_file(&site, &csv, None),
+            Err(ImportError::NoPhoto { .. })
+        ));
+        let Command::Batch(b) = import_file(&site, &csv, Some("P1")).expect("import") else {
+            panic!("a batch");
+        };
+        assert_eq!(b.len(), 2);
+        assert!(matches!(&b[1], Command::PutObservation { observation, .. }
+            if observation.photo == "P1" && (observation.x_px - 10.5).abs() < 1e-12));
+        let gcp = dir.path().join("gcp_list.txt");
+        std::fs::write(
+            &gcp,
+            "EPSG:2056\n1 2 3 40 50 IMG_1.jpg g1\n1 2 3 4 5 other.jpg g1\n",
+        )
+        .expect("write");
+        let Command::Batch(b) = import_file(&site, &gcp, None).expect("import") else {
+            panic!("a batch");
+        };
+        assert_eq!(
+            b.len(),
+            2,
+            "one point, one observation (other.jpg is not in the site)"
+        );
+        let bad = dir.path().join("bad.csv");
+        std::fs::write(&bad, "A,1,2\n").expect("write");
+        let e = import_file(&site, &bad, Some("P1")).expect_err("bad");
+        assert!(e.to_string().contains("line 1"), "{e}");
+    }
+}

@@ -1,0 +1,229 @@
+//! Solving in the studio: [`photomontage::site::solve_site`] (resection of every photo, then the
+//! bundle adjustment; Durisch 1992 §4.1) on a named worker thread, its result sent back over a
+//! channel; the residual table, the residual vectors drawn on the photo with a scale bar, and the
+//! warnings and failures as readable messages.
+//!
+//! The table shows the numbers exactly as `photomontage solve` prints them (same rounding), so
+//! the two can be compared by eye and by the tests.
+//!
+//! # Known limitations
+//! A solve cannot be cancelled once started (the library solver has no cancellation hook); a
+//! second request while one runs is refused with a message rather than queued.
+
+use eframe::egui::{self, Color32, Pos2, Stroke};
+use egui_extras::{Column, TableBuilder};
+use photomontage::site::{SiteDocument, SiteSolution, solve::PhotoSolution};
+use std::sync::mpsc;
+
+use crate::viewport::ViewTransform;
+
+/// A solve running on the worker, or its outcome.
+#[derive(Default)]
+pub struct SolveWorker {
+    rx: Option<mpsc::Receiver<Result<SiteSolution, String>>>,
+}
+
+impl SolveWorker {
+    /// Starts solving a snapshot of the site. Returns false when a solve is already running.
+    pub fn start(&mut self, doc: SiteDocument, ctx: egui::Context) -> bool {
+        if self.rx.is_some() {
+            return false;
+        }
+        let (tx, rx) = mpsc::channel();
+        let spawned = std::thread::Builder::new()
+            .name("solve".into())
+            .spawn(move || {
+                let result = std::panic::catch_unwind(|| photomontage::site::solve_site(&doc))
+                    .map_err(|_| "the solver crashed; the site is unchanged".to_string());
+                let _ = tx.send(result);
+                ctx.request_repaint();
+            });
+        match spawned {
+            Ok(_) => {
+                self.rx = Some(rx);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Whether a solve is running.
+    #[must_use]
+    pub fn busy(&self) -> bool {
+        self.rx.is_some()
+    }
+
+    /// The outcome, once the worker has finished.
+    pub fn poll(&mut self) -> Option<Result<SiteSolution, String>> {
+        let rx = self.rx.as_ref()?;
+        match rx.try_recv() {
+            Ok(r) => {
+                self.rx = None;
+                Some(r)
+            }
+            Err(mpsc::TryRecvError::Empty) => None,
+            Err(mpsc::TryRecvError::Disconnected) => {
+                self.rx = None;
+                Some(Err("the solve worker stopped without an answer".into()))
+            }
+        }
+    }
+}
+
+/// `|v|` and `|v|/σ` of a residual row, as the CLI computes them.
+#[must_use]
+pub fn row_numbers(r: &photomontage::photogrammetry::ObservationResidual) -> [f64; 4] {
+    [
+        r.residual_px[0],
+        r.residual_px[1],
+        r.residual_px[0].hypot(r.residual_px[1]),
+        r.normalised[0].hypot(r.normalised[1]),
+    ]
+}
+
+/// The text of one residual row's cells, as `photomontage solve` prints them.
+#[must_use]
+pub fn row_cells(r: &photomontage::photogrammetry::ObservationResidual) -> [String; 4] {
+    let [vx, vy, n, w] = row_numbers(r);
+    [
+        format!("{vx:.3}"),
+        format!("{vy:.3}"),
+        format!("{n:.3}"),
+        format!("{w:.2}"),
+    ]
+}
+
+/// Summary lines and the residual table of one photo's solution.
+pub fn photo_solution_ui(ui: &mut egui::Ui, s: &PhotoSolution) {
+    let c = s.camera.pose.camera_center_in_world;
+    ui.label(format!(
+        "{}: {} · RMS {:.3} px · focal {:.2} px",
+        s.id, s.solved_by, s.rms_px, s.camera.intrinsics.focal_px
+    ));
+    ui.label(format!(
+        "centre X {:.4} Y {:.4} Z {:.4} (σ {:.4} {:.4} {:.4} m)",
+        c.x, c.y, c.z, s.sigma_center_m[0], s.sigma_center_m[1], s.sigma_center_m[2]
+    ));
+    for w in &s.warnings {
+        ui.colored_label(Color32::from_rgb(230, 160, 40), format!("warning: {w}"));
+    }
+    TableBuilder::new(ui)
+        .id_salt(("residuals", &s.id))
+        .striped(true)
+        .column(Column::auto().at_least(60.0))
+        .columns(Column::auto().at_least(55.0), 4)
+        .column(Column::remainder())
+        .max_scroll_height(260.0)
+        .header(18.0, |mut h| {
+            for t in ["point", "vx px", "vy px", "|v| px", "|v|/σ", "flag"] {
+                h.col(|ui| {
+                    ui.strong(t);
+                });
+            }
+        })
+        .body(|mut body| {
+            for r in &s.residuals {
+                body.row(18.0, |mut row| {
+                    let colour = if r.outlier {
+                        Color32::from_rgb(230, 60, 60)
+                    } else {
+                        ui_text_colour()
+                    };
+                    row.col(|ui| {
+                        ui.colored_label(colour, &r.point_id);
+                    });
+                    for cell in row_cells(r) {
+                        row.col(|ui| {
+                            ui.colored_label(colour, cell);
+                        });
+                    }
+                    row.col(|ui| {
+                        if r.outlier {
+                            ui.colored_label(colour, "OUTLIER");
+                        }
+                    });
+                });
+            }
+        });
+}
+
+fn ui_text_colour() -> Color32 {
+    Color32::from_gray(220)
+}
+
+/// A round residual length (1, 2 or 5 × 10ⁿ px) whose bar is about `target_points` long.
+#[must_use]
+pub fn scale_bar_px(points_per_residual_px: f64, target_points: f64) -> f64 {
+    let raw = target_points / points_per_residual_px.max(1e-12);
+    let decade = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .rfind(|v| *v <= raw)
+        .unwrap_or(decade)
+}
+
+/// Draws residual vectors (magnified `exaggeration` times) from each observation of the photo,
+/// and a scale bar in the lower-left corner of the view.
+pub fn paint_residuals(
+    painter: &egui::Painter,
+    t: &ViewTransform,
+    site: &photomontage::site::Site,
+    solution: &PhotoSolution,
+    exaggeration: f64,
+) {
+    let ok = Stroke::new(2.0, Color32::from_rgb(40, 220, 255));
+    let bad = Stroke::new(2.0, Color32::from_rgb(255, 60, 60));
+    for r in &solution.residuals {
+        let Some(o) = site
+            .observations
+            .iter()
+            .find(|o| o.photo == solution.id && o.point == r.point_id)
+        else {
+            continue;
+        };
+        if !(r.residual_px[0].is_finite() && r.residual_px[1].is_finite()) {
+            continue;
+        }
+        let from = t.screen_from_photo([o.x_px, o.y_px]);
+        let to = t.screen_from_photo([
+            o.x_px + r.residual_px[0] * exaggeration,
+            o.y_px + r.residual_px[1] * exaggeration,
+        ]);
+        painter.arrow(from, to - from, if r.outlier { bad } else { ok });
+    }
+    // Scale bar: a residual of `len_px` drawn at this zoom and exaggeration.
+    let points_per_px = t.zoom * exaggeration;
+    let len_px = scale_bar_px(points_per_px, 120.0);
+    let bar = (len_px * points_per_px) as f32;
+    let origin = Pos2::new(t.rect.left() + 16.0, t.rect.bottom() - 20.0);
+    painter.rect_filled(
+        egui::Rect::from_min_max(
+            origin - egui::vec2(8.0, 22.0),
+            origin + egui::vec2(bar + 8.0, 10.0),
+        ),
+        3.0,
+        Color32::from_black_alpha(170),
+    );
+    painter.line_segment([origin, origin + egui::vec2(bar, 0.0)], ok);
+    painter.text(
+        origin - egui::vec2(0.0, 4.0),
+        egui::Align2::LEFT_BOTTOM,
+        format!("{len_px} px residual (×{exaggeration})"),
+        egui::FontId::proportional(12.0),
+        Color32::WHITE,
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scale_bar_is_a_round_length_near_the_target() {
+        // 3 points per residual px, 120 points wanted: 40 px → 20 (1-2-5 series, not above).
+        assert!((scale_bar_px(3.0, 120.0) - 20.0).abs() < 1e-12);
+        assert!((scale_bar_px(120.0, 120.0) - 1.0).abs() < 1e-12);
+        assert!((scale_bar_px(500.0, 120.0) - 0.2).abs() < 1e-12);
+    }
+}
