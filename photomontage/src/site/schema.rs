@@ -58,6 +58,9 @@ pub struct Site {
     /// CAD models of the planned (artificial) objects.
     #[serde(default)]
     pub models: Vec<CadModel>,
+    /// Artificial lights: luminaires with a photometric file (IES LM-63 or EULUMDAT).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub luminaires: Vec<SiteLuminaire>,
 }
 
 impl Default for Site {
@@ -75,6 +78,7 @@ impl Default for Site {
             observations: Vec::new(),
             polygons: Vec::new(),
             models: Vec::new(),
+            luminaires: Vec::new(),
         }
     }
 }
@@ -376,6 +380,42 @@ impl Default for Placement {
             scale: 1.0,
         }
     }
+}
+
+/// A luminaire of the site (an artificial light, Durisch 1992 §3.2 / §6.2 cases C and D1).
+///
+/// Photometric frame: with both angles 0 the luminaire hangs in its photometric position, nadir
+/// (γ = 0) straight down (world −Z) and the C0 half-plane towards world +X (C90 towards +Y).
+/// `tilt_deg` then swings the nadir up towards the C0 direction, and `rotation_z_deg` turns the
+/// whole luminaire about the vertical: `world_from_luminaire = R_z(rotation_z) · R_y(−tilt)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SiteLuminaire {
+    /// Unique id, named in errors and warnings.
+    pub id: String,
+    /// IES LM-63 (`.ies`) or EULUMDAT (`.ldt`) file, relative to the site file.
+    pub file: String,
+    /// Photometric centre, world coordinates (metres).
+    pub position_m: [f64; 3],
+    /// Rotation about world Z, degrees counter-clockwise seen from above (C0 from +X).
+    #[serde(default)]
+    pub rotation_z_deg: f64,
+    /// Tilt of the nadir from straight down towards the C0 direction, degrees.
+    #[serde(default)]
+    pub tilt_deg: f64,
+    /// Colour multiplier per RGB channel (linear).
+    #[serde(default = "default_colour")]
+    pub colour_rgb: [f64; 3],
+    /// Photo linear units × m² per candela: a luminaire of I cd gives the irradiance
+    /// `I · scale · colour / d²` in the units of `lighting.sun_weight`.
+    pub scale: f64,
+    /// Disabled luminaires are kept but give no light.
+    #[serde(default = "default_true")]
+    pub enabled: bool,
+}
+
+fn default_colour() -> [f64; 3] {
+    [1.0; 3]
 }
 
 /// Render settings.

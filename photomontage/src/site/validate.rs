@@ -240,6 +240,8 @@ impl Site {
             }
         }
 
+        validate_luminaires(&self.luminaires, &mut issues);
+
         let lighting = &self.lighting;
         if !valid_sky_model(&lighting.sky_model) {
             issues.push(issue(
@@ -293,5 +295,51 @@ fn valid_sky_model(name: &str) -> bool {
             .strip_prefix("cie_general:")
             .and_then(|n| n.parse::<u8>().ok())
             .is_some_and(|n| (1..=15).contains(&n)),
+    }
+}
+
+fn validate_luminaires(luminaires: &[super::SiteLuminaire], issues: &mut Vec<SiteIssue>) {
+    let mut ids = HashSet::new();
+    for (i, l) in luminaires.iter().enumerate() {
+        let field = format!("luminaires[{i}]");
+        if l.id.trim().is_empty() {
+            issues.push(issue(format!("{field}.id"), "must not be empty"));
+        }
+        if !ids.insert(l.id.as_str()) {
+            issues.push(issue(
+                format!("{field}.id"),
+                format!("duplicate luminaire id `{}`", l.id),
+            ));
+        }
+        if l.file.trim().is_empty() {
+            issues.push(issue(
+                format!("{field}.file"),
+                format!("luminaire `{}`: must not be empty", l.id),
+            ));
+        }
+        for (name, values) in [
+            ("position_m", &l.position_m[..]),
+            ("rotation_z_deg", &[l.rotation_z_deg][..]),
+            ("tilt_deg", &[l.tilt_deg][..]),
+        ] {
+            if values.iter().any(|v| !v.is_finite()) {
+                issues.push(issue(
+                    format!("{field}.{name}"),
+                    format!("luminaire `{}`: must be finite (not NaN or infinite)", l.id),
+                ));
+            }
+        }
+        if !l.colour_rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            issues.push(issue(
+                format!("{field}.colour_rgb"),
+                format!("luminaire `{}`: must be finite and ≥ 0", l.id),
+            ));
+        }
+        if !(l.scale.is_finite() && l.scale >= 0.0) {
+            issues.push(issue(
+                format!("{field}.scale"),
+                format!("luminaire `{}`: must be finite and ≥ 0", l.id),
+            ));
+        }
     }
 }
