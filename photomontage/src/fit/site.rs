@@ -1,0 +1,1 @@
+//! Site glue (being written).
