@@ -120,7 +120,10 @@ fn validate(
             found: usize::from(!samples.is_empty()),
         });
     }
-    if samples.iter().all(|s| s.1 == horizon_radiance) {
+    if samples
+        .iter()
+        .all(|s| (s.1 - horizon_radiance).abs() <= f64::MIN_POSITIVE)
+    {
         return Err(AtmosphereError::Undetermined {
             reason: "every sample equals the horizon colour",
         });
