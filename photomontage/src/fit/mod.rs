@@ -12,7 +12,8 @@
 //!   and underexposed pixels rejected), linearised.
 //! - [`sun_check`]: the sun direction measured from an object/shadow pair against the SPA sun for
 //!   the photo's time, with the camera-clock offset that would explain a disagreement.
-//! - [`site`]: the glue that runs all of it on a site file and writes the result back.
+//! - [`site`]: the glue that runs all of it on a site file; [`report`] its report and the
+//!   write-back into the site.
 //!
 //! Progress of the iterative solvers is reported through [`FitObserver`] (an adapter turns it
 //! into an argmin observer).
@@ -25,6 +26,7 @@
 pub mod atmosphere;
 pub mod colour;
 pub mod daylight;
+pub mod report;
 pub mod site;
 pub mod sun_check;
 
