@@ -313,7 +313,7 @@ fn locate_sample(
             pixel.x, pixel.y, sample.photo
         )
     })?;
-    let point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+    let mut point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
     if let Some(p) = sample.point {
         let gap = (point - Point3::from(p)).norm();
         let limit = POINT_ON_POLYGON_M.max(1e-3 * (point - centre).norm());
@@ -324,6 +324,8 @@ fn locate_sample(
                 sample.photo
             ));
         }
+        // The given point, not the f32 hit (which a grazing ray moves along the surface).
+        point = Point3::from(p);
     }
     let material = scene
         .materials()
@@ -734,3 +736,6 @@ fn run_fits(
         extinction_per_m: atmosphere.as_ref().map(AtmosphereFit::extinction_per_m),
     })
 }
+
+#[cfg(test)]
+mod tests;
