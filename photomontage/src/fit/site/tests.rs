@@ -464,7 +464,10 @@ fn bad_samples_are_named() {
         .site
         .samples
         .iter()
-        .find(|s| s.purpose == SamplePurpose::Daylight && s.point.is_some_and(|p| p[1] == 20.0))
+        .find(|s| {
+            s.purpose == SamplePurpose::Daylight
+                && s.point.is_some_and(|p| (p[1] - 20.0).abs() < 1e-9)
+        })
         .unwrap()
         .id
         .clone();
