@@ -6,7 +6,9 @@
 //!   the horizon colour L∞ if it points above the horizon.
 //! - **Case C** ([`DifferentialTracer::case_c_artificial_hit`]): an artificial object → eq. 6 with
 //!   the natural lights (sun, ambient, sky facets, visibility by any-hit against the whole scene)
-//!   and the artificial point lights, mirror reflection recursively, then the atmosphere (eq. 2).
+//!   and the artificial lights (points or luminaires), the GGX lobe ([`super::specular`]), mirror
+//!   and thin-glass reflection and transmission recursively ([`super::glass`]), water-wave
+//!   shading normals ([`super::water`]), then the atmosphere (eq. 2).
 //! - **Case D** ([`DifferentialTracer::case_d_natural_hit`]): a natural object → its apparent
 //!   colour from the photo, its true colour L₀ by the atmosphere's second inversion (eq. 8), its
 //!   albedo ρ_d by the illumination model's second inversion (eq. 10), then
@@ -31,8 +33,9 @@
 //! # Known limitations
 //! Secondary rays that hit natural objects take their apparent colour from the current photo only
 //! (not from the polygon's image attribute photo), when the point is visible in it; otherwise the
-//! library material is shaded by eq. 6. Only ideal mirror reflection is recursed (no refraction,
-//! no glossy lobes). The gather is one bounce on a fixed facet set (deterministic, so it has
+//! library material is shaded by eq. 6. Glass is a thin pane (no refraction through solids) and
+//! opaque to shadow rays; the glossy lobe is sampled with few rays (see [`super::specular`]).
+//! The gather is one bounce on a fixed facet set (deterministic, so it has
 //! quantisation error rather than noise); the artificial radiance a natural point gathers takes sky
 //! facets as visible and gets its own photo bounce only from the coarser nested dome; natural surfaces blocked from the photo's view
 //! fall back to their library material; the light a natural surface no longer receives from
@@ -43,15 +46,20 @@
 use image::Rgb32FImage;
 use nalgebra::{Point2, Point3, Vector3};
 
+use super::glass::PhotoBehind;
 use super::illumination::{
-    Daylight, PointLight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour,
-    mul, natural_irradiance_rgb, scale,
+    Daylight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour, mul,
+    natural_irradiance_rgb, scale,
 };
+use super::luminaire_light::ArtificialLight;
+use super::specular::{SurfaceFrame, reflect_above};
+use super::water::shading_normal;
 use crate::atmosphere::schachter::SchachterAtmosphere;
 use crate::bvh::BuildQuality;
 use crate::camera::Camera;
 use crate::colour::Colour;
-use crate::scene::{ImportedModel, ObjectKind, Scene, SceneError, SceneHit, SceneTracer};
+use crate::scene::material::GradientNoise;
+use crate::scene::{ImportedModel, Material, ObjectKind, Scene, SceneError, SceneHit, SceneTracer};
 
 /// Shadow and reflection rays start this far off the surface, along its normal, so they do not
 /// re-hit it: 1 mm, far above the `f32` spacing (≤ 0.5 mm) of the local tracing frame within
@@ -74,8 +82,9 @@ pub enum DifferentialError {
 pub struct Lighting {
     /// Natural daylight (from the first inversion, §4.3).
     pub daylight: Daylight,
-    /// Artificial point lights of the project.
-    pub artificial_lights: Vec<PointLight>,
+    /// Artificial lights of the project: isotropic points or luminaires with a photometric web
+    /// ([`super::luminaire_light`]).
+    pub artificial_lights: Vec<ArtificialLight>,
     /// Schachter atmosphere (eq. 2); `None` for a clear atmosphere.
     pub atmosphere: Option<SchachterAtmosphere>,
     /// Light reflected by the photographed surroundings onto artificial objects (one diffuse
@@ -116,6 +125,17 @@ pub struct DifferentialTracer<'a> {
     camera: &'a Camera,
     photo_linear: &'a Rgb32FImage,
     max_depth: u32,
+    /// The materials shaded (the scene's, or per-band ones in spectral mode).
+    pub(super) materials: &'a [Material],
+    /// Noise of each material's water waves (index = material id).
+    pub(super) water_noise: Vec<Option<GradientNoise>>,
+}
+
+fn water_noise_of(materials: &[Material]) -> Vec<Option<GradientNoise>> {
+    materials
+        .iter()
+        .map(|m| m.water.map(|w| GradientNoise::new(w.seed)))
+        .collect()
 }
 
 fn sub_scene(scene: &Scene, kind: ObjectKind) -> Scene {
@@ -175,7 +195,53 @@ impl<'a> DifferentialTracer<'a> {
             camera,
             photo_linear,
             max_depth,
+            materials: scene.materials(),
+            water_noise: water_noise_of(scene.materials()),
         })
+    }
+
+    /// The same geometry (BVHs cloned, not rebuilt) with other lights, photo and materials
+    /// (`materials` indexed like the scene's): the spectral mode's per-band passes.
+    #[must_use]
+    pub fn with_inputs<'b>(
+        &self,
+        lighting: &'b Lighting,
+        photo_linear: &'b Rgb32FImage,
+        materials: &'b [Material],
+    ) -> DifferentialTracer<'b>
+    where
+        'a: 'b,
+    {
+        DifferentialTracer {
+            scene: self.scene,
+            all: self.all.clone(),
+            natural: self.natural.clone(),
+            artificial: self.artificial.clone(),
+            artificial_bounds_in_world_m: self.artificial_bounds_in_world_m,
+            lighting,
+            camera: self.camera,
+            photo_linear,
+            max_depth: self.max_depth,
+            materials,
+            water_noise: water_noise_of(materials),
+        }
+    }
+
+    /// The material of a hit (`None` for an unknown id).
+    pub(super) fn material_of(&self, hit: &SceneHit) -> Option<&'a Material> {
+        self.materials.get(hit.material.0 as usize)
+    }
+
+    /// The lighting of this tracer.
+    #[must_use]
+    pub fn lighting(&self) -> &'a Lighting {
+        self.lighting
+    }
+
+    /// The mirror / glass / glossy recursion depth limit.
+    #[must_use]
+    pub fn max_depth(&self) -> u32 {
+        self.max_depth
     }
 
     /// The current photo, linear RGB.
@@ -211,7 +277,14 @@ impl<'a> DifferentialTracer<'a> {
                 let d = f64::from(hit.hit.t);
                 match hit.kind {
                     ObjectKind::Artificial => RaySample {
-                        radiance_rgb: self.case_c_artificial_hit(&hit, &point, dir_in_world, d, 0),
+                        radiance_rgb: self.case_c_shade(
+                            &hit,
+                            &point,
+                            dir_in_world,
+                            d,
+                            0,
+                            Some(PhotoBehind::at_camera(photo_pixel_rgb)),
+                        ),
                         changed: true,
                         hit_artificial: true,
                     },
@@ -255,7 +328,11 @@ impl<'a> DifferentialTracer<'a> {
         }
     }
 
-    fn normal_facing(&self, hit: &SceneHit, dir_in_world: &Vector3<f64>) -> Vector3<f64> {
+    pub(super) fn normal_facing(
+        &self,
+        hit: &SceneHit,
+        dir_in_world: &Vector3<f64>,
+    ) -> Vector3<f64> {
         let n = self
             .scene
             .triangles()
@@ -267,7 +344,7 @@ impl<'a> DifferentialTracer<'a> {
         if n.dot(dir_in_world) > 0.0 { -n } else { n }
     }
 
-    fn blocked_by(
+    pub(super) fn blocked_by(
         tracer: &SceneTracer,
         origin: &Point3<f64>,
         dir: &Vector3<f64>,
@@ -313,28 +390,44 @@ impl<'a> DifferentialTracer<'a> {
             .is_some_and(|n| Self::blocked_by(n, origin, dir, t_max))
     }
 
-    /// Irradiance from the artificial point lights at a point, visibility against everything.
-    /// Also says whether any artificial light reaches the point.
-    fn artificial_light_irradiance(
+    /// The artificial lights that reach the surface point `point` (in front of the geometric
+    /// `normal`; shadow ray from the offset point `origin` by any-hit against everything): unit
+    /// direction towards each and its irradiance at `point` on a surface facing it, `I(−dir)/d²`
+    /// (inverse-square law).
+    pub(super) fn visible_artificial_lights(
         &self,
+        point: &Point3<f64>,
         origin: &Point3<f64>,
         normal: &Vector3<f64>,
-    ) -> (Rgb, bool) {
-        let mut e = [0.0; 3];
-        let mut lit = false;
+    ) -> Vec<(Vector3<f64>, Rgb)> {
+        let mut out = Vec::new();
         for light in &self.lighting.artificial_lights {
-            let to_light = light.position_in_world_m - origin;
+            let to_light = light.position_in_world_m() - origin;
             let dist = to_light.norm();
             if dist <= SURFACE_OFFSET_M || to_light.dot(normal) <= 0.0 {
                 continue;
             }
             let dir = to_light / dist;
             if !Self::blocked_by(&self.all, origin, &dir, dist - SURFACE_OFFSET_M) {
-                e = add(e, light.irradiance_rgb(origin, normal));
-                lit = true;
+                let to_light_from_point = light.position_in_world_m() - point;
+                let dir_from_point = to_light_from_point.try_normalize(0.0).unwrap_or(dir);
+                out.push((dir_from_point, light.normal_irradiance_rgb(point)));
             }
         }
-        (e, lit)
+        out
+    }
+
+    /// Irradiance from the artificial lights `visible` on a surface of unit (shading) normal
+    /// `normal` (cosine law); also says whether any light reaches the point.
+    fn artificial_light_irradiance(
+        visible: &[(Vector3<f64>, Rgb)],
+        normal: &Vector3<f64>,
+    ) -> (Rgb, bool) {
+        let mut e = [0.0; 3];
+        for (dir, e_normal) in visible {
+            e = add(e, scale(*e_normal, dir.dot(normal).max(0.0)));
+        }
+        (e, !visible.is_empty())
     }
 
     fn transmission(&self, distance_m: f64) -> Rgb {
@@ -377,16 +470,35 @@ impl<'a> DifferentialTracer<'a> {
         distance_m: f64,
         depth: u32,
     ) -> Rgb {
+        self.case_c_shade(hit, point, dir_in_world, distance_m, depth, None)
+    }
+
+    /// Case C with, for a ray still on the camera's line of sight (`behind` given), the photo's
+    /// value at that pixel as what a glass pane lets through from behind.
+    pub(super) fn case_c_shade(
+        &self,
+        hit: &SceneHit,
+        point: &Point3<f64>,
+        dir_in_world: &Vector3<f64>,
+        distance_m: f64,
+        depth: u32,
+        behind: Option<PhotoBehind>,
+    ) -> Rgb {
         let normal = self.normal_facing(hit, dir_in_world);
         let origin = point + normal * SURFACE_OFFSET_M;
-        let material = self.scene.materials().get(hit.material.0 as usize);
+        let material = self.material_of(hit);
+        let noise = self
+            .water_noise
+            .get(hit.material.0 as usize)
+            .and_then(Option::as_ref);
+        let shading_normal = shading_normal(material, noise, point, &normal, dir_in_world);
         let rho = material.map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
         let daylight = &self.lighting.daylight;
         let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
             s.dir_in_world.dot(&normal) > 0.0
                 && !Self::blocked_by(&self.all, &origin, &s.dir_in_world, f64::INFINITY)
         });
-        let e_natural = natural_irradiance_rgb(daylight, &normal, sun_visible, |i| {
+        let e_natural = natural_irradiance_rgb(daylight, &shading_normal, sun_visible, |i| {
             !Self::blocked_by(
                 &self.all,
                 &origin,
@@ -394,9 +506,10 @@ impl<'a> DifferentialTracer<'a> {
                 f64::INFINITY,
             )
         });
+        let lights = self.visible_artificial_lights(point, &origin, &normal);
         let mut e = add(
             e_natural,
-            self.artificial_light_irradiance(&origin, &normal).0,
+            Self::artificial_light_irradiance(&lights, &shading_normal).0,
         );
         if depth < self.max_depth {
             e = add(
@@ -404,7 +517,7 @@ impl<'a> DifferentialTracer<'a> {
                 self.photo_bounce_irradiance(
                     self.lighting.photo_bounce_dome.as_ref(),
                     &origin,
-                    &normal,
+                    &shading_normal,
                 ),
             );
         }
@@ -414,9 +527,39 @@ impl<'a> DifferentialTracer<'a> {
                 l0 = add(l0, emission);
             }
             if let (Some(mirror), true) = (m.mirror_rgb, depth < self.max_depth) {
-                let reflected = dir_in_world - normal * (2.0 * dir_in_world.dot(&normal));
+                let reflected = reflect_above(dir_in_world, &shading_normal, &normal);
                 let incoming = self.trace_secondary(&origin, &reflected, depth + 1);
                 l0 = add(l0, mul(mirror, incoming));
+            }
+            if let Some(spec) = &m.specular {
+                let frame = SurfaceFrame {
+                    origin: &origin,
+                    normal: &normal,
+                    shading_normal: &shading_normal,
+                };
+                let sun = daylight.sun.as_ref().filter(|_| sun_visible);
+                l0 = add(
+                    l0,
+                    self.specular_radiance(spec, &frame, dir_in_world, sun, &lights, depth),
+                );
+            }
+            if let (Some(glass), true) = (&m.glass, depth < self.max_depth) {
+                let behind = behind.map(|b| PhotoBehind {
+                    camera_distance_m: b.camera_distance_m + distance_m,
+                    ..b
+                });
+                l0 = add(
+                    l0,
+                    self.glass_radiance(
+                        glass,
+                        point,
+                        &normal,
+                        &shading_normal,
+                        dir_in_world,
+                        depth,
+                        behind,
+                    ),
+                );
             }
         }
         self.apparent(l0, distance_m)
@@ -455,7 +598,10 @@ impl<'a> DifferentialTracer<'a> {
             })
             .collect();
         // D1: artificial lights add.
-        let (e_d1, lit_d1) = self.artificial_light_irradiance(&origin, &normal);
+        let (e_d1, lit_d1) = Self::artificial_light_irradiance(
+            &self.visible_artificial_lights(point, &origin, &normal),
+            &normal,
+        );
         let unchanged = !sun_d3 && sky_d3.is_empty() && !lit_d1;
         if unchanged {
             // D2 only: the natural light is already in the photo.
@@ -478,9 +624,7 @@ impl<'a> DifferentialTracer<'a> {
             // No natural light reaches the point: nothing to remove; D1 needs ρ_d from the
             // material library.
             let rho = self
-                .scene
-                .materials()
-                .get(hit.material.0 as usize)
+                .material_of(hit)
                 .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
             let delta = diffuse_radiance_rgb(rho, e_d1);
             return self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m);
@@ -515,6 +659,19 @@ impl<'a> DifferentialTracer<'a> {
         } else {
             (self.apparent(add(l0, delta), distance_m), true)
         }
+    }
+
+    /// The closest hit of the ray `origin + t·dir` (`dir` unit), its point and distance.
+    pub(super) fn closest_hit_from(
+        &self,
+        origin: &Point3<f64>,
+        dir: &Vector3<f64>,
+    ) -> Option<(SceneHit, Point3<f64>, f64)> {
+        let ray = self.all.ray_from_world(origin, dir, 0.0, f32::INFINITY);
+        let hit = self.all.closest_hit(&ray)?;
+        let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
+        let t = f64::from(hit.hit.t);
+        Some((hit, point, t))
     }
 
     /// A secondary ray (reflection) from `origin` along `dir`, at recursion depth `depth`.
@@ -629,9 +786,7 @@ impl<'a> DifferentialTracer<'a> {
         let origin = point + normal * SURFACE_OFFSET_M;
         let daylight = &self.lighting.daylight;
         let rho = self
-            .scene
-            .materials()
-            .get(hit.material.0 as usize)
+            .material_of(hit)
             .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
         let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
             s.dir_in_world.dot(&normal) > 0.0
@@ -688,9 +843,7 @@ impl<'a> DifferentialTracer<'a> {
             }
             None => {
                 let rho = self
-                    .scene
-                    .materials()
-                    .get(hit.material.0 as usize)
+                    .material_of(hit)
                     .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
                 let sun_visible = sun_natural
                     && daylight.sun.as_ref().is_some_and(|s| {

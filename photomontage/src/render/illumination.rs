@@ -20,9 +20,11 @@
 //! those units (they come from the first inversion, §4.3, so only ratios matter).
 //!
 //! # Known limitations
-//! Diffuse reflection only: the specular term of Hall & Greenberg's full model is not evaluated
-//! (materials' `specular` lobes are ignored here; mirrors are handled by recursion in
-//! [`super::differential`]). Artificial lights are isotropic points (no luminaire photometry yet).
+//! Diffuse reflection only here: the specular term of Hall & Greenberg's full model is the GGX
+//! lobe of [`super::specular`], mirrors and glass are recursion in [`super::differential`] and
+//! [`super::glass`]. Artificial lights are points: isotropic ([`PointLight`]) or with a
+//! luminaire's photometric web ([`super::luminaire_light`]), both through
+//! [`inverse_square_cosine_rgb`].
 //! The inversion is undefined where the natural irradiance is zero (fully shadowed with no
 //! ambient term): [`diffuse_reflectance_from_true_colour`] returns `None` there.
 
@@ -64,14 +66,36 @@ impl PointLight {
     /// from behind.
     #[must_use]
     pub fn irradiance_rgb(&self, point_in_world_m: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
-        let to_light = self.position_in_world_m - point_in_world_m;
-        let r2 = to_light.norm_squared();
-        if r2 <= 0.0 {
-            return [0.0; 3];
-        }
-        let cos = (to_light.dot(normal) / r2.sqrt()).max(0.0);
-        self.intensity_rgb.map(|i| i * cos / r2)
+        inverse_square_cosine_rgb(
+            &self.position_in_world_m,
+            |_| self.intensity_rgb,
+            point_in_world_m,
+            normal,
+        )
     }
+}
+
+/// Irradiance at `point_in_world_m` (unit `normal`) from a point source at `light_in_world_m`
+/// whose intensity towards a unit direction (from the light) is `intensity_toward_rgb`:
+/// `E = I(dir)·cos θ / d²`, zero from behind or at the source itself.
+#[must_use]
+pub fn inverse_square_cosine_rgb(
+    light_in_world_m: &Point3<f64>,
+    intensity_toward_rgb: impl Fn(&Vector3<f64>) -> Rgb,
+    point_in_world_m: &Point3<f64>,
+    normal: &Vector3<f64>,
+) -> Rgb {
+    let to_light = light_in_world_m - point_in_world_m;
+    let r2 = to_light.norm_squared();
+    if r2 <= 0.0 {
+        return [0.0; 3];
+    }
+    let r = r2.sqrt();
+    let cos = (to_light.dot(normal) / r).max(0.0);
+    if cos <= 0.0 {
+        return [0.0; 3];
+    }
+    intensity_toward_rgb(&(-to_light / r)).map(|i| i * cos / r2)
 }
 
 /// Natural daylight: sun, ambient and sky facets (Durisch §3.3).

@@ -14,6 +14,11 @@
 //! object (no artificial hit, no natural light blocked only by an artificial object, no
 //! artificial light), the pixel keeps the photo's value bit for bit and alpha 0.
 //!
+//! Materials: diffuse (eq. 6), GGX specular ([`specular`]), mirror, thin glass panes
+//! ([`glass`]), emission and water-wave normals ([`water`]); artificial lights are points or
+//! luminaires with photometric webs ([`luminaire_light`]). [`render_view_spectral`] runs the same
+//! tracer on spectral samples ([`spectral`], Durisch §7 and Appendix A).
+//!
 //! Output: linear RGBA with alpha = coverage of artificial objects (fraction of rays whose first
 //! hit is artificial), written as EXR ([`RenderedImage::write_exr`]) or sRGB PNG through
 //! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]).
@@ -21,11 +26,16 @@
 //! # Known limitations
 //! The "unchanged" decision uses the first 4 rays of a pixel: an artificial sliver thinner than
 //! the gaps between them can be missed at the pixel level (as any 4-sample renderer would).
-//! Box filter only; RGB only (no spectral mode yet). See [`differential`] for the per-ray
-//! limitations.
+//! Box filter only. See [`differential`] for the per-ray limitations and [`glass`],
+//! [`specular`], [`water`], [`luminaire_light`], [`spectral`] for those of each physical model.
 
 pub mod differential;
+pub mod glass;
 pub mod illumination;
+pub mod luminaire_light;
+pub mod spectral;
+pub mod specular;
+pub mod water;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -38,6 +48,8 @@ use rayon::prelude::*;
 
 pub use differential::{DifferentialError, DifferentialTracer, Lighting, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
+pub use luminaire_light::{ArtificialLight, LuminaireLight};
+pub use spectral::{SpectralError, render_view_spectral};
 
 use crate::colour::ToneMap;
 
@@ -188,29 +200,9 @@ pub fn render_view(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderError> {
+    check_view(tracer, settings)?;
     let photo = tracer.photo();
-    let camera = tracer.camera();
-    let photo_px = [photo.width(), photo.height()];
-    if photo_px != camera.intrinsics.image_size_px {
-        return Err(RenderError::SizeMismatch {
-            photo_px,
-            camera_px: camera.intrinsics.image_size_px,
-        });
-    }
-    if settings.tile_size_px == 0 {
-        return Err(RenderError::InvalidSetting {
-            name: "tile_size_px",
-            reason: "must be positive",
-        });
-    }
-    let (lo, hi) = (settings.min_rays_per_pixel, settings.max_rays_per_pixel);
-    if lo == 0 || lo % 4 != 0 || hi % 4 != 0 || hi < lo || hi > 64 {
-        return Err(RenderError::InvalidSetting {
-            name: "rays_per_pixel",
-            reason: "min and max must be multiples of 4 with 4 ≤ min ≤ max ≤ 64",
-        });
-    }
-    let [w, h] = photo_px;
+    let [w, h] = [photo.width(), photo.height()];
     let ts = settings.tile_size_px;
     let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
     let tile_count = (tiles_x * tiles_y) as usize;
@@ -261,6 +253,36 @@ pub fn render_view(
         changed_pixels,
         primary_rays,
     })
+}
+
+/// Checks that the photo is the camera's size and the settings are valid.
+fn check_view(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+) -> Result<(), RenderError> {
+    let photo = tracer.photo();
+    let camera = tracer.camera();
+    let photo_px = [photo.width(), photo.height()];
+    if photo_px != camera.intrinsics.image_size_px {
+        return Err(RenderError::SizeMismatch {
+            photo_px,
+            camera_px: camera.intrinsics.image_size_px,
+        });
+    }
+    if settings.tile_size_px == 0 {
+        return Err(RenderError::InvalidSetting {
+            name: "tile_size_px",
+            reason: "must be positive",
+        });
+    }
+    let (lo, hi) = (settings.min_rays_per_pixel, settings.max_rays_per_pixel);
+    if lo == 0 || lo % 4 != 0 || hi % 4 != 0 || hi < lo || hi > 64 {
+        return Err(RenderError::InvalidSetting {
+            name: "rays_per_pixel",
+            reason: "min and max must be multiples of 4 with 4 ≤ min ≤ max ≤ 64",
+        });
+    }
+    Ok(())
 }
 
 fn render_tile(
@@ -354,5 +376,7 @@ pub fn linear_photo(photo: &crate::photo::PhotoImage) -> Rgb32FImage {
     }
 }
 
+#[cfg(test)]
+mod physics_tests;
 #[cfg(test)]
 mod tests;

@@ -14,6 +14,7 @@
 //! the line of the enclosing table.
 
 mod locate;
+pub mod render;
 mod schema;
 pub mod solve;
 mod validate;

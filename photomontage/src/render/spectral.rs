@@ -1,0 +1,477 @@
+//! Spectral mode of the differential renderer (Durisch 1992 §7: the montage computed on 9
+//! spectral samples; Appendix A for the photo's RGB → spectrum; Meyer 1988 / Cohen & Wallace
+//! 1993 eq. 9.24 for the 4-sample alternative).
+//!
+//! All the tracer's arithmetic is per channel, so the RGB tracer is run over the spectral
+//! samples three at a time ([`SampleSet::Durisch9`]: 3 passes, [`SampleSet::Meyer4`]: 2, the
+//! last one padded): each pass gets its own photo (Appendix A per pixel, sRGB primaries), lights
+//! (Appendix A of each light colour: sun, ambient, sky facets, horizon, artificial lights,
+//! emission) and materials (reflectances: the material's `diffuse_spectrum` averaged over the
+//! band or sampled at the wavelength, or Appendix A of its RGB divided by Appendix A of white, so
+//! that a grey reflectance is flat and white is exactly 1). Every ray position is traced through
+//! all passes (identical sample positions), the samples are turned into CIE 1931 XYZ (eq. 11 as a
+//! quadrature, [`crate::colour::SpectralSampling::xyz`]) and then linear sRGB, and the adaptive
+//! antialiasing works on that RGB, exactly as [`super::render_view`] does.
+//!
+//! What holds: untouched pixels (and unchanged rays within a changed pixel) are the photo's
+//! value copied, bit for bit (never round-tripped). Where all colours are in the gamut the
+//! Appendix A conversion is linear, so a scene of grey materials renders as in RGB mode within
+//! round-off (the RGB → spectrum → RGB round trip of sRGB on Durisch's 9 bands is exact to
+//! ~1e-12, see [`crate::colour::spectrum`]); coloured materials differ from RGB mode, which is
+//! the point of the mode (products of spectra are not products of RGB triples).
+//!
+//! # Known limitations
+//! The photo is taken to be linear sRGB. The atmosphere's transmittance is converted like a
+//! reflectance (ratio to white), its horizon colour like a light. Meyer's 4 samples cannot
+//! represent sRGB green without clamping (see [`crate::colour::spectrum`]), so that mode is not
+//! exact even for grey scenes with green light. Specular Fresnel (F0) is achromatic. The passes
+//! share the geometry but trace it once each (3× the ray casts of RGB mode for Durisch's 9).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use image::Rgb32FImage;
+use nalgebra::Point2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use super::differential::{DifferentialTracer, Lighting};
+use super::illumination::Rgb;
+use super::luminaire_light::ArtificialLight;
+use super::{RenderError, RenderSettings, RenderedImage, TileProgress};
+use crate::atmosphere::schachter::SchachterAtmosphere;
+use crate::colour::spectrum::{DURISCH_RANGE_NM, MEYER4_WAVELENGTHS_NM};
+use crate::colour::{Colour, RgbColourSpace, RgbToSpectrum, SampleSet, SpectrumError};
+use crate::scene::Material;
+use crate::scene::material::Spectrum;
+
+/// Errors of a spectral render.
+#[derive(Debug, thiserror::Error)]
+pub enum SpectralError {
+    /// The render itself failed (size, settings, cancellation).
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The Appendix A conversion could not be set up.
+    #[error("spectral conversion: {0}")]
+    Spectrum(#[from] SpectrumError),
+    /// The atmosphere could not be expressed on a pass's bands.
+    #[error("atmosphere on spectral samples {bands:?}: {message}")]
+    Atmosphere {
+        /// The pass's sample indices.
+        bands: [usize; 3],
+        /// Why.
+        message: String,
+    },
+}
+
+/// Colour conversions of one sample set.
+struct Converter {
+    rgb_to_spectrum: RgbToSpectrum,
+    white: Vec<f64>,
+    set: SampleSet,
+}
+
+impl Converter {
+    fn new(set: SampleSet) -> Result<Self, SpectrumError> {
+        let rgb_to_spectrum = RgbToSpectrum::for_sample_set(RgbColourSpace::srgb(), set)?;
+        let white = rgb_to_spectrum.spectrum([1.0; 3]);
+        Ok(Self {
+            rgb_to_spectrum,
+            white,
+            set,
+        })
+    }
+
+    fn len(&self) -> usize {
+        self.white.len()
+    }
+
+    /// A light's or a photo's colour: Appendix A.
+    fn light(&self, rgb: Rgb) -> Vec<f64> {
+        self.rgb_to_spectrum.spectrum(rgb)
+    }
+
+    /// A reflectance (or transmittance): Appendix A relative to white, in [0, 1].
+    fn reflectance(&self, rgb: Rgb) -> Vec<f64> {
+        let mean = (rgb[0] + rgb[1] + rgb[2]) / 3.0;
+        self.light(rgb)
+            .iter()
+            .zip(&self.white)
+            .map(|(s, w)| if *w > 0.0 { s / w } else { mean }.clamp(0.0, 1.0))
+            .collect()
+    }
+
+    /// A tabulated reflectance spectrum on the samples: band means (Durisch's 9) or point
+    /// values (Meyer's 4).
+    fn tabulated(&self, spectrum: &Spectrum) -> Vec<f64> {
+        match self.set {
+            SampleSet::Durisch9 => {
+                let [lo, hi] = DURISCH_RANGE_NM;
+                (0..9_u32)
+                    .map(|k| {
+                        let a = lo + (hi - lo) * f64::from(k) / 9.0;
+                        let b = lo + (hi - lo) * f64::from(k + 1) / 9.0;
+                        spectrum.band_mean(a, b)
+                    })
+                    .collect()
+            }
+            SampleSet::Meyer4 => MEYER4_WAVELENGTHS_NM
+                .iter()
+                .map(|&w| spectrum.at(w))
+                .collect(),
+        }
+    }
+
+    /// Spectral samples → linear sRGB.
+    fn rgb(&self, samples: &[f64]) -> Rgb {
+        self.rgb_to_spectrum.rgb(samples)
+    }
+}
+
+fn pick(values: &[f64], bands: [usize; 3]) -> Rgb {
+    bands.map(|b| values.get(b).copied().unwrap_or(0.0))
+}
+
+/// The inputs of one pass (three spectral samples as the tracer's three channels).
+struct Pass {
+    bands: [usize; 3],
+    lighting: Lighting,
+    photo: Rgb32FImage,
+    materials: Vec<Material>,
+}
+
+fn pass_lighting(
+    lighting: &Lighting,
+    conv: &Converter,
+    bands: [usize; 3],
+) -> Result<Lighting, SpectralError> {
+    let light = |rgb: Rgb| pick(&conv.light(rgb), bands);
+    let mut out = lighting.clone();
+    if let Some(sun) = &mut out.daylight.sun {
+        sun.normal_irradiance_rgb = light(sun.normal_irradiance_rgb);
+    }
+    out.daylight.ambient_radiance_rgb = light(out.daylight.ambient_radiance_rgb);
+    for facet in &mut out.daylight.sky {
+        facet.normal_irradiance_rgb = light(facet.normal_irradiance_rgb);
+    }
+    for l in &mut out.artificial_lights {
+        match l {
+            ArtificialLight::Point(p) => p.intensity_rgb = light(p.intensity_rgb),
+            ArtificialLight::Luminaire(lum) => lum.rgb_per_cd = light(lum.rgb_per_cd),
+        }
+    }
+    out.horizon_rgb = light(out.horizon_rgb);
+    if let Some(a) = &lighting.atmosphere {
+        let rgb = |c: Colour| [0, 1, 2].map(|k| f64::from(c.channels[k]));
+        let tau = pick(&conv.reflectance(rgb(a.transmittance())), bands);
+        let horizon = light(rgb(a.horizon()));
+        #[allow(clippy::cast_possible_truncation)]
+        let to_colour = |v: Rgb| Colour::from_slice(&v.map(|x| x as f32));
+        let atmosphere = SchachterAtmosphere::new(
+            to_colour(tau.map(|t| t.max(1e-6))),
+            to_colour(horizon),
+            a.reference_distance_m(),
+            3,
+        )
+        .map_err(|e| SpectralError::Atmosphere {
+            bands,
+            message: e.to_string(),
+        })?;
+        out.atmosphere = Some(atmosphere);
+    }
+    Ok(out)
+}
+
+fn pass_material(m: &Material, conv: &Converter, bands: [usize; 3]) -> Material {
+    let refl = |rgb: Rgb| pick(&conv.reflectance(rgb), bands);
+    let diffuse = match &m.diffuse_spectrum {
+        Some(s) => pick(&conv.tabulated(s), bands),
+        None => refl(m.diffuse_rgb),
+    };
+    let mut out = m.clone();
+    out.diffuse_rgb = diffuse;
+    out.diffuse_spectrum = None;
+    out.mirror_rgb = m.mirror_rgb.map(refl);
+    if let Some(g) = &mut out.glass {
+        g.transmittance_rgb = refl(g.transmittance_rgb);
+    }
+    out.emission_rgb_w_m2_sr = m.emission_rgb_w_m2_sr.map(|e| pick(&conv.light(e), bands));
+    out
+}
+
+fn passes(tracer: &DifferentialTracer<'_>, conv: &Converter) -> Result<Vec<Pass>, SpectralError> {
+    let n = conv.len();
+    let band_sets: Vec<[usize; 3]> = (0..n.div_ceil(3))
+        .map(|p| [0, 1, 2].map(|k| (3 * p + k).min(n - 1)))
+        .collect();
+    let photo = tracer.photo();
+    let (w, h) = (photo.width(), photo.height());
+    let mut photos: Vec<Rgb32FImage> = band_sets.iter().map(|_| Rgb32FImage::new(w, h)).collect();
+    let mut samples = vec![0.0; n];
+    for (x, y, p) in photo.enumerate_pixels() {
+        conv.rgb_to_spectrum
+            .spectrum_into(p.0.map(f64::from), &mut samples);
+        for (img, bands) in photos.iter_mut().zip(&band_sets) {
+            #[allow(clippy::cast_possible_truncation)]
+            let v = pick(&samples, *bands).map(|s| s as f32);
+            img.put_pixel(x, y, image::Rgb(v));
+        }
+    }
+    band_sets
+        .into_iter()
+        .zip(photos)
+        .map(|(bands, photo)| {
+            Ok(Pass {
+                bands,
+                lighting: pass_lighting(tracer.lighting(), conv, bands)?,
+                photo,
+                materials: tracer
+                    .materials
+                    .iter()
+                    .map(|m| pass_material(m, conv, bands))
+                    .collect(),
+            })
+        })
+        .collect()
+}
+
+/// Renders the current view in spectral mode on `sample_set` (see the module doc): same
+/// arguments, tiling, seed, adaptive sampling, progress and cancellation as
+/// [`super::render_view`], same output (linear sRGB + coverage alpha; untouched pixels are the
+/// photo bit for bit).
+///
+/// # Errors
+/// [`SpectralError::Render`] for the errors of [`super::render_view`], and the conversion's.
+pub fn render_view_spectral(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+    sample_set: SampleSet,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<RenderedImage, SpectralError> {
+    super::check_view(tracer, settings)?;
+    let conv = Converter::new(sample_set)?;
+    let passes = passes(tracer, &conv)?;
+    let tracers: Vec<DifferentialTracer<'_>> = passes
+        .iter()
+        .map(|p| tracer.with_inputs(&p.lighting, &p.photo, &p.materials))
+        .collect();
+    let job = Job {
+        tracer,
+        passes: &passes,
+        tracers: &tracers,
+        conv: &conv,
+        settings,
+    };
+    let [w, h] = [tracer.photo().width(), tracer.photo().height()];
+    let ts = settings.tile_size_px;
+    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
+    let tile_count = (tiles_x * tiles_y) as usize;
+    let tiles: Vec<Option<TileOut>> = (0..tile_count)
+        .into_par_iter()
+        .map(|index| {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            #[allow(clippy::cast_possible_truncation)]
+            let i = index as u32;
+            let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
+            let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
+            let out = job.tile(index, origin_px, size_px);
+            on_tile(TileProgress {
+                tile_index: index,
+                tile_count,
+                origin_px,
+                size_px,
+            });
+            Some(out)
+        })
+        .collect();
+    let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
+    let (mut changed_pixels, mut primary_rays) = (0, 0);
+    for (index, tile) in tiles.into_iter().enumerate() {
+        let Some(tile) = tile else {
+            return Err(RenderError::Cancelled.into());
+        };
+        #[allow(clippy::cast_possible_truncation)]
+        let i = index as u32;
+        let (x0, y0) = ((i % tiles_x) * ts, (i / tiles_x) * ts);
+        let tw = ts.min(w - x0);
+        for (k, p) in tile.rgba.iter().enumerate() {
+            #[allow(clippy::cast_possible_truncation)]
+            let k = k as u32;
+            rgba[((y0 + k / tw) * w + x0 + k % tw) as usize] = *p;
+        }
+        changed_pixels += tile.changed;
+        primary_rays += tile.rays;
+    }
+    if cancel.load(Ordering::Relaxed) {
+        return Err(RenderError::Cancelled.into());
+    }
+    Ok(RenderedImage {
+        size_px: [w, h],
+        rgba,
+        changed_pixels,
+        primary_rays,
+    })
+}
+
+struct TileOut {
+    rgba: Vec<[f32; 4]>,
+    changed: usize,
+    rays: u64,
+}
+
+struct Job<'j, 't> {
+    tracer: &'j DifferentialTracer<'t>,
+    passes: &'j [Pass],
+    tracers: &'j [DifferentialTracer<'j>],
+    conv: &'j Converter,
+    settings: &'j RenderSettings,
+}
+
+impl Job<'_, '_> {
+    /// One ray position through every pass: linear sRGB, changed, first hit artificial.
+    fn sample(&self, x: u32, y: u32, pixel: Point2<f64>, bands: &mut [f64]) -> (Rgb, bool, bool) {
+        let dir = self.tracer.camera().ray_dir_in_world(pixel);
+        let (mut changed, mut hit_artificial) = (false, false);
+        for (k, (pass, tracer)) in self.passes.iter().zip(self.tracers).enumerate() {
+            let photo_rgb = pass.photo.get_pixel(x, y).0.map(f64::from);
+            let s = tracer.trace_primary(&dir, photo_rgb);
+            changed |= s.changed;
+            if k == 0 {
+                hit_artificial = s.hit_artificial;
+            }
+            for (c, &b) in pass.bands.iter().enumerate() {
+                if let Some(v) = bands.get_mut(b) {
+                    *v = s.radiance_rgb[c];
+                }
+            }
+        }
+        if changed {
+            (self.conv.rgb(bands), true, hit_artificial)
+        } else {
+            let photo = self.tracer.photo().get_pixel(x, y).0.map(f64::from);
+            (photo, false, hit_artificial)
+        }
+    }
+
+    fn tile(&self, tile_index: usize, origin_px: [u32; 2], size_px: [u32; 2]) -> TileOut {
+        let settings = self.settings;
+        let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+        rng.set_stream(tile_index as u64);
+        let mut bands = vec![0.0; self.conv.len()];
+        let mut out = TileOut {
+            rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),
+            changed: 0,
+            rays: 0,
+        };
+        for y in origin_px[1]..origin_px[1] + size_px[1] {
+            for x in origin_px[0]..origin_px[0] + size_px[0] {
+                let mut sum = [0.0_f64; 3];
+                let mut sum_sq = [0.0_f64; 3];
+                let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
+                loop {
+                    for s in 0..4 {
+                        let (sx, sy) = (f64::from(s % 2), f64::from(s / 2));
+                        let (u, v): (f64, f64) = (rng.random(), rng.random());
+                        let pixel = Point2::new(
+                            f64::from(x) - 0.5 + (sx + u) / 2.0,
+                            f64::from(y) - 0.5 + (sy + v) / 2.0,
+                        );
+                        let (rgb, ch, art) = self.sample(x, y, pixel, &mut bands);
+                        changed |= ch;
+                        covered += u32::from(art);
+                        for k in 0..3 {
+                            sum[k] += rgb[k];
+                            sum_sq[k] += rgb[k] * rgb[k];
+                        }
+                    }
+                    n += 4;
+                    if !changed || n >= settings.max_rays_per_pixel {
+                        break;
+                    }
+                    if n >= settings.min_rays_per_pixel {
+                        let nf = f64::from(n);
+                        let worst_var = (0..3)
+                            .map(|k| ((sum_sq[k] - sum[k] * sum[k] / nf) / (nf - 1.0)).max(0.0))
+                            .fold(0.0, f64::max);
+                        if (worst_var / nf).sqrt() <= settings.max_standard_error {
+                            break;
+                        }
+                    }
+                }
+                out.rays += u64::from(n);
+                let photo = self.tracer.photo().get_pixel(x, y).0;
+                if changed {
+                    out.changed += 1;
+                    let nf = f64::from(n);
+                    #[allow(clippy::cast_possible_truncation)]
+                    out.rgba.push([
+                        (sum[0] / nf) as f32,
+                        (sum[1] / nf) as f32,
+                        (sum[2] / nf) as f32,
+                        (f64::from(covered) / nf) as f32,
+                    ]);
+                } else {
+                    out.rgba.push([photo[0], photo[1], photo[2], 0.0]);
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Appendix A and the XYZ quadrature in f64: round-off of a few dozen operations.
+    const ROUND_OFF_TOL: f64 = 1e-12;
+
+    #[test]
+    fn white_reflectance_is_one_and_grey_is_flat() {
+        for set in [SampleSet::Durisch9, SampleSet::Meyer4] {
+            let conv = Converter::new(set).unwrap();
+            assert_eq!(conv.len(), set.len());
+            for v in conv.reflectance([1.0; 3]) {
+                assert!((v - 1.0).abs() < ROUND_OFF_TOL, "{set:?}: {v}");
+            }
+            for v in conv.reflectance([0.37; 3]) {
+                assert!((v - 0.37).abs() < ROUND_OFF_TOL, "{set:?}: {v}");
+            }
+        }
+    }
+
+    #[test]
+    fn light_round_trip_is_exact_for_srgb_on_durisch9() {
+        let conv = Converter::new(SampleSet::Durisch9).unwrap();
+        for rgb in [[0.2, 0.5, 0.9], [1.0, 0.1, 0.05], [0.3, 0.3, 0.3]] {
+            let back = conv.rgb(&conv.light(rgb));
+            for k in 0..3 {
+                assert!(
+                    (back[k] - rgb[k]).abs() < ROUND_OFF_TOL,
+                    "{rgb:?} → {back:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn tabulated_spectra_are_band_means() {
+        let conv = Converter::new(SampleSet::Durisch9).unwrap();
+        // A ramp from 0 at 380 nm to 0.8 at 780 nm: the band mean is the ramp at the centre.
+        let ramp = Spectrum {
+            wavelengths_nm: vec![380.0, 780.0],
+            values: vec![0.0, 0.8],
+        };
+        for (k, v) in conv.tabulated(&ramp).iter().enumerate() {
+            #[allow(clippy::cast_precision_loss)]
+            let centre = 380.0 + 400.0 * (k as f64 + 0.5) / 9.0;
+            assert!(
+                (v - 0.8 * (centre - 380.0) / 400.0).abs() < 1e-9,
+                "{k}: {v}"
+            );
+        }
+    }
+}

@@ -1,0 +1,756 @@
+//! From a site file to a render job: the scene (Durisch 1992 §4.1 natural polygons and §5 CAD
+//! objects), the lighting of §3.3–3.4 in the site's units, the solved camera of a photo and the
+//! photo itself, linearised — everything [`crate::render::render_view`] needs for one view.
+//!
+//! # Lighting units (the site's `[lighting]` table, per RGB channel, in the photo's linear units)
+//! - `sun_weight` k_s: irradiance of the direct sun on a surface facing it (eq. 3), the sun's
+//!   [`DistantLight::normal_irradiance_rgb`];
+//! - `sky_weight` k_h: horizontal irradiance of the whole unobstructed sky (eq. 5): the facets of
+//!   a Durisch dome carry the relative luminance of `sky_model`, scaled so that the sum over the
+//!   facets of `L_i Δω_i cos Z_i` equals k_h exactly (a uniform sky of radiance L has k_h = π·L);
+//! - `ambient_weight` k_u: ambient radiance (eq. 4), irradiance π·k_u on any surface.
+//!
+//! The sun direction is `lighting.sun_manual` if given, else the NREL SPA ([`crate::sun`]) at
+//! `lighting.time`, else the photo's `taken_at`, else its EXIF capture time, at `[location]`.
+//! Azimuths (manual or SPA) are from true north; they are turned into the survey frame (+Y = grid
+//! north, Z up) with `location.grid_convergence_deg`. A sun at or below the horizon gives no
+//! sunlight.
+//!
+//! # Known limitations
+//! Polygons are single-sided triangles of their vertex points (no holes). CAD materials named in
+//! the material library take the library's definition; the others keep their file's definition.
+//! The sky is sampled on a fixed Durisch dome (its facet count is [`SiteLightingOptions`]), so a
+//! CIE sky's circumsolar peak is averaged over a facet. Artificial luminaires are not yet part of
+//! the site file.
+
+use std::collections::HashMap;
+use std::fmt;
+
+use image::Rgb32FImage;
+use nalgebra::{Point3, Vector3};
+use serde::Serialize;
+
+use super::{CadModel, SiteDocument};
+use crate::atmosphere::schachter::{AtmosphereError, SchachterAtmosphere};
+use crate::camera::Camera;
+use crate::colour::Colour;
+use crate::photo::PhotoError;
+use crate::render::{Daylight, DistantLight, Lighting, RenderSettings};
+use crate::scene::{
+    ImportOptions, LengthUnit, Material, MaterialLibrary, ObjectKind, Placement, Scene, SceneError,
+    SceneObject, UpAxis,
+};
+use crate::sky::SkyModel;
+use crate::sky_dome::DomeError;
+use crate::sky_dome::durisch_facets::durisch_dome;
+use crate::sun::{SpaParams, SunError, solar_position};
+
+/// Diffuse reflectance of a polygon whose material is not in the library (or when the site has
+/// no library): ρ_d = 0.5, mid-grey, [`Material::default`]. The name is kept so the warning and
+/// the material list show what was meant.
+pub const DEFAULT_POLYGON_ALBEDO: [f64; 3] = [0.5; 3];
+
+/// A CAD model whose largest bounding-box side is above this gets a scale warning: 10 km, larger
+/// than any single planned development (probably millimetres read as metres).
+pub const SCALE_WARNING_MAX_EXTENT_M: f64 = 1e4;
+/// A CAD model whose largest bounding-box side is below this gets a scale warning: 1 mm
+/// (probably metres read as millimetres).
+pub const SCALE_WARNING_MIN_EXTENT_M: f64 = 1e-3;
+
+/// What can go wrong turning a site into a render job.
+#[derive(Debug, thiserror::Error)]
+pub enum SiteRenderError {
+    #[error("no photo `{id}` in the site; valid view ids: {}", valid.join(", "))]
+    UnknownView { id: String, valid: Vec<String> },
+    #[error("photo {photo} is not solved; run `photomontage solve` first")]
+    NotSolved { photo: String },
+    #[error(
+        "photo {photo} has an exterior but no interior with image_size_px; run `photomontage solve` again"
+    )]
+    NoInterior { photo: String },
+    #[error("polygon `{polygon}`: vertex `{point}` is neither a control point nor a tie point")]
+    UnknownPoint { polygon: String, point: String },
+    #[error("polygon `{polygon}`: {source}")]
+    Polygon { polygon: String, source: SceneError },
+    #[error("material library {path}: {source}")]
+    MaterialLibrary {
+        path: String,
+        source: crate::scene::material::MaterialError,
+    },
+    #[error("model `{model}` ({path}): {source}")]
+    Model {
+        model: String,
+        path: String,
+        source: SceneError,
+    },
+    #[error("model `{model}`: {field} `{value}` is not one of {allowed}")]
+    ModelSetting {
+        model: String,
+        field: &'static str,
+        value: String,
+        allowed: &'static str,
+    },
+    #[error(
+        "no visible model in the site: nothing to render (add a [[models]] entry or make one visible)"
+    )]
+    NoVisibleModel,
+    #[error(
+        "no sun direction for photo `{photo}`: {reason}; set lighting.sun_manual, or lighting.time \
+         (or photos.taken_at) and [location]"
+    )]
+    NoSunDirection { photo: String, reason: String },
+    #[error("sun position: {0}")]
+    Sun(#[from] SunError),
+    #[error("sky: {reason}")]
+    Sky { reason: String },
+    #[error("sky dome: {0}")]
+    Dome(#[from] DomeError),
+    #[error("lighting.atmosphere: {reason}")]
+    AtmosphereSetting { reason: String },
+    #[error("lighting.atmosphere: {0}")]
+    Atmosphere(#[from] AtmosphereError),
+    #[error(transparent)]
+    Photo(#[from] PhotoError),
+    #[error("photo `{photo}` is {photo_px:?} px but its camera images {camera_px:?} px")]
+    SizeMismatch {
+        photo: String,
+        photo_px: [u32; 2],
+        camera_px: [u32; 2],
+    },
+    #[error("scene: {0}")]
+    Scene(#[from] SceneError),
+}
+
+/// Something worth telling the user that does not stop the render.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SiteWarning {
+    /// Polygons name a material the library does not have (or there is no library); they get
+    /// [`DEFAULT_POLYGON_ALBEDO`].
+    MissingMaterial {
+        material: String,
+        polygons: Vec<String>,
+    },
+    /// A CAD model's size is implausible (outside [`SCALE_WARNING_MIN_EXTENT_M`],
+    /// [`SCALE_WARNING_MAX_EXTENT_M`]).
+    ModelScale { model: String, extent_m: f64 },
+    /// An importer warning, rendered as text.
+    Import { model: String, message: String },
+    /// A render setting of the site was adjusted to what the renderer accepts.
+    Setting { message: String },
+}
+
+impl fmt::Display for SiteWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::MissingMaterial { material, polygons } => write!(
+                f,
+                "material `{material}` is not in the material library; polygons {} use the \
+                 default diffuse reflectance 0.5",
+                polygons.join(", ")
+            ),
+            Self::ModelScale { model, extent_m } => write!(
+                f,
+                "model `{model}` is {extent_m:.4} m across: check its units and placement.scale"
+            ),
+            Self::Import { model, message } => write!(f, "model `{model}`: {message}"),
+            Self::Setting { message } => f.write_str(message),
+        }
+    }
+}
+
+/// Which site entity a scene object came from (for the object-id output layer).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", content = "id", rename_all = "snake_case")]
+pub enum ObjectSource {
+    /// A scene polygon (natural), by id.
+    Polygon(String),
+    /// A CAD model (artificial), by id.
+    Model(String),
+}
+
+impl ObjectSource {
+    /// `polygon:ID` or `model:ID`.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match self {
+            Self::Polygon(id) => format!("polygon:{id}"),
+            Self::Model(id) => format!("model:{id}"),
+        }
+    }
+}
+
+/// The scene of a site.
+#[derive(Debug, Clone)]
+pub struct SiteScene {
+    /// Natural polygons and artificial models.
+    pub scene: Scene,
+    /// For every scene object (by [`crate::scene::ObjectId`] index), where it came from.
+    pub object_sources: Vec<ObjectSource>,
+    /// Problems that did not stop the build.
+    pub warnings: Vec<SiteWarning>,
+}
+
+/// Quality knobs of the site lighting.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SiteLightingOptions {
+    /// m_h of the Durisch sky dome (4·m_h² facets).
+    pub sky_dome_m_h: u32,
+    /// m_h of the photo-bounce gather dome; `None` disables the bounce.
+    pub photo_bounce_m_h: Option<u32>,
+    /// m_h of the nested (second) bounce gather; `None` disables it.
+    pub photo_bounce_nested_m_h: Option<u32>,
+}
+
+impl Default for SiteLightingOptions {
+    /// The settings that meet the 3 % Mitsuba accuracy goal (`tests/tests/render_mitsuba.rs`):
+    /// sky m_h = 8 (256 facets), bounce m_h = 6, nested bounce m_h = 2.
+    fn default() -> Self {
+        Self {
+            sky_dome_m_h: 8,
+            photo_bounce_m_h: Some(6),
+            photo_bounce_nested_m_h: Some(2),
+        }
+    }
+}
+
+/// Everything needed to render one view of a site.
+#[derive(Debug, Clone)]
+pub struct ViewJob {
+    /// The photo id.
+    pub photo_id: String,
+    /// The scene.
+    pub scene: SiteScene,
+    /// Lights and atmosphere.
+    pub lighting: Lighting,
+    /// The solved camera of the photo.
+    pub camera: Camera,
+    /// The photo, linear RGB, the camera's size.
+    pub photo_linear: Rgb32FImage,
+    /// Render settings from the site's `[render]` table.
+    pub settings: RenderSettings,
+    /// The sun direction used (survey frame), `None` when none was needed or it is below the
+    /// horizon.
+    pub sun_dir_in_world: Option<Vector3<f64>>,
+    /// Scene warnings and setting adjustments.
+    pub warnings: Vec<SiteWarning>,
+}
+
+fn point_table(doc: &SiteDocument) -> HashMap<&str, [f64; 3]> {
+    let mut points: HashMap<&str, [f64; 3]> = doc
+        .site
+        .tie_points
+        .iter()
+        .map(|t| (t.id.as_str(), t.xyz))
+        .collect();
+    // Control points win over tie points of the same id.
+    for c in &doc.site.control_points {
+        points.insert(c.id.as_str(), c.xyz);
+    }
+    points
+}
+
+fn import_options(model: &CadModel) -> Result<ImportOptions, SiteRenderError> {
+    let setting = |field, value: &str, allowed| SiteRenderError::ModelSetting {
+        model: model.id.clone(),
+        field,
+        value: value.to_owned(),
+        allowed,
+    };
+    let unit = match model.units.as_str() {
+        "m" => LengthUnit::Metre,
+        "cm" => LengthUnit::Centimetre,
+        "mm" => LengthUnit::Millimetre,
+        "in" => LengthUnit::Inch,
+        "ft" => LengthUnit::Foot,
+        other => return Err(setting("units", other, "m, cm, mm, in, ft")),
+    };
+    let up = match model.up_axis.as_str() {
+        "z" | "Z" => UpAxis::Z,
+        "y" | "Y" => UpAxis::Y,
+        other => return Err(setting("up_axis", other, "z, y")),
+    };
+    Ok(ImportOptions {
+        unit: Some(unit),
+        up_axis: Some(up),
+        placement: Placement {
+            translation_in_world_m: model.placement.translation,
+            rotation_about_z_deg: model.placement.rotation_z_deg,
+            scale: model.placement.scale,
+        },
+        // Small models only warn (SCALE_WARNING_MIN_EXTENT_M); beyond the importer's 100 km the
+        // unit is certainly wrong and it is an error.
+        min_extent_m: 0.0,
+        ..ImportOptions::default()
+    })
+}
+
+/// The material library of the site, if it names one.
+///
+/// # Errors
+/// [`SiteRenderError::MaterialLibrary`] when it cannot be read or is invalid.
+pub fn site_material_library(
+    doc: &SiteDocument,
+) -> Result<Option<MaterialLibrary>, SiteRenderError> {
+    let Some(rel) = &doc.site.lighting.material_library else {
+        return Ok(None);
+    };
+    let path = doc.resolve(rel);
+    MaterialLibrary::load(&path)
+        .map(Some)
+        .map_err(|source| SiteRenderError::MaterialLibrary {
+            path: path.display().to_string(),
+            source,
+        })
+}
+
+/// Builds the scene of a site: one natural object per polygon (triangulated, material from the
+/// library, image attribute = the polygon's photo) and one artificial object per visible model.
+///
+/// # Errors
+/// An unknown vertex id, a polygon that cannot be triangulated, an unreadable material library
+/// or CAD file (no faces, non-finite vertices, a size above 100 km), a bad unit or up axis.
+pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
+    let library = site_material_library(doc)?;
+    let points = point_table(doc);
+    let mut scene = Scene::new();
+    let mut object_sources = Vec::new();
+    let mut warnings = Vec::new();
+    let mut missing: Vec<(String, Vec<String>)> = Vec::new();
+    for poly in &doc.site.polygons {
+        let vertices = poly
+            .vertices
+            .iter()
+            .map(|v| {
+                points
+                    .get(v.as_str())
+                    .map(|&xyz| Point3::from(xyz))
+                    .ok_or_else(|| SiteRenderError::UnknownPoint {
+                        polygon: poly.id.clone(),
+                        point: v.clone(),
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let material = match library.as_ref().and_then(|l| l.get(&poly.material)) {
+            Some(m) => m.clone(),
+            None => {
+                match missing.iter_mut().find(|(m, _)| *m == poly.material) {
+                    Some((_, polys)) => polys.push(poly.id.clone()),
+                    None => missing.push((poly.material.clone(), vec![poly.id.clone()])),
+                }
+                Material::diffuse(&poly.material, DEFAULT_POLYGON_ALBEDO)
+            }
+        };
+        let material = scene.add_material(material)?;
+        let object = scene.add_object(SceneObject {
+            name: poly.id.clone(),
+            kind: ObjectKind::Natural,
+            image_attribute: poly.image.clone(),
+        })?;
+        object_sources.push(ObjectSource::Polygon(poly.id.clone()));
+        scene
+            .add_polygon(&vertices, material, object)
+            .map_err(|source| SiteRenderError::Polygon {
+                polygon: poly.id.clone(),
+                source,
+            })?;
+    }
+    warnings.extend(
+        missing
+            .into_iter()
+            .map(|(material, polygons)| SiteWarning::MissingMaterial { material, polygons }),
+    );
+    for model in doc.site.models.iter().filter(|m| m.visible) {
+        let options = import_options(model)?;
+        let path = doc.resolve(&model.file);
+        let imported =
+            crate::scene::load_model(&path, &options).map_err(|source| SiteRenderError::Model {
+                model: model.id.clone(),
+                path: path.display().to_string(),
+                source,
+            })?;
+        warnings.extend(imported.warnings.iter().map(|w| SiteWarning::Import {
+            model: model.id.clone(),
+            message: import_warning_text(w),
+        }));
+        let mut extent = [Point3::origin(); 2];
+        let mut first = true;
+        for p in imported.triangles_in_world_m.iter().flatten() {
+            if first {
+                extent = [*p, *p];
+                first = false;
+            }
+            extent = [extent[0].inf(p), extent[1].sup(p)];
+        }
+        let extent_m = (extent[1] - extent[0]).max();
+        if !(SCALE_WARNING_MIN_EXTENT_M..=SCALE_WARNING_MAX_EXTENT_M).contains(&extent_m) {
+            warnings.push(SiteWarning::ModelScale {
+                model: model.id.clone(),
+                extent_m,
+            });
+        }
+        scene.add_model(&imported, &model.id, ObjectKind::Artificial)?;
+        object_sources.push(ObjectSource::Model(model.id.clone()));
+    }
+    if let Some(lib) = &library {
+        scene.apply_material_library(lib);
+    }
+    Ok(SiteScene {
+        scene,
+        object_sources,
+        warnings,
+    })
+}
+
+fn import_warning_text(w: &crate::scene::ImportWarning) -> String {
+    use crate::scene::ImportWarning as W;
+    match w {
+        W::MissingMaterialLibrary { name, reason } => {
+            format!("material library `{name}` not read ({reason}); default material used")
+        }
+        W::FacesWithoutMaterial { triangle_count } => {
+            format!("{triangle_count} triangles without a material get the default (ρ_d = 0.5)")
+        }
+        W::UnitAssumed { unit } => format!("no unit in the file; {unit:?} assumed"),
+        W::PolygonsSkipped { count } => {
+            format!("{count} degenerate polygons skipped")
+        }
+        W::IgnoredEntities { kind, count } => format!("{count} {kind} entities ignored"),
+    }
+}
+
+/// The solved camera of photo `photo_id`.
+///
+/// # Errors
+/// [`SiteRenderError::UnknownView`] listing the valid ids, [`SiteRenderError::NotSolved`],
+/// [`SiteRenderError::NoInterior`].
+pub fn site_camera(doc: &SiteDocument, photo_id: &str) -> Result<Camera, SiteRenderError> {
+    let Some(photo) = doc.site.photos.iter().find(|p| p.id == photo_id) else {
+        return Err(SiteRenderError::UnknownView {
+            id: photo_id.to_owned(),
+            valid: doc.site.photos.iter().map(|p| p.id.clone()).collect(),
+        });
+    };
+    if photo.exterior.is_none() {
+        return Err(SiteRenderError::NotSolved {
+            photo: photo_id.to_owned(),
+        });
+    }
+    super::stored_camera(&doc.site, photo_id).ok_or_else(|| SiteRenderError::NoInterior {
+        photo: photo_id.to_owned(),
+    })
+}
+
+/// The sky model named by `lighting.sky_model`.
+///
+/// # Errors
+/// [`SiteRenderError::Sky`] for an unknown name.
+pub fn parse_sky_model(name: &str) -> Result<SkyModel, SiteRenderError> {
+    let bad = || SiteRenderError::Sky {
+        reason: format!("`{name}` is not `uniform`, `cie_overcast` or `cie_general:N` (N = 1–15)"),
+    };
+    match name {
+        "uniform" => Ok(SkyModel::Uniform),
+        "cie_overcast" => Ok(SkyModel::CieOvercast),
+        other => {
+            let n: u8 = other
+                .strip_prefix("cie_general:")
+                .and_then(|n| n.parse().ok())
+                .ok_or_else(bad)?;
+            SkyModel::cie_general(n).map_err(|_| bad())
+        }
+    }
+}
+
+/// Turns a true-north azimuth and an elevation into a survey-frame unit vector (+Y grid north,
+/// Z up), given the grid convergence (angle from grid north to true north, clockwise).
+#[must_use]
+pub fn survey_dir_from_true_azimuth(
+    azimuth_deg: f64,
+    elevation_deg: f64,
+    grid_convergence_deg: f64,
+) -> Vector3<f64> {
+    crate::sky::direction_from_elevation_azimuth(
+        elevation_deg.to_radians(),
+        (azimuth_deg + grid_convergence_deg).to_radians(),
+    )
+}
+
+/// The sun direction for photo `photo_id` in the survey frame (possibly below the horizon):
+/// `sun_manual`, else the SPA at `lighting.time`, the photo's `taken_at` or its EXIF time.
+///
+/// # Errors
+/// [`SiteRenderError::NoSunDirection`] when there is no time or no location,
+/// [`SiteRenderError::Sun`] from the SPA.
+pub fn site_sun_dir(doc: &SiteDocument, photo_id: &str) -> Result<Vector3<f64>, SiteRenderError> {
+    let site = &doc.site;
+    let convergence = site
+        .location
+        .as_ref()
+        .map_or(0.0, |l| l.grid_convergence_deg);
+    if let Some(m) = &site.lighting.sun_manual {
+        return Ok(survey_dir_from_true_azimuth(
+            m.azimuth_deg,
+            m.elevation_deg,
+            convergence,
+        ));
+    }
+    let no_sun = |reason: &str| SiteRenderError::NoSunDirection {
+        photo: photo_id.to_owned(),
+        reason: reason.to_owned(),
+    };
+    let photo = site.photos.iter().find(|p| p.id == photo_id);
+    let time = site
+        .lighting
+        .time
+        .clone()
+        .or_else(|| photo.and_then(|p| p.taken_at.clone()))
+        .or_else(|| {
+            photo.and_then(|p| {
+                crate::photo::read_exif(&doc.resolve(&p.file))
+                    .ok()?
+                    .taken_at_rfc3339()
+            })
+        })
+        .ok_or_else(|| no_sun("no time (lighting.time, photos.taken_at or EXIF with offset)"))?;
+    let time = chrono::DateTime::parse_from_rfc3339(&time)
+        .map_err(|e| no_sun(&format!("time `{time}` is not RFC 3339: {e}")))?;
+    let loc = site
+        .location
+        .as_ref()
+        .ok_or_else(|| no_sun("the site has no [location]"))?;
+    let params = SpaParams {
+        elevation_m: loc.elevation_m,
+        ..SpaParams::at(loc.latitude_deg, loc.longitude_deg)
+    };
+    let pos = solar_position(&time, &params)?;
+    Ok(survey_dir_from_true_azimuth(
+        pos.azimuth_deg,
+        pos.elevation_deg,
+        convergence,
+    ))
+}
+
+/// Sky facets of `model` for a sun in `sun_dir_in_world`, scaled so that their unobstructed
+/// horizontal irradiance Σ L_i Δω_i cos Z_i equals `sky_weight_rgb` in every channel.
+///
+/// # Errors
+/// [`SiteRenderError::Sky`] when the model gives no light above the horizon.
+pub fn sky_lights(
+    model: &SkyModel,
+    sun_dir_in_world: &Vector3<f64>,
+    dome: &crate::sky_dome::SkyDome,
+    sky_weight_rgb: [f64; 3],
+) -> Result<Vec<DistantLight>, SiteRenderError> {
+    let relative: Vec<f64> = dome
+        .facets
+        .iter()
+        .map(|f| {
+            model.relative_luminance(&f.centre_dir_in_world, sun_dir_in_world) * f.solid_angle_sr
+        })
+        .collect();
+    let horizontal: f64 = dome
+        .facets
+        .iter()
+        .zip(&relative)
+        .map(|(f, r)| r * f.centre_dir_in_world.z.max(0.0))
+        .sum();
+    if !(horizontal.is_finite() && horizontal > 0.0) {
+        return Err(SiteRenderError::Sky {
+            reason: format!("the sky model gives horizontal irradiance {horizontal}"),
+        });
+    }
+    Ok(dome
+        .facets
+        .iter()
+        .zip(&relative)
+        .map(|(f, r)| DistantLight {
+            dir_in_world: f.centre_dir_in_world,
+            normal_irradiance_rgb: sky_weight_rgb.map(|k| k * r / horizontal),
+        })
+        .collect())
+}
+
+fn atmosphere(a: &super::Atmosphere) -> Result<Option<SchachterAtmosphere>, SiteRenderError> {
+    if a.extinction_per_m
+        .iter()
+        .any(|s| !(s.is_finite() && *s >= 0.0))
+    {
+        return Err(SiteRenderError::AtmosphereSetting {
+            reason: format!(
+                "extinction_per_m {:?} must be finite and ≥ 0",
+                a.extinction_per_m
+            ),
+        });
+    }
+    let sigma_max = a.extinction_per_m.iter().copied().fold(0.0, f64::max);
+    if sigma_max <= 0.0 {
+        return Ok(None);
+    }
+    // Reference distance 1/σ_max keeps every channel's τ_a in [1/e, 1], well inside f32.
+    let reference_m = 1.0 / sigma_max;
+    #[allow(clippy::cast_possible_truncation)]
+    let tau: Vec<f32> = a
+        .extinction_per_m
+        .iter()
+        .map(|s| (-s * reference_m).exp() as f32)
+        .collect();
+    #[allow(clippy::cast_possible_truncation)]
+    let horizon: Vec<f32> = a.horizon_colour.iter().map(|&h| h as f32).collect();
+    Ok(Some(SchachterAtmosphere::new(
+        Colour::from_slice(&tau),
+        Colour::from_slice(&horizon),
+        reference_m,
+        3,
+    )?))
+}
+
+fn sun_needed(doc: &SiteDocument, sky: &SkyModel) -> bool {
+    doc.site.lighting.sun_weight.iter().any(|&k| k != 0.0)
+        || matches!(sky, SkyModel::CieGeneral(_) | SkyModel::Perez(_))
+}
+
+/// The lighting of photo `photo_id`: sun (normal irradiance = `sun_weight`), sky facets
+/// (horizontal irradiance = `sky_weight`), ambient radiance = `ambient_weight`, the atmosphere,
+/// the horizon colour and the photo-bounce domes of `options`.
+///
+/// # Errors
+/// No sun direction where one is needed, an SPA error, a bad sky model or atmosphere.
+pub fn site_lighting(
+    doc: &SiteDocument,
+    photo_id: &str,
+    options: &SiteLightingOptions,
+) -> Result<(Lighting, Option<Vector3<f64>>), SiteRenderError> {
+    let l = &doc.site.lighting;
+    let model = parse_sky_model(&l.sky_model)?;
+    let sun_dir = if sun_needed(doc, &model) {
+        Some(site_sun_dir(doc, photo_id)?)
+    } else {
+        None
+    };
+    // Skies without sun dependence ignore the direction.
+    let sky_sun_dir = sun_dir.unwrap_or_else(Vector3::z);
+    let sky = if l.sky_weight.iter().any(|&k| k != 0.0) {
+        sky_lights(
+            &model,
+            &sky_sun_dir,
+            &durisch_dome(options.sky_dome_m_h)?,
+            l.sky_weight,
+        )?
+    } else {
+        Vec::new()
+    };
+    let sun_up = sun_dir.filter(|d| d.z > 0.0);
+    let sun = sun_up
+        .filter(|_| l.sun_weight.iter().any(|&k| k != 0.0))
+        .map(|d| DistantLight {
+            dir_in_world: d,
+            normal_irradiance_rgb: l.sun_weight,
+        });
+    let lighting = Lighting {
+        daylight: Daylight {
+            sun,
+            ambient_radiance_rgb: l.ambient_weight,
+            sky,
+        },
+        artificial_lights: Vec::new(),
+        atmosphere: atmosphere(&l.atmosphere)?,
+        photo_bounce_dome: options.photo_bounce_m_h.map(durisch_dome).transpose()?,
+        photo_bounce_nested_dome: options
+            .photo_bounce_nested_m_h
+            .map(durisch_dome)
+            .transpose()?,
+        horizon_rgb: l.atmosphere.horizon_colour,
+    };
+    Ok((lighting, sun_up))
+}
+
+/// The renderer's settings from the site's `[render]` table; ray counts are rounded up to the
+/// renderer's multiples of 4 (at most 64), with a warning when that changes them.
+#[must_use]
+pub fn site_render_settings(r: &super::RenderSettings) -> (RenderSettings, Vec<SiteWarning>) {
+    let round = |n: u32| n.clamp(4, 64).div_ceil(4) * 4;
+    let (lo, hi) = (round(r.spp_min), round(r.spp_max.max(r.spp_min)));
+    let mut warnings = Vec::new();
+    if lo != r.spp_min || hi != r.spp_max {
+        warnings.push(SiteWarning::Setting {
+            message: format!(
+                "render.spp_min/spp_max {}/{} rounded to {lo}/{hi} (multiples of 4, 4–64)",
+                r.spp_min, r.spp_max
+            ),
+        });
+    }
+    (
+        RenderSettings {
+            min_rays_per_pixel: lo,
+            max_rays_per_pixel: hi,
+            seed: r.seed,
+            max_depth: r.max_depth,
+            ..RenderSettings::default()
+        },
+        warnings,
+    )
+}
+
+/// Everything to render photo `photo_id`: camera, scene, lighting, the photo (linearised, size
+/// checked against the camera) and the settings of the site's `[render]` table.
+///
+/// # Errors
+/// Any error of [`site_camera`], [`site_scene`], [`site_lighting`], the photo's decoding,
+/// [`SiteRenderError::SizeMismatch`] and [`SiteRenderError::NoVisibleModel`].
+pub fn prepare_view(doc: &SiteDocument, photo_id: &str) -> Result<ViewJob, SiteRenderError> {
+    prepare_view_with(doc, photo_id, &SiteLightingOptions::default())
+}
+
+/// [`prepare_view`] with explicit lighting options.
+///
+/// # Errors
+/// As [`prepare_view`].
+pub fn prepare_view_with(
+    doc: &SiteDocument,
+    photo_id: &str,
+    options: &SiteLightingOptions,
+) -> Result<ViewJob, SiteRenderError> {
+    let camera = site_camera(doc, photo_id)?;
+    if !doc.site.models.iter().any(|m| m.visible) {
+        return Err(SiteRenderError::NoVisibleModel);
+    }
+    let scene = site_scene(doc)?;
+    let (lighting, sun_dir_in_world) = site_lighting(doc, photo_id, options)?;
+    let photo = doc
+        .site
+        .photos
+        .iter()
+        .find(|p| p.id == photo_id)
+        .ok_or_else(|| SiteRenderError::UnknownView {
+            id: photo_id.to_owned(),
+            valid: Vec::new(),
+        })?;
+    let loaded = crate::photo::load(&doc.resolve(&photo.file))?;
+    let photo_linear = crate::render::linear_photo(&loaded);
+    let photo_px = [photo_linear.width(), photo_linear.height()];
+    if photo_px != camera.intrinsics.image_size_px {
+        return Err(SiteRenderError::SizeMismatch {
+            photo: photo_id.to_owned(),
+            photo_px,
+            camera_px: camera.intrinsics.image_size_px,
+        });
+    }
+    let (settings, setting_warnings) = site_render_settings(&doc.site.render);
+    let mut warnings = scene.warnings.clone();
+    warnings.extend(setting_warnings);
+    Ok(ViewJob {
+        photo_id: photo_id.to_owned(),
+        scene,
+        lighting,
+        camera,
+        photo_linear,
+        settings,
+        sun_dir_in_world,
+        warnings,
+    })
+}
+
+#[cfg(test)]
+#[path = "render_tests.rs"]
+mod tests;
