@@ -10,15 +10,15 @@
 //! The scene here holds the **natural** polygons only: the photos show the site without the
 //! planned building, so its CAD models must not shadow the samples.
 //!
-//! Sun direction: `lighting.sun_manual` if given, else the SPA for `lighting.time` or the time of
-//! the first daylight sample's photo (`taken_at`, else EXIF), at `[location]`; azimuths are
-//! turned into the survey frame with `location.grid_convergence_deg`.
+//! Sun direction, sky model and material library as the renderer takes them
+//! ([`crate::site::render`]: `lighting.sun_manual`, else the SPA for `lighting.time` or the
+//! time of the first daylight sample's photo, turned into the survey frame with
+//! `location.grid_convergence_deg`), so the fitted weights mean what the renderer uses.
 //!
 //! # Known limitations
 //! A problem with one sample (no solved camera, not on any polygon, wrong material, clipped
 //! window) drops that sample with a warning naming it; the fits then fail only if too few samples
-//! remain. The horizon colour is the mean of the horizon rectangles' medians. The sky-model
-//! names are parsed here (`uniform`, `cie_overcast`, `cie_general:N`).
+//! remain. The horizon colour is the mean of the horizon rectangles' medians.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -34,14 +34,14 @@ use super::daylight::{
     normalised_sky_facets,
 };
 pub use super::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport, apply_fit};
-use super::sun_check::{DEFAULT_TOLERANCE_DEG, check_sun, sun_dir_in_survey};
+use super::sun_check::{DEFAULT_TOLERANCE_DEG, check_sun};
 use crate::atmosphere::{AtmosphereError, schachter::true_radiance};
 use crate::photo::PhotoImage;
 use crate::scene::{Material, MaterialLibrary, ObjectKind, Scene, SceneObject, SceneTracer};
+use crate::site::render::{parse_sky_model, site_material_library, site_sun_dir};
 use crate::site::{SamplePurpose, Site, SiteDocument, stored_camera};
-use crate::sky::SkyModel;
 use crate::sky_dome::durisch_facets::durisch_dome;
-use crate::sun::{SpaParams, solar_position};
+use crate::sun::SpaParams;
 
 /// Reference distance dₐ of the reported transmittance: 1 km, so τₐ reads as "the fraction of
 /// light left after a kilometre" (0.5–0.95 in ordinary haze).
@@ -122,22 +122,6 @@ pub enum SiteFitError {
     Sun(String),
 }
 
-/// The sky model named in the site file.
-///
-/// # Errors
-/// A message for an unknown name.
-pub fn parse_sky_model(name: &str) -> Result<SkyModel, String> {
-    match name {
-        "uniform" => Ok(SkyModel::Uniform),
-        "cie_overcast" => Ok(SkyModel::CieOvercast),
-        other => other
-            .strip_prefix("cie_general:")
-            .and_then(|n| n.parse::<u8>().ok())
-            .and_then(|n| SkyModel::cie_general(n).ok())
-            .ok_or_else(|| format!("unknown sky model `{other}`")),
-    }
-}
-
 /// The natural scene of a site: its polygons with their materials (library definitions where
 /// the library has them). Polygons whose vertices are not yet located are skipped with a warning.
 ///
@@ -204,43 +188,6 @@ fn spa_params(site: &Site) -> Option<(SpaParams, f64)> {
     let mut p = SpaParams::at(loc.latitude_deg, loc.longitude_deg);
     p.elevation_m = loc.elevation_m;
     Some((p, loc.grid_convergence_deg))
-}
-
-/// The sun direction in the survey frame for the daylight fit (`None` when it is below the
-/// horizon).
-///
-/// # Errors
-/// [`SiteFitError::Sun`] when neither a manual sun nor a time and location are available.
-pub fn site_sun_dir(
-    doc: &SiteDocument,
-    photo_id: &str,
-) -> Result<Option<Vector3<f64>>, SiteFitError> {
-    let site = &doc.site;
-    let convergence = site
-        .location
-        .as_ref()
-        .map_or(0.0, |l| l.grid_convergence_deg);
-    if let Some(m) = &site.lighting.sun_manual {
-        let d = crate::sky::direction_from_elevation_azimuth(
-            m.elevation_deg.to_radians(),
-            (m.azimuth_deg + convergence).to_radians(),
-        );
-        return Ok((d.z > 0.0).then_some(d));
-    }
-    let time = match &site.lighting.time {
-        Some(t) => DateTime::parse_from_rfc3339(t).ok(),
-        None => photo_time(doc, photo_id),
-    }
-    .ok_or_else(|| {
-        SiteFitError::Sun(format!(
-            "no lighting.sun_manual, lighting.time, taken_at or EXIF time for photo `{photo_id}`"
-        ))
-    })?;
-    let (params, convergence) =
-        spa_params(site).ok_or_else(|| SiteFitError::Sun("the site has no [location]".into()))?;
-    let position = solar_position(&time, &params).map_err(|e| SiteFitError::Sun(e.to_string()))?;
-    let d = sun_dir_in_survey(&position, convergence);
-    Ok((d.z > 0.0).then_some(d))
 }
 
 struct Located {
@@ -404,13 +351,8 @@ pub fn fit_site(
         return Err(SiteFitError::NothingToFit);
     }
     let mut warnings = Vec::new();
-    let library = match &site.lighting.material_library {
-        Some(path) => Some(
-            MaterialLibrary::load(&doc.resolve(path))
-                .map_err(|e| SiteFitError::MaterialLibrary(e.to_string()))?,
-        ),
-        None => None,
-    };
+    let library =
+        site_material_library(doc).map_err(|e| SiteFitError::MaterialLibrary(e.to_string()))?;
     let mut photos = Photos {
         doc,
         cache: HashMap::new(),
@@ -638,8 +580,11 @@ fn run_fits(
         None
     } else {
         one_material("daylight", &day_samples)?;
-        let model = parse_sky_model(&site.lighting.sky_model).map_err(SiteFitError::Sun)?;
-        let sun_dir = site_sun_dir(doc, &day_samples[0].photo)?;
+        let model = parse_sky_model(&site.lighting.sky_model)
+            .map_err(|e| SiteFitError::Sun(e.to_string()))?;
+        let sun_dir = site_sun_dir(doc, &day_samples[0].photo)
+            .map(|d| (d.z > 0.0).then_some(d))
+            .map_err(|e| SiteFitError::Sun(e.to_string()))?;
         if sun_dir.is_none() {
             warnings.push("the sun is below the horizon: only ambient and sky are fitted".into());
         }

@@ -98,11 +98,11 @@ fn hms(s: u64) -> String {
 }
 
 /// The SPA direction in the survey frame (x grid east, y grid north, z up).
-#[must_use]
-pub fn sun_dir_in_survey(position: &SolarPosition, grid_convergence_deg: f64) -> Vector3<f64> {
-    crate::sky::direction_from_elevation_azimuth(
-        position.elevation_deg.to_radians(),
-        (position.azimuth_deg + grid_convergence_deg).to_radians(),
+fn sun_dir_in_survey(position: &SolarPosition, grid_convergence_deg: f64) -> Vector3<f64> {
+    crate::site::render::survey_dir_from_true_azimuth(
+        position.azimuth_deg,
+        position.elevation_deg,
+        grid_convergence_deg,
     )
 }
 

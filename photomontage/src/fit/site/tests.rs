@@ -188,7 +188,7 @@ fn synthetic_site(seed: u64, corrupt_every: Option<usize>) -> Synthetic {
         path: dir.path().join("site.toml"),
         site: site.clone(),
     };
-    let sun = site_sun_dir(&doc0, "P1").unwrap().unwrap();
+    let sun = site_sun_dir(&doc0, "P1").unwrap();
     let sky = normalised_sky_facets(
         &durisch_dome(SiteFitOptions::default().sky_m_h).unwrap(),
         &parse_sky_model("cie_general:12").unwrap(),
@@ -510,7 +510,7 @@ fn sun_pair_cross_check_flags_a_wrong_clock() {
     let syn = synthetic_site(24, None);
     let mut doc = syn.doc.clone();
     // The box's top corner and the point its shadow falls on, from the true sun.
-    let sun = site_sun_dir(&doc, "P1").unwrap().unwrap();
+    let sun = site_sun_dir(&doc, "P1").unwrap();
     let top = Point3::new(8.0, 8.0, 4.0);
     let shadow = top - sun * (4.0 / sun.z);
     doc.site.control_points.push(ControlPoint {
