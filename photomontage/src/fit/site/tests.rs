@@ -540,3 +540,125 @@ fn sun_pair_cross_check_flags_a_wrong_clock() {
             .any(|w| w.contains("sun check `box`") && w.contains("fast"))
     );
 }
+
+/// The sample colours rendered by our renderer (`crate::render`, case C of Durisch §6.2, eq. 6
+/// and eq. 2) with the site's lighting built by `crate::site::render::site_lighting` from chosen
+/// weights: the fit must give those weights back, which also checks that the fit's units are the
+/// renderer's (sun normal irradiance, ambient radiance, horizontal sky irradiance).
+#[test]
+fn weights_rendered_by_the_renderer_are_recovered() {
+    use crate::render::DifferentialTracer;
+    use crate::site::render::{SiteLightingOptions, site_lighting};
+    let dir = tempfile::tempdir().unwrap();
+    let mut site = base_site();
+    std::fs::write(
+        dir.path().join("materials.toml"),
+        format!("[[material]]\nname = \"stone\"\ndiffuse_rgb = {RHO:?}\n"),
+    )
+    .unwrap();
+    site.lighting.sun_weight = K_S;
+    site.lighting.ambient_weight = K_U;
+    site.lighting.sky_weight = K_H;
+    site.lighting.atmosphere.extinction_per_m = TAU_1KM.map(|t| -t.ln() / 1000.0);
+    site.lighting.atmosphere.horizon_colour = HORIZON;
+    let doc = SiteDocument {
+        path: dir.path().join("site.toml"),
+        site: site.clone(),
+    };
+    // No photo bounce: the rendered surfaces are lit by sun, sky and ambient only, as eq. 9.
+    let options = SiteLightingOptions {
+        sky_dome_m_h: SiteFitOptions::default().sky_m_h,
+        photo_bounce_m_h: None,
+        photo_bounce_nested_m_h: None,
+    };
+    let (lighting, _) = site_lighting(&doc, "P1", &options).unwrap();
+    // The same polygons as artificial objects, so the renderer shades them (case C).
+    let (natural, _) = natural_scene(&site, None).unwrap();
+    let mut scene = Scene::new();
+    let object = scene
+        .add_object(SceneObject {
+            name: "rendered".into(),
+            kind: ObjectKind::Artificial,
+            image_attribute: None,
+        })
+        .unwrap();
+    let stone = scene.add_material(Material::diffuse("stone", RHO)).unwrap();
+    for t in natural.triangles() {
+        scene
+            .add_polygon(&t.vertices_in_world_m, stone, object)
+            .unwrap();
+    }
+    let camera = stored_camera(&site, "P1").unwrap();
+    let blank = Rgb32FImage::from_pixel(SIZE_PX[0], SIZE_PX[1], Rgb(HORIZON.map(|c| c as f32)));
+    let tracer = DifferentialTracer::new(&scene, &lighting, &camera, &blank, 1).unwrap();
+    let mut img = blank.clone();
+    let mut pixels: Vec<([u32; 2], SamplePurpose)> = Vec::new();
+    // Atmosphere: open ground just below the horizon row (149.5): rows 150–155 are 1.3 km …
+    // 116 m away, at azimuths between the wall and the box.
+    for (i, x) in [80_u32, 130, 180, 230, 280, 320].iter().enumerate() {
+        pixels.push(([*x, 150 + i as u32], SamplePurpose::Atmosphere));
+    }
+    // Daylight: pixels of random points near the box and on the wall.
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    while pixels.len() < 6 + 24 {
+        let p = match rng.random_range(0..4) {
+            0 => Point3::new(
+                rng.random_range(0.0..16.0),
+                rng.random_range(1.0..18.0),
+                0.0,
+            ),
+            1 => Point3::new(rng.random_range(8.3..11.7), 8.0, rng.random_range(0.3..3.7)),
+            2 => Point3::new(8.0, rng.random_range(8.3..11.7), rng.random_range(0.3..3.7)),
+            _ => Point3::new(
+                rng.random_range(-29.0..-13.0),
+                20.0,
+                rng.random_range(0.3..7.5),
+            ),
+        };
+        let Some(px) = camera.project(&p) else {
+            continue;
+        };
+        let c = [px.x.round() as u32, px.y.round() as u32];
+        if c[0] >= SIZE_PX[0] || c[1] >= SIZE_PX[1] || pixels.iter().any(|(q, _)| *q == c) {
+            continue;
+        }
+        pixels.push((c, SamplePurpose::Daylight));
+    }
+    for (i, (c, purpose)) in pixels.iter().enumerate() {
+        let dir = camera.ray_dir_in_world(Point2::new(f64::from(c[0]), f64::from(c[1])));
+        let sample = tracer.trace_primary(&dir, HORIZON);
+        assert!(sample.hit_artificial, "sample {i} at {c:?} sees no surface");
+        img.put_pixel(c[0], c[1], Rgb(sample.radiance_rgb.map(|v| v as f32)));
+        site.samples.push(Sample {
+            id: format!("r{i}"),
+            photo: "P1".into(),
+            material: "stone".into(),
+            purpose: *purpose,
+            point: None,
+            x_px: Some(f64::from(c[0])),
+            y_px: Some(f64::from(c[1])),
+            window_px: 1,
+            enabled: true,
+        });
+    }
+    image::DynamicImage::ImageRgb32F(img)
+        .save(dir.path().join("p1.exr"))
+        .unwrap();
+    // The fit starts from the site's defaults, not from the truth.
+    site.lighting = crate::site::Lighting {
+        time: site.lighting.time.clone(),
+        sky_model: site.lighting.sky_model.clone(),
+        material_library: site.lighting.material_library.clone(),
+        ..crate::site::Lighting::default()
+    };
+    let path = dir.path().join("site.toml");
+    site.save(&path).unwrap();
+    let doc = SiteDocument::load(&path).unwrap();
+    let report = fit_site(&doc, &SiteFitOptions::default(), None).unwrap();
+    assert!(
+        report.residuals.iter().all(|r| !r.flagged),
+        "{:?}",
+        report.warnings
+    );
+    assert_recovered(&report, SYNTHETIC_SITE_REL);
+}
