@@ -248,6 +248,8 @@ pub struct AtmosphereFit {
     pub iterations: [u64; 3],
     /// Channels clamped to τₐ = 1.
     pub clamped: [bool; 3],
+    /// Samples dropped as outliers by [`fit_atmosphere_robust`] (all `false` otherwise).
+    pub flagged: Vec<bool>,
 }
 
 impl AtmosphereFit {
@@ -277,6 +279,7 @@ pub fn fit_atmosphere_rgb(
         reference_distance_m,
         iterations: [0; 3],
         clamped: [false; 3],
+        flagged: vec![false; samples.len()],
     };
     for k in 0..3 {
         let channel: Vec<(f64, f64)> = samples.iter().map(|(d, c)| (*d, c[k])).collect();
@@ -296,6 +299,80 @@ pub fn fit_atmosphere_rgb(
         }
     }
     Ok(fit)
+}
+
+/// Eq. 7 per channel with outlying samples dropped one at a time, as the daylight fit does
+/// ([`super::daylight`]): after each fit the sample with the largest normalised residual
+/// `|r|/σ̂` over the channels (σ̂ = 1.4826·MAD of the kept samples' residuals, floored at
+/// [`super::daylight::NOISE_FLOOR_REL`] of their RMS colour) is dropped while that exceeds
+/// `outlier_threshold` and more than three samples remain. Residuals are reported for every
+/// sample against the final fit.
+///
+/// # Errors
+/// As [`fit_atmosphere_rgb`].
+pub fn fit_atmosphere_robust(
+    horizon_rgb: [f64; 3],
+    samples: &[(f64, [f64; 3])],
+    reference_distance_m: f64,
+    outlier_threshold: f64,
+    observer: Option<Arc<dyn FitObserver>>,
+) -> Result<AtmosphereFit, AtmosphereError> {
+    let mut active = vec![true; samples.len()];
+    loop {
+        let kept: Vec<(f64, [f64; 3])> = samples
+            .iter()
+            .zip(&active)
+            .filter(|(_, a)| **a)
+            .map(|(s, _)| *s)
+            .collect();
+        let mut fit =
+            fit_atmosphere_rgb(horizon_rgb, &kept, reference_distance_m, observer.clone())?;
+        // Residuals of every sample against this fit: model − apparent.
+        let residuals: Vec<[f64; 3]> = samples
+            .iter()
+            .map(|(d, c)| {
+                [0, 1, 2].map(|k| {
+                    crate::atmosphere::schachter::apparent_radiance(
+                        fit.true_colour[k],
+                        horizon_rgb[k],
+                        fit.transmittance[k],
+                        *d,
+                        reference_distance_m,
+                    ) - c[k]
+                })
+            })
+            .collect();
+        let scale = [0, 1, 2].map(|k| {
+            let mut abs: Vec<f64> = residuals
+                .iter()
+                .zip(&active)
+                .filter(|(_, a)| **a)
+                .map(|(r, _)| r[k].abs())
+                .collect();
+            abs.sort_by(f64::total_cmp);
+            let mad = abs.get(abs.len() / 2).copied().unwrap_or(0.0);
+            #[allow(clippy::cast_precision_loss)]
+            let rms = (kept.iter().map(|s| s.1[k].powi(2)).sum::<f64>() / kept.len() as f64).sqrt();
+            (1.4826 * mad).max(super::daylight::NOISE_FLOOR_REL * rms)
+        });
+        let worst = (0..samples.len())
+            .filter(|&i| active[i])
+            .map(|i| {
+                let z = (0..3)
+                    .map(|k| residuals[i][k].abs() / scale[k])
+                    .fold(0.0, f64::max);
+                (i, z)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match worst {
+            Some((i, z)) if z > outlier_threshold && kept.len() > 3 => active[i] = false,
+            _ => {
+                fit.residuals = residuals;
+                fit.flagged = active.iter().map(|a| !a).collect();
+                return Ok(fit);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -410,6 +487,33 @@ mod tests {
                 );
                 assert!((fit.true_colour[k] - l0).abs() < 1e-6, "{fit:?} L0 {l0}");
             }
+        }
+    }
+
+    #[test]
+    fn a_corrupted_sample_is_flagged_and_does_not_bias() {
+        // Ten samples, one (10 %) mis-clicked on a darker object: flagged, τ exact again.
+        let (tau, l0, linf) = ([0.7, 0.65, 0.55], [0.2, 0.22, 0.25], [0.7, 0.75, 0.9]);
+        let samples: Vec<(f64, [f64; 3])> = (0..10)
+            .map(|i| {
+                let d = 100.0 + 300.0 * f64::from(i);
+                let mut c = [0, 1, 2].map(|k| apparent_radiance(l0[k], linf[k], tau[k], d, 1000.0));
+                if i == 6 {
+                    c = c.map(|v| v * 0.7);
+                }
+                (d, c)
+            })
+            .collect();
+        let plain = fit_atmosphere_rgb(linf, &samples, 1000.0, None).unwrap();
+        assert!(
+            (plain.transmittance[0] - tau[0]).abs() > 0.01,
+            "the outlier biases a plain fit"
+        );
+        let fit = fit_atmosphere_robust(linf, &samples, 1000.0, 3.5, None).unwrap();
+        assert_eq!(fit.flagged.iter().filter(|f| **f).count(), 1);
+        assert!(fit.flagged[6]);
+        for k in 0..3 {
+            assert!((fit.transmittance[k] - tau[k]).abs() < EXACT_TOL, "{fit:?}");
         }
     }
 

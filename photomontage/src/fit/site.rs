@@ -27,7 +27,7 @@ use chrono::{DateTime, FixedOffset};
 use nalgebra::{Point2, Point3, Vector3};
 
 use super::FitObserver;
-use super::atmosphere::{AtmosphereFit, fit_atmosphere_rgb};
+use super::atmosphere::{AtmosphereFit, fit_atmosphere_robust};
 use super::colour::{ColourReadOptions, read_rect, read_window};
 use super::daylight::{
     DaylightFit, DaylightFitOptions, DaylightSample, fit_daylight, irradiance_components,
@@ -541,10 +541,11 @@ fn run_fits(
             .iter()
             .map(|s| (s.distance_m, s.apparent))
             .collect();
-        let fit = fit_atmosphere_rgb(
+        let fit = fit_atmosphere_robust(
             horizon_colour,
             &data,
             REPORT_REFERENCE_DISTANCE_M,
+            site.solve.outlier_threshold_sigma,
             observer.clone(),
         )
         .map_err(|source| SiteFitError::Atmosphere {
@@ -559,14 +560,27 @@ fn run_fits(
                 ));
             }
         }
-        for (s, r) in atm_samples.iter().zip(&fit.residuals) {
+        for ((s, r), flagged) in atm_samples.iter().zip(&fit.residuals).zip(&fit.flagged) {
             residuals.push(FitResidual {
                 sample: s.id.clone(),
                 fit: "atmosphere",
                 residual_rgb: *r,
                 normalised: None,
-                flagged: false,
+                flagged: *flagged,
             });
+        }
+        let dropped: Vec<&Located> = atm_samples
+            .iter()
+            .zip(&fit.flagged)
+            .filter(|(_, f)| **f)
+            .map(|(s, _)| *s)
+            .collect();
+        if !dropped.is_empty() {
+            warnings.push(format!(
+                "atmosphere samples dropped as outliers (normalised residual > {}): {}",
+                site.solve.outlier_threshold_sigma,
+                id_list(&dropped)
+            ));
         }
         Some(fit)
     };
