@@ -138,7 +138,6 @@ pub fn irradiance_components(
     sky: &[SkyFacetWeight],
 ) -> IrradianceComponents {
     let origin = point_in_world_m + normal_in_world * SURFACE_OFFSET_M;
-    #[allow(clippy::cast_possible_truncation)]
     let visible = |dir: &Vector3<f64>| {
         !tracer.any_hit(&tracer.ray_from_world(&origin, dir, 0.0, f32::INFINITY))
     };
