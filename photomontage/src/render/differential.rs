@@ -111,6 +111,17 @@ pub struct RaySample {
     pub changed: bool,
     /// Whether the ray's first hit is an artificial object (coverage).
     pub hit_artificial: bool,
+    /// The first hit (distance along the ray, object), for the depth and object-id layers.
+    pub first_hit: Option<PrimaryHit>,
+}
+
+/// Where a primary ray first hit the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrimaryHit {
+    /// Distance from the camera centre along the (unit) ray, metres.
+    pub distance_m: f64,
+    /// The object hit.
+    pub object: crate::scene::ObjectId,
 }
 
 /// The scene split for differential tracing: all geometry, natural only and artificial only.
@@ -275,6 +286,10 @@ impl<'a> DifferentialTracer<'a> {
             Some(hit) => {
                 let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
                 let d = f64::from(hit.hit.t);
+                let first_hit = Some(PrimaryHit {
+                    distance_m: d,
+                    object: hit.object,
+                });
                 match hit.kind {
                     ObjectKind::Artificial => RaySample {
                         radiance_rgb: self.case_c_shade(
@@ -287,6 +302,7 @@ impl<'a> DifferentialTracer<'a> {
                         ),
                         changed: true,
                         hit_artificial: true,
+                        first_hit,
                     },
                     ObjectKind::Natural => {
                         let (radiance_rgb, changed) = self.case_d_natural_hit(
@@ -301,6 +317,7 @@ impl<'a> DifferentialTracer<'a> {
                             radiance_rgb,
                             changed,
                             hit_artificial: false,
+                            first_hit,
                         }
                     }
                 }
@@ -315,6 +332,7 @@ impl<'a> DifferentialTracer<'a> {
             radiance_rgb: photo_pixel_rgb,
             changed: false,
             hit_artificial: false,
+            first_hit: None,
         }
     }
 

@@ -21,7 +21,9 @@
 //!
 //! Output: linear RGBA with alpha = coverage of artificial objects (fraction of rays whose first
 //! hit is artificial), written as EXR ([`RenderedImage::write_exr`]) or sRGB PNG through
-//! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]).
+//! [`crate::colour::tonemap`] ([`RenderedImage::write_png`]); [`render_view_with_layers`] also
+//! fills depth, object-id and shadow-change layers, and [`output`] writes them as a multi-channel
+//! EXR or 8-bit sRGB PNG/JPEG/TIFF.
 //!
 //! # Known limitations
 //! The "unchanged" decision uses the first 4 rays of a pixel: an artificial sliver thinner than
@@ -33,6 +35,7 @@ pub mod differential;
 pub mod glass;
 pub mod illumination;
 pub mod luminaire_light;
+pub mod output;
 pub mod spectral;
 pub mod specular;
 pub mod water;
@@ -46,9 +49,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-pub use differential::{DifferentialError, DifferentialTracer, Lighting, RaySample};
+pub use differential::{DifferentialError, DifferentialTracer, Lighting, PrimaryHit, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
 pub use luminaire_light::{ArtificialLight, LuminaireLight};
+pub use output::{LayerSet, OutputError, OutputFormat, OutputLayers};
 pub use spectral::{SpectralError, render_view_spectral};
 
 use crate::colour::ToneMap;
@@ -184,6 +188,7 @@ impl RenderedImage {
 
 struct TileOut {
     rgba: Vec<[f32; 4]>,
+    layers: OutputLayers,
     changed: usize,
     rays: u64,
 }
@@ -200,6 +205,22 @@ pub fn render_view(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderError> {
+    render_view_with_layers(tracer, settings, LayerSet::default(), on_tile, cancel)
+        .map(|(image, _)| image)
+}
+
+/// [`render_view`] that also fills the auxiliary output layers chosen in `layers` (see
+/// [`output`] for their definitions).
+///
+/// # Errors
+/// As [`render_view`].
+pub fn render_view_with_layers(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+    layers: LayerSet,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<(RenderedImage, OutputLayers), RenderError> {
     check_view(tracer, settings)?;
     let photo = tracer.photo();
     let [w, h] = [photo.width(), photo.height()];
@@ -216,7 +237,7 @@ pub fn render_view(
             let i = index as u32;
             let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
             let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
-            let out = render_tile(tracer, settings, index, origin_px, size_px);
+            let out = render_tile(tracer, settings, layers, index, origin_px, size_px);
             on_tile(TileProgress {
                 tile_index: index,
                 tile_count,
@@ -227,6 +248,7 @@ pub fn render_view(
         })
         .collect();
     let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
+    let mut out_layers = OutputLayers::new(layers, (w * h) as usize);
     let (mut changed_pixels, mut primary_rays) = (0, 0);
     for (index, tile) in tiles.into_iter().enumerate() {
         let Some(tile) = tile else {
@@ -239,7 +261,9 @@ pub fn render_view(
         for (k, p) in tile.rgba.iter().enumerate() {
             #[allow(clippy::cast_possible_truncation)]
             let k = k as u32;
-            rgba[((y0 + k / tw) * w + x0 + k % tw) as usize] = *p;
+            let to = ((y0 + k / tw) * w + x0 + k % tw) as usize;
+            rgba[to] = *p;
+            out_layers.copy_pixel(&tile.layers, k as usize, to);
         }
         changed_pixels += tile.changed;
         primary_rays += tile.rays;
@@ -247,12 +271,15 @@ pub fn render_view(
     if cancel.load(Ordering::Relaxed) {
         return Err(RenderError::Cancelled);
     }
-    Ok(RenderedImage {
-        size_px: [w, h],
-        rgba,
-        changed_pixels,
-        primary_rays,
-    })
+    Ok((
+        RenderedImage {
+            size_px: [w, h],
+            rgba,
+            changed_pixels,
+            primary_rays,
+        },
+        out_layers,
+    ))
 }
 
 /// Checks that the photo is the camera's size and the settings are valid.
@@ -288,6 +315,7 @@ fn check_view(
 fn render_tile(
     tracer: &DifferentialTracer<'_>,
     settings: &RenderSettings,
+    layers: LayerSet,
     tile_index: usize,
     origin_px: [u32; 2],
     size_px: [u32; 2],
@@ -298,6 +326,7 @@ fn render_tile(
     let camera = tracer.camera();
     let mut out = TileOut {
         rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),
+        layers: OutputLayers::new(layers, 0),
         changed: 0,
         rays: 0,
     };
@@ -307,6 +336,8 @@ fn render_tile(
             let photo_rgb = photo_f32.map(f64::from);
             let mut sum = [0.0_f64; 3];
             let mut sum_sq = [0.0_f64; 3];
+            let mut natural_change = [0.0_f64; 3];
+            let mut first_hit = None;
             let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
             loop {
                 for s in 0..4 {
@@ -317,6 +348,14 @@ fn render_tile(
                         f64::from(y) - 0.5 + (sy + v) / 2.0,
                     );
                     let sample = tracer.trace_primary(&camera.ray_dir_in_world(pixel), photo_rgb);
+                    if n == 0 && s == 0 {
+                        first_hit = Some(sample.first_hit);
+                    }
+                    if !sample.hit_artificial {
+                        for k in 0..3 {
+                            natural_change[k] += sample.radiance_rgb[k] - photo_rgb[k];
+                        }
+                    }
                     changed |= sample.changed;
                     covered += u32::from(sample.hit_artificial);
                     for k in 0..3 {
@@ -339,6 +378,8 @@ fn render_tile(
                 }
             }
             out.rays += u64::from(n);
+            out.layers
+                .push_pixel(first_hit.flatten(), natural_change, changed, n);
             if changed {
                 out.changed += 1;
                 let nf = f64::from(n);

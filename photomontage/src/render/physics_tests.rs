@@ -477,3 +477,48 @@ fn a_luminaire_lights_an_artificial_surface_case_c_and_aiming_turns_it_away() {
             .all(|p| p[0].abs() < 1e-12 && p[2].abs() < 1e-12)
     );
 }
+
+#[test]
+fn glossy_glass_and_spectral_renders_are_identical_for_one_and_two_threads() {
+    let (mut scene, lighting, cam, photo) = grey_box_scene();
+    // A glossy glass roof over the box's top face adds the glass and GGX code paths.
+    let roof = Material {
+        glass: Some(Glass {
+            ior: 1.52,
+            transmittance_rgb: [0.85, 0.88, 0.86],
+        }),
+        specular: Some(Specular {
+            roughness: 0.3,
+            f0: 0.04,
+        }),
+        ..Material::diffuse("roof", [0.0; 3])
+    };
+    add_quad(&mut scene, 3.0, 5.0, roof, ObjectKind::Artificial);
+    let tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 2).unwrap();
+    let settings = RenderSettings {
+        tile_size_px: 16,
+        seed: 7,
+        ..RenderSettings::default()
+    };
+    let run = |threads: usize, spectral: bool| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let cancel = AtomicBool::new(false);
+        let img = pool.install(|| {
+            if spectral {
+                render_view_spectral(&tracer, &settings, SampleSet::Durisch9, &|_| {}, &cancel)
+                    .unwrap()
+            } else {
+                render_view(&tracer, &settings, &|_| {}, &cancel).unwrap()
+            }
+        });
+        img.rgba
+            .iter()
+            .map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(run(1, false), run(2, false));
+    assert_eq!(run(1, true), run(2, true));
+}

@@ -25,7 +25,9 @@
 //! reflectance (ratio to white), its horizon colour like a light. Meyer's 4 samples cannot
 //! represent sRGB green without clamping (see [`crate::colour::spectrum`]), so that mode is not
 //! exact even for grey scenes with green light. Specular Fresnel (F0) is achromatic. The passes
-//! share the geometry but trace it once each (3× the ray casts of RGB mode for Durisch's 9).
+//! share the geometry but trace it once each (3× the ray casts of RGB mode for Durisch's 9), and
+//! each pass holds its own f32 copy of the photo (the secondary rays look natural surfaces up in
+//! it): 3 extra photo-sized images for Durisch's 9.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -522,3 +522,74 @@ fn photographed_ground_lights_the_wall_by_its_photo_radiance() {
         );
     }
 }
+
+#[test]
+fn output_layers_give_depth_object_and_the_exact_shadow_change() {
+    let scene = site(true);
+    let lighting = sun_and_ambient();
+    let cam = camera();
+    let photo = uniform_photo(ground_radiance());
+    let tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 2).unwrap();
+    let settings = RenderSettings::default();
+    let all = LayerSet::parse("depth,object_id,shadow_change").unwrap();
+    let (out, layers) =
+        render_view_with_layers(&tracer, &settings, all, &|_| {}, &AtomicBool::new(false)).unwrap();
+    // The layers do not change the image.
+    assert_eq!(out, render(&tracer, &settings));
+    let depth = layers.depth_m.unwrap();
+    let ids = layers.object_id.unwrap();
+    let change = layers.shadow_change_rgb.unwrap();
+
+    let a = BOX_HALF_M;
+    let shadow_x = BOX_HEIGHT_M * (-sun_dir().x / sun_dir().z);
+    let margin = 0.05;
+    let c = cam.pose.camera_center_in_world;
+    let (mut ground, mut shadow) = (0, 0);
+    for y in 0..SIZE_PX[1] {
+        for x in 0..SIZE_PX[0] {
+            let i = (y * SIZE_PX[0] + x) as usize;
+            let fp = footprint_on_ground(&cam, x, y);
+            let min_x = fp.iter().map(|p| p.x).fold(f64::INFINITY, f64::min);
+            let max_x = fp.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max);
+            let min_y = fp.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+            let max_y = fp.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+            let far_from_box = max_x < -a - 5.0 || min_y > a + 5.0;
+            if far_from_box {
+                // Ground (object 0): the first ray's distance lies between the pixel corners'.
+                ground += 1;
+                assert_eq!(ids[i].to_bits(), 0.0_f32.to_bits());
+                let d: Vec<f64> = fp.iter().map(|p| (p - c).norm()).collect();
+                let (lo, hi) = (
+                    d.iter().copied().fold(f64::INFINITY, f64::min),
+                    d.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                );
+                let got = f64::from(depth[i]);
+                assert!(got >= lo * (1.0 - F32_REL_TOL) && got <= hi * (1.0 + F32_REL_TOL));
+                assert_eq!(change[i].map(f32::to_bits), [0; 3]);
+            }
+            let inside_shadow = min_x > a + margin
+                && max_x < a + shadow_x - margin
+                && min_y > -a + margin
+                && max_y < a - margin
+                && out.rgba[i][3] <= 0.0;
+            if inside_shadow {
+                // D3: the sun's share of the photo is removed, exactly.
+                shadow += 1;
+                for k in 0..3 {
+                    let e = E_SUN[k] * sun_dir().z;
+                    let expected = -ground_radiance()[k] * e / (e + PI * K_U[k]);
+                    assert_close(change[i][k], expected, "shadow change");
+                }
+            }
+        }
+    }
+    assert!(
+        ground > 500 && shadow > 10,
+        "{ground} ground, {shadow} shadow"
+    );
+    // The box top (object 1, the first artificial quad) at its projected centre.
+    let top = cam.project(&Point3::new(0.0, 0.0, BOX_HEIGHT_M)).unwrap();
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let i = (top.y.round() as u32 * SIZE_PX[0] + top.x.round() as u32) as usize;
+    assert_eq!(ids[i].to_bits(), 1.0_f32.to_bits());
+}

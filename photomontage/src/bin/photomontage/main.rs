@@ -3,6 +3,7 @@
 mod fit;
 mod info;
 mod luminaire;
+mod render;
 mod report;
 mod resect;
 mod sky;
@@ -30,6 +31,9 @@ enum Command {
     /// Solve every photo of a site (resection, then bundle adjustment), print the residuals
     /// and write the cameras back into the site atomically.
     Solve(solve::Args),
+    /// Render the site's planned models into one solved photo (differential ray tracing) and
+    /// write EXR (linear, alpha, optional layers) or 8-bit sRGB PNG/JPEG/TIFF.
+    Render(render::Args),
     /// Solve one photo from a control-point file (CSV or OpenDroneMap gcp_list.txt).
     Resect(resect::Args),
     /// Solar position (NREL SPA), sunrise and sunset.
@@ -48,6 +52,7 @@ fn main() -> anyhow::Result<()> {
     match cli.command {
         Command::Info(args) => info::run(&args),
         Command::Solve(args) => solve::run(&args),
+        Command::Render(args) => render::run(&args),
         Command::Resect(args) => resect::run(&args),
         Command::Sun(args) => sun::run(&args),
         Command::Sky(args) => sky::run(&args),
