@@ -15,6 +15,7 @@ pub mod colour;
 pub mod fit;
 pub mod geo;
 pub mod luminaire;
+pub mod peer_scene;
 pub mod photo;
 pub mod photogrammetry;
 pub mod render;

@@ -9,13 +9,8 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
-use photomontage::camera::{BrownConrady, Camera, Intrinsics, Pose};
-use photomontage::render::{
-    Daylight, DifferentialTracer, DistantLight, Lighting, RenderSettings, render_view,
-};
-use photomontage::scene::{Material, ObjectKind, Scene, SceneObject};
-use photomontage::sky_dome::durisch_facets::durisch_dome;
+use photomontage::peer_scene::{MAX_DEPTH, mitsuba_pair_scene};
+use photomontage::render::{DifferentialTracer, RenderSettings, render_view};
 use photomontage_tests::shared_file;
 use serde_json::Value;
 
@@ -37,10 +32,6 @@ const BOX_MEAN_REL_TOL: f64 = 0.03;
 /// Shadow pixels: the acceptance goal (3 %); measured 2.0 % (4.8 % without the nested
 /// bounce that lights the box walls facing the shadow, 11 % without any bounce from the box).
 const SHADOW_MEAN_REL_TOL: f64 = 0.03;
-
-fn vec3(v: &Value) -> [f64; 3] {
-    [0, 1, 2].map(|k| v[k].as_f64().unwrap())
-}
 
 fn downscale(img: &image::Rgb32FImage) -> image::Rgb32FImage {
     let scale = scale();
@@ -78,101 +69,11 @@ fn box_and_shadow_match_mitsuba_1024spp() {
     let photo = downscale(&load(&photo_path));
     let truth = downscale(&load(&truth_path));
 
-    // Camera: Mitsuba's look-at with a vertical field of view.
-    let cam = &spec["camera"];
-    let eye = Point3::from(vec3(&cam["position"]));
-    let target = Point3::from(vec3(&cam["target"]));
-    let f = (target - eye).normalize();
-    let r = f.cross(&Vector3::from(vec3(&cam["up"]))).normalize();
-    let d = f.cross(&r);
+    // Scene, camera and lights: shared with the render-speed bench (`render_bench`).
     let (w, h) = (photo.width(), photo.height());
-    let vfov = cam["vfov_deg"].as_f64().unwrap().to_radians();
-    let camera = Camera {
-        intrinsics: Intrinsics {
-            distortion: BrownConrady::default(),
-            ..Intrinsics::centred(f64::from(h) / 2.0 / (vfov / 2.0).tan(), [w, h])
-        },
-        pose: Pose {
-            rotation_world_from_camera: Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
-                r, d, f,
-            ])),
-            camera_center_in_world: eye,
-        },
-    };
-
-    // Scene: the natural ground and the artificial box.
-    let mut scene = Scene::new();
-    let add = |scene: &mut Scene, name: &str, kind, albedo: [f64; 3], faces: Vec<Vec<[f64; 3]>>| {
-        let m = scene.add_material(Material::diffuse(name, albedo)).unwrap();
-        let o = scene
-            .add_object(SceneObject {
-                name: name.into(),
-                kind,
-                image_attribute: None,
-            })
-            .unwrap();
-        for face in faces {
-            let poly: Vec<Point3<f64>> = face.into_iter().map(Point3::from).collect();
-            scene.add_polygon(&poly, m, o).unwrap();
-        }
-    };
-    let ground = &spec["ground"];
-    let corners: Vec<[f64; 3]> = ground["corners"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(vec3)
-        .collect();
-    add(
-        &mut scene,
-        "ground",
-        ObjectKind::Natural,
-        vec3(&ground["albedo_rgb"]),
-        vec![corners],
-    );
-    let building = &spec["building"];
-    let c: Vec<[f64; 3]> = building["corners"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(vec3)
-        .collect();
-    let faces = [
-        [0, 1, 3, 2],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [1, 3, 7, 5],
-        [3, 2, 6, 7],
-        [2, 0, 4, 6],
-    ]
-    .iter()
-    .map(|f| f.iter().map(|&i| c[i]).collect())
-    .collect();
-    add(
-        &mut scene,
-        "box",
-        ObjectKind::Artificial,
-        vec3(&building["albedo_rgb"]),
-        faces,
-    );
-
-    // Lights: directional sun, uniform sky on a Durisch dome (m_h = 8, 256 facets).
-    let dome = durisch_dome(8).unwrap();
-    let lighting = Lighting {
-        daylight: Daylight {
-            sun: Some(DistantLight {
-                dir_in_world: Vector3::from(vec3(&spec["sun"]["direction_to_sun"])).normalize(),
-                normal_irradiance_rgb: vec3(&spec["sun"]["irradiance_rgb"]),
-            }),
-            ambient_radiance_rgb: [0.0; 3],
-            sky: Daylight::uniform_sky_lights(&dome, vec3(&spec["sky"]["radiance_rgb"])),
-        },
-        photo_bounce_dome: Some(durisch_dome(6).unwrap()),
-        photo_bounce_nested_dome: Some(durisch_dome(2).unwrap()),
-        horizon_rgb: vec3(&spec["sky"]["radiance_rgb"]),
-        ..Lighting::default()
-    };
-    let tracer = DifferentialTracer::new(&scene, &lighting, &camera, &photo, 1).unwrap();
+    let peer = mitsuba_pair_scene(&spec, [w, h]).unwrap();
+    let (scene, camera, lighting) = (peer.scene, peer.camera, peer.lighting);
+    let tracer = DifferentialTracer::new(&scene, &lighting, &camera, &photo, MAX_DEPTH).unwrap();
     let out = render_view(
         &tracer,
         &RenderSettings::default(),

@@ -25,7 +25,12 @@
 //! point gathers the radiance of the natural surfaces around it from the photo (Durisch's
 //! secondary ray in case D, the photo standing for their true colour), and a changed natural
 //! point gathers the light the artificial objects reflect onto it (added like D1), those objects
-//! lit in turn by the photo over [`Lighting::photo_bounce_nested_dome`].
+//! lit in turn by the photo over [`Lighting::photo_bounce_nested_dome`]. A changed natural point
+//! also gathers the light its photographed surroundings reflect onto it, once against the natural
+//! geometry (part of the natural irradiance that the eq. 10 inversion divides by: without it a
+//! point in a street lit by sunny façades gets too high an albedo and its new shadow comes out
+//! too dark) and once against all geometry with the sun removed where only artificial objects
+//! block it; the difference is added like D1/D3.
 //!
 //! Because eq. 2 is affine in L₀, the apparent colour of a changed natural point is computed as
 //! `L_photo + τ(d)·ΔL₀`: an unchanged point returns the photo value unaltered, bit for bit.
@@ -149,8 +154,10 @@ fn water_noise_of(materials: &[Material]) -> Vec<Option<GradientNoise>> {
         .collect()
 }
 
+/// The triangles of `scene` whose object is of `kind`, as one object; material ids are kept
+/// (the materials are copied in order, so a hit's material id means the same in both scenes).
 fn sub_scene(scene: &Scene, kind: ObjectKind) -> Scene {
-    let triangles: Vec<[Point3<f64>; 3]> = scene
+    let (triangles, triangle_materials): (Vec<[Point3<f64>; 3]>, Vec<u32>) = scene
         .triangles()
         .iter()
         .filter(|t| {
@@ -159,12 +166,12 @@ fn sub_scene(scene: &Scene, kind: ObjectKind) -> Scene {
                 .get(t.object.0 as usize)
                 .is_some_and(|o| o.kind == kind)
         })
-        .map(|t| t.vertices_in_world_m)
-        .collect();
+        .map(|t| (t.vertices_in_world_m, t.material.0))
+        .unzip();
     let model = ImportedModel {
-        triangle_materials: vec![0; triangles.len()],
+        triangle_materials,
         triangles_in_world_m: triangles,
-        materials: vec![],
+        materials: scene.materials().to_vec(),
         warnings: vec![],
     };
     let mut out = Scene::new();
@@ -638,6 +645,10 @@ impl<'a> DifferentialTracer<'a> {
         let e_natural = natural_irradiance_rgb(daylight, &normal, sun_natural, |i| {
             !self.natural_blocks(&origin, &daylight.sky[i].dir_in_world, inf)
         });
+        // Light the photographed surroundings reflect onto the point, before and after the
+        // artificial objects arrive (they block some of it and shade the surfaces it comes from).
+        let (e_inter_before, e_inter_after) = self.natural_interreflection(&origin, &normal);
+        let e_natural = add(e_natural, e_inter_before);
         let Some(rho) = diffuse_reflectance_from_true_colour(l0, e_natural) else {
             // No natural light reaches the point: nothing to remove; D1 needs ρ_d from the
             // material library.
@@ -657,7 +668,14 @@ impl<'a> DifferentialTracer<'a> {
         }
         // D1 for the light the artificial objects reflect onto the point.
         let e_reflected = self.artificial_bounce_irradiance(&origin, &normal);
-        let delta = diffuse_radiance_rgb(rho, add(add(e_d1, e_reflected), scale(e_d3, -1.0)));
+        let e_inter_change = add(e_inter_after, scale(e_inter_before, -1.0));
+        let delta = diffuse_radiance_rgb(
+            rho,
+            add(
+                add(add(e_d1, e_reflected), scale(e_d3, -1.0)),
+                e_inter_change,
+            ),
+        );
         self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m)
     }
 
@@ -729,6 +747,7 @@ impl<'a> DifferentialTracer<'a> {
             return [0.0; 3];
         };
         self.gather_over_dome(
+            &self.all,
             dome,
             origin,
             normal,
@@ -741,8 +760,10 @@ impl<'a> DifferentialTracer<'a> {
     /// Irradiance at `origin` gathered over the facets of `dome` and their mirror images below
     /// the horizon: each direction with a positive cosine that `worth_tracing` admits is traced,
     /// and the first hit, if it is of `kind`, contributes `radiance · cos · solid angle`.
+    #[allow(clippy::too_many_arguments)]
     fn gather_over_dome(
         &self,
+        tracer: &SceneTracer,
         dome: &crate::sky_dome::SkyDome,
         origin: &Point3<f64>,
         normal: &Vector3<f64>,
@@ -759,14 +780,14 @@ impl<'a> DifferentialTracer<'a> {
                 if cos <= 0.0 || !worth_tracing(&dir) {
                     continue;
                 }
-                let ray = self.all.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
-                let Some(hit) = self.all.closest_hit(&ray) else {
+                let ray = tracer.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
+                let Some(hit) = tracer.closest_hit(&ray) else {
                     continue;
                 };
                 if hit.kind != kind {
                     continue;
                 }
-                let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
+                let point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
                 let l = radiance(&hit, &point, &dir, f64::from(hit.hit.t));
                 e = add(e, scale(l, cos * facet.solid_angle_sr));
             }
@@ -781,6 +802,7 @@ impl<'a> DifferentialTracer<'a> {
             return [0.0; 3];
         };
         self.gather_over_dome(
+            &self.all,
             dome,
             origin,
             normal,
@@ -832,6 +854,44 @@ impl<'a> DifferentialTracer<'a> {
         dir_in_world: &Vector3<f64>,
         distance_m: f64,
     ) -> Rgb {
+        self.natural_radiance_towards(hit, point, dir_in_world, distance_m, true)
+    }
+
+    /// Irradiance at a natural point (`origin` offset along its unit `normal`) from the natural
+    /// surfaces around it, their radiance taken from the photo, over
+    /// [`Lighting::photo_bounce_dome`]: `(before, after)` the artificial objects arrive. Before:
+    /// traced against the natural geometry, the photo's radiance as is (it is in the photo, so
+    /// it belongs in the denominator of the eq. 10 inversion). After: traced against all
+    /// geometry (artificial objects block some directions) with the surfaces' radiance less the
+    /// sun the artificial objects take from them. Both zero without a dome.
+    fn natural_interreflection(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> (Rgb, Rgb) {
+        let (Some(dome), Some(natural)) = (&self.lighting.photo_bounce_dome, &self.natural) else {
+            return ([0.0; 3], [0.0; 3]);
+        };
+        let before = self.gather_over_dome(
+            natural,
+            dome,
+            origin,
+            normal,
+            ObjectKind::Natural,
+            |_| true,
+            |hit, point, dir, t| self.natural_radiance_towards(hit, point, dir, t, false),
+        );
+        let after = self.photo_bounce_irradiance(Some(dome), origin, normal);
+        (before, after)
+    }
+
+    /// Radiance leaving a natural point towards a gather ray; with `with_artificial` the sun
+    /// blocked only by artificial objects is removed (case D3 at the bounce), without it the
+    /// radiance is the photo's (the scene before the artificial objects).
+    fn natural_radiance_towards(
+        &self,
+        hit: &SceneHit,
+        point: &Point3<f64>,
+        dir_in_world: &Vector3<f64>,
+        distance_m: f64,
+        with_artificial: bool,
+    ) -> Rgb {
         let normal = self.normal_facing(hit, dir_in_world);
         let origin = point + normal * SURFACE_OFFSET_M;
         let daylight = &self.lighting.daylight;
@@ -843,7 +903,8 @@ impl<'a> DifferentialTracer<'a> {
         let l0 = match self.photo_colour_of(point) {
             Some((photo_rgb, photo_distance_m)) => {
                 let l0 = self.true_colour(photo_rgb, photo_distance_m);
-                let sun_d3 = sun_natural
+                let sun_d3 = with_artificial
+                    && sun_natural
                     && daylight.sun.as_ref().is_some_and(|s| {
                         self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
                     });
@@ -865,7 +926,7 @@ impl<'a> DifferentialTracer<'a> {
                     .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
                 let sun_visible = sun_natural
                     && daylight.sun.as_ref().is_some_and(|s| {
-                        !self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
+                        !with_artificial || !self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
                     });
                 diffuse_radiance_rgb(
                     rho,
