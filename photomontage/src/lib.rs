@@ -12,6 +12,7 @@ pub mod atmosphere;
 pub mod bvh;
 pub mod camera;
 pub mod colour;
+pub mod fit;
 pub mod geo;
 pub mod luminaire;
 pub mod peer_scene;

@@ -9,8 +9,9 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
+use photomontage::colour::SampleSet;
 use photomontage::peer_scene::{MAX_DEPTH, mitsuba_pair_scene};
-use photomontage::render::{DifferentialTracer, RenderSettings, render_view};
+use photomontage::render::{DifferentialTracer, RenderSettings, render_view, render_view_spectral};
 use photomontage_tests::shared_file;
 use serde_json::Value;
 
@@ -74,13 +75,17 @@ fn box_and_shadow_match_mitsuba_1024spp() {
     let peer = mitsuba_pair_scene(&spec, [w, h]).unwrap();
     let (scene, camera, lighting) = (peer.scene, peer.camera, peer.lighting);
     let tracer = DifferentialTracer::new(&scene, &lighting, &camera, &photo, MAX_DEPTH).unwrap();
-    let out = render_view(
-        &tracer,
-        &RenderSettings::default(),
-        &|_| {},
-        &AtomicBool::new(false),
-    )
-    .unwrap();
+    // `RENDER_MITSUBA_SPECTRAL=durisch9|meyer4` measures the spectral mode instead.
+    let spectral = match std::env::var("RENDER_MITSUBA_SPECTRAL").as_deref() {
+        Ok("durisch9") => Some(SampleSet::Durisch9),
+        Ok("meyer4") => Some(SampleSet::Meyer4),
+        _ => None,
+    };
+    let (settings, cancel) = (RenderSettings::default(), AtomicBool::new(false));
+    let out = match spectral {
+        None => render_view(&tracer, &settings, &|_| {}, &cancel).unwrap(),
+        Some(set) => render_view_spectral(&tracer, &settings, set, &|_| {}, &cancel).unwrap(),
+    };
 
     if let Some(dir) = std::env::var_os("RENDER_MITSUBA_DUMP") {
         let dir = Path::new(&dir);
@@ -135,7 +140,7 @@ fn box_and_shadow_match_mitsuba_1024spp() {
     let shadow_mre = shadow_err / f64::from(shadow_n);
     let rmse = (sq / f64::from(3 * w * h)).sqrt();
     println!(
-        "mitsuba {w}x{h}: box pixels {box_n} mean rel err {box_mre:.4}; shadow pixels {shadow_n} \
+        "mitsuba {w}x{h} {spectral:?}: box pixels {box_n} mean rel err {box_mre:.4}; shadow pixels {shadow_n} \
          mean rel err {shadow_mre:.4}; signed: box {:+.4}, shadow {:+.4}; RMSE {rmse:.5}; changed pixels {}; rays/pixel {:.2}",
         box_bias / f64::from(box_n),
         shadow_bias / f64::from(shadow_n),

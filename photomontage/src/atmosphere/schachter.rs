@@ -14,8 +14,8 @@
 //!   `L₀ = (L − L∞) · τₐ^(−d/dₐ) + L∞`, the true colour of a photographed object at a known
 //!   distance (Durisch §4.2; §6 case D).
 //! - **First inversion** (eq. 7, [`fit_transmittance`]): τₐ (and a common L₀) from n ≥ 2 samples
-//!   of one material at known distances, given L∞, by damped Gauss–Newton started, as Durisch
-//!   does, at τₐ = 1 and L₀ = the nearest sample.
+//!   of one material at known distances, given L∞, by [`crate::fit::atmosphere`] (argmin
+//!   Gauss–Newton) started, as Durisch does, at τₐ = 1 and L₀ = the nearest sample.
 //! - Koschmieder's law ([`transmittance_from_visibility`]) turns a reported visibility into τₐ.
 //!
 //! # Known limitations
@@ -351,17 +351,15 @@ pub struct Eq7Fit {
     pub true_radiance: f64,
     /// Root-mean-square residual of eq. 7 at the solution.
     pub rms_residual: f64,
-    /// Gauss–Newton iterations taken.
+    /// Solver iterations taken.
     pub iterations: usize,
 }
 
-/// Most Gauss–Newton iterations of [`fit_transmittance`].
-const EQ7_MAX_ITERATIONS: usize = 200;
-
 /// Durisch eq. 7 (first inversion) for one channel: fits τₐ and L₀ to samples
-/// `(distance_m, apparent_radiance)` of one material, given the horizon radiance. Damped
-/// Gauss–Newton (Levenberg–Marquardt) in (L₀, σ) with τₐ = e^(−σ), σ ≥ 0, started at τₐ = 1 and
-/// L₀ = the apparent radiance of the nearest sample.
+/// `(distance_m, apparent_radiance)` of one material, given the horizon radiance, started at
+/// τₐ = 1 and L₀ = the apparent radiance of the nearest sample. The solver is
+/// [`crate::fit::atmosphere::solve_eq7`] (argmin Gauss–Newton with a line search), which also
+/// gives σ(τₐ) and the residuals.
 ///
 /// # Errors
 /// Fewer than two distinct distances, non-finite samples, or samples that do not determine τₐ
@@ -371,99 +369,13 @@ pub fn fit_transmittance(
     samples: &[(f64, f64)],
     reference_distance_m: f64,
 ) -> Result<Eq7Fit, AtmosphereError> {
-    if !(reference_distance_m.is_finite() && reference_distance_m > 0.0) {
-        return Err(AtmosphereError::InvalidDistance {
-            value_m: reference_distance_m,
-        });
-    }
-    for (index, &(d, l)) in samples.iter().enumerate() {
-        if !(d.is_finite() && d >= 0.0 && l.is_finite()) {
-            return Err(AtmosphereError::InvalidSample { index });
-        }
-    }
-    let Some(&(d_min, l_nearest)) = samples.iter().min_by(|a, b| a.0.total_cmp(&b.0)) else {
-        return Err(AtmosphereError::NotEnoughSamples {
-            required: 2,
-            found: 0,
-        });
-    };
-    let d_max = samples.iter().map(|s| s.0).fold(d_min, f64::max);
-    if samples.len() < 2 || d_max <= d_min {
-        return Err(AtmosphereError::NotEnoughSamples {
-            required: 2,
-            found: usize::from(!samples.is_empty()),
-        });
-    }
-    if !horizon_radiance.is_finite() {
-        return Err(AtmosphereError::InvalidSample { index: 0 });
-    }
-    let scaled: Vec<(f64, f64)> = samples
-        .iter()
-        .map(|&(d, l)| (d / reference_distance_m, l - horizon_radiance))
-        .collect();
-    if scaled.iter().all(|s| s.1 == 0.0) {
-        return Err(AtmosphereError::Undetermined {
-            reason: "every sample equals the horizon colour",
-        });
-    }
-    // Unknowns: a = L₀ − L∞ and σ. Residual r_i = a·e^(−σ d_i) − (L_i − L∞).
-    let cost = |a: f64, sigma: f64| -> f64 {
-        scaled
-            .iter()
-            .map(|&(d, y)| (a * (-sigma * d).exp() - y).powi(2))
-            .sum()
-    };
-    let (mut a, mut sigma) = (l_nearest - horizon_radiance, 0.0_f64);
-    let mut current = cost(a, sigma);
-    let mut lambda = 1e-3;
-    let mut iterations = 0;
-    while iterations < EQ7_MAX_ITERATIONS {
-        iterations += 1;
-        // Normal equations JᵀJ δ = −Jᵀr with J = [t_i, −a d_i t_i].
-        let (mut h11, mut h12, mut h22, mut g1, mut g2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        for &(d, y) in &scaled {
-            let t = (-sigma * d).exp();
-            let r = a * t - y;
-            let (j1, j2) = (t, -a * d * t);
-            h11 += j1 * j1;
-            h12 += j1 * j2;
-            h22 += j2 * j2;
-            g1 += j1 * r;
-            g2 += j2 * r;
-        }
-        let mut improved = false;
-        while lambda < 1e12 {
-            let (m11, m22) = (h11 * (1.0 + lambda), h22 * (1.0 + lambda));
-            let det = m11 * m22 - h12 * h12;
-            if det.abs() < 1e-300 {
-                lambda *= 10.0;
-                continue;
-            }
-            let da = -(m22 * g1 - h12 * g2) / det;
-            let ds = -(m11 * g2 - h12 * g1) / det;
-            let (na, ns) = (a + da, (sigma + ds).max(0.0));
-            let trial = cost(na, ns);
-            if trial <= current {
-                let step = (na - a).abs() + (ns - sigma).abs();
-                a = na;
-                sigma = ns;
-                let gain = current - trial;
-                current = trial;
-                lambda = (lambda * 0.3).max(1e-12);
-                improved = step > 1e-15 * (1.0 + a.abs() + sigma) && gain > 1e-30;
-                break;
-            }
-            lambda *= 10.0;
-        }
-        if !improved {
-            break;
-        }
-    }
+    let s =
+        crate::fit::atmosphere::solve_eq7(horizon_radiance, samples, reference_distance_m, None)?;
     Ok(Eq7Fit {
-        transmittance: (-sigma).exp(),
-        true_radiance: a + horizon_radiance,
-        rms_residual: (current / scaled.len() as f64).sqrt(),
-        iterations,
+        transmittance: s.transmittance,
+        true_radiance: s.true_radiance,
+        rms_residual: s.rms_residual,
+        iterations: usize::try_from(s.iterations).unwrap_or(usize::MAX),
     })
 }
 

@@ -926,7 +926,8 @@ impl<'a> DifferentialTracer<'a> {
                     .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
                 let sun_visible = sun_natural
                     && daylight.sun.as_ref().is_some_and(|s| {
-                        !with_artificial || !self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
+                        !with_artificial
+                            || !self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
                     });
                 diffuse_radiance_rgb(
                     rho,

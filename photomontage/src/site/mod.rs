@@ -14,6 +14,7 @@
 //! the line of the enclosing table.
 
 mod locate;
+pub mod luminaires;
 pub mod render;
 mod schema;
 pub mod solve;
@@ -107,7 +108,7 @@ impl SiteDocument {
     }
 
     /// Saves atomically to `path` and makes it the document's path. When the new file is in
-    /// another folder, relative photo, model and material-library paths are rewritten as absolute
+    /// another folder, relative photo, model, luminaire and material-library paths are rewritten as absolute
     /// paths so they still point at the same files.
     ///
     /// # Errors
@@ -135,6 +136,7 @@ impl SiteDocument {
             };
             site.photos.iter_mut().for_each(|ph| rebase(&mut ph.file));
             site.models.iter_mut().for_each(|m| rebase(&mut m.file));
+            site.luminaires.iter_mut().for_each(|l| rebase(&mut l.file));
             if let Some(lib) = site.lighting.material_library.as_mut() {
                 rebase(lib);
             }

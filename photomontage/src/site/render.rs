@@ -20,8 +20,8 @@
 //! Polygons are single-sided triangles of their vertex points (no holes). CAD materials named in
 //! the material library take the library's definition; the others keep their file's definition.
 //! The sky is sampled on a fixed Durisch dome (its facet count is [`SiteLightingOptions`]), so a
-//! CIE sky's circumsolar peak is averaged over a facet. Artificial luminaires are not yet part of
-//! the site file.
+//! CIE sky's circumsolar peak is averaged over a facet. Luminaires (`[[luminaires]]`) are
+//! added by [`super::luminaires`].
 
 use std::collections::HashMap;
 use std::fmt;
@@ -119,6 +119,18 @@ pub enum SiteRenderError {
     },
     #[error("scene: {0}")]
     Scene(#[from] SceneError),
+    #[error("luminaire `{luminaire}` ({path}): {reason}")]
+    LuminaireFile {
+        luminaire: String,
+        path: String,
+        reason: String,
+    },
+    #[error("luminaire `{luminaire}`: {field} {reason}")]
+    LuminaireSetting {
+        luminaire: String,
+        field: &'static str,
+        reason: String,
+    },
 }
 
 /// Something worth telling the user that does not stop the render.
@@ -138,6 +150,8 @@ pub enum SiteWarning {
     Import { model: String, message: String },
     /// A render setting of the site was adjusted to what the renderer accepts.
     Setting { message: String },
+    /// A luminaire that will not light as the user probably meant (e.g. zero scale).
+    Luminaire { luminaire: String, message: String },
 }
 
 impl fmt::Display for SiteWarning {
@@ -155,6 +169,9 @@ impl fmt::Display for SiteWarning {
             ),
             Self::Import { model, message } => write!(f, "model `{model}`: {message}"),
             Self::Setting { message } => f.write_str(message),
+            Self::Luminaire { luminaire, message } => {
+                write!(f, "luminaire `{luminaire}`: {message}")
+            }
         }
     }
 }
@@ -611,11 +628,13 @@ fn sun_needed(doc: &SiteDocument, sky: &SkyModel) -> bool {
 }
 
 /// The lighting of photo `photo_id`: sun (normal irradiance = `sun_weight`), sky facets
-/// (horizontal irradiance = `sky_weight`), ambient radiance = `ambient_weight`, the atmosphere,
+/// (horizontal irradiance = `sky_weight`), ambient radiance = `ambient_weight`, the enabled
+/// `[[luminaires]]` ([`super::luminaires::site_luminaire_lights`]), the atmosphere,
 /// the horizon colour and the photo-bounce domes of `options`.
 ///
 /// # Errors
-/// No sun direction where one is needed, an SPA error, a bad sky model or atmosphere.
+/// No sun direction where one is needed, an SPA error, a bad sky model or atmosphere, a
+/// luminaire whose file is missing or invalid.
 pub fn site_lighting(
     doc: &SiteDocument,
     photo_id: &str,
@@ -653,7 +672,7 @@ pub fn site_lighting(
             ambient_radiance_rgb: l.ambient_weight,
             sky,
         },
-        artificial_lights: Vec::new(),
+        artificial_lights: super::luminaires::site_luminaire_lights(doc)?,
         atmosphere: atmosphere(&l.atmosphere)?,
         photo_bounce_dome: options.photo_bounce_m_h.map(durisch_dome).transpose()?,
         photo_bounce_nested_dome: options
@@ -739,6 +758,7 @@ pub fn prepare_view_with(
     let (settings, setting_warnings) = site_render_settings(&doc.site.render);
     let mut warnings = scene.warnings.clone();
     warnings.extend(setting_warnings);
+    warnings.extend(super::luminaires::luminaire_warnings(&doc.site));
     Ok(ViewJob {
         photo_id: photo_id.to_owned(),
         scene,

@@ -58,6 +58,21 @@ pub struct Site {
     /// CAD models of the planned (artificial) objects.
     #[serde(default)]
     pub models: Vec<CadModel>,
+    /// Artificial lights: luminaires with a photometric file (IES LM-63 or EULUMDAT).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub luminaires: Vec<SiteLuminaire>,
+    /// Colour samples for the lighting fits (Durisch 1992 §4.2–4.3).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub samples: Vec<Sample>,
+    /// Rectangles of sky at the horizon giving the horizon colour L∞.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub horizon_samples: Vec<HorizonSample>,
+    /// Object/shadow point pairs for the sun cross-check.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sun_shadow_pairs: Vec<SunShadowPair>,
+    /// Record of the last lighting fit, written by `fit`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit: Option<FitRecord>,
 }
 
 impl Default for Site {
@@ -75,6 +90,11 @@ impl Default for Site {
             observations: Vec::new(),
             polygons: Vec::new(),
             models: Vec::new(),
+            luminaires: Vec::new(),
+            samples: Vec::new(),
+            horizon_samples: Vec::new(),
+            sun_shadow_pairs: Vec::new(),
+            fit: None,
         }
     }
 }
@@ -378,6 +398,42 @@ impl Default for Placement {
     }
 }
 
+/// A luminaire of the site (an artificial light, Durisch 1992 §3.2 / §6.2 cases C and D1).
+///
+/// Photometric frame: with both angles 0 the luminaire hangs in its photometric position, nadir
+/// (γ = 0) straight down (world −Z) and the C0 half-plane towards world +X (C90 towards +Y).
+/// `tilt_deg` then swings the nadir up towards the C0 direction, and `rotation_z_deg` turns the
+/// whole luminaire about the vertical: `world_from_luminaire = R_z(rotation_z) · R_y(−tilt)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SiteLuminaire {
+    /// Unique id, named in errors and warnings.
+    pub id: String,
+    /// IES LM-63 (`.ies`) or EULUMDAT (`.ldt`) file, relative to the site file.
+    pub file: String,
+    /// Photometric centre, world coordinates (metres).
+    pub position_m: [f64; 3],
+    /// Rotation about world Z, degrees counter-clockwise seen from above (C0 from +X).
+    #[serde(default)]
+    pub rotation_z_deg: f64,
+    /// Tilt of the nadir from straight down towards the C0 direction, degrees.
+    #[serde(default)]
+    pub tilt_deg: f64,
+    /// Colour multiplier per RGB channel (linear).
+    #[serde(default = "default_colour")]
+    pub colour_rgb: [f64; 3],
+    /// Photo linear units × m² per candela: a luminaire of I cd gives the irradiance
+    /// `I · scale · colour / d²` in the units of `lighting.sun_weight`.
+    pub scale: f64,
+    /// Disabled luminaires are kept but give no light.
+    #[serde(default = "default_true")]
+    pub enabled: bool,
+}
+
+fn default_colour() -> [f64; 3] {
+    [1.0; 3]
+}
+
 /// Render settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -408,4 +464,118 @@ impl Default for RenderSettings {
             exposure: 1.0,
         }
     }
+}
+
+fn default_window_px() -> u32 {
+    5
+}
+
+/// What a colour sample is used for.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SamplePurpose {
+    /// The atmosphere's first inversion (eq. 7): one material, same illumination, different
+    /// distances.
+    Atmosphere,
+    /// The daylight first inversion (eq. 9): one material, different illumination.
+    #[default]
+    Daylight,
+}
+
+/// A point on a scene polygon whose colour is read from a photo (Durisch 1992 §4.2–4.3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sample {
+    /// Unique sample id.
+    pub id: String,
+    /// The photo the colour is read from (and whose camera gives the distance).
+    pub photo: String,
+    /// Material of the polygon the sample lies on.
+    pub material: String,
+    /// Which fit uses the sample.
+    #[serde(default)]
+    pub purpose: SamplePurpose,
+    /// World point (metres); projected into the photo. Give either this or `x_px`/`y_px`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// Pixel x in the photo; the ray through it is intersected with the scene polygons.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x_px: Option<f64>,
+    /// Pixel y in the photo.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y_px: Option<f64>,
+    /// Edge of the square window the median colour is taken over (odd, 1–101).
+    #[serde(default = "default_window_px")]
+    pub window_px: u32,
+    /// Disabled samples are kept but not used.
+    #[serde(default = "default_true")]
+    pub enabled: bool,
+}
+
+/// A rectangle of sky at the horizon in a photo: its median colour is L∞.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HorizonSample {
+    /// Unique id.
+    pub id: String,
+    /// The photo.
+    pub photo: String,
+    /// Top-left pixel [x, y] of the rectangle.
+    pub origin_px: [u32; 2],
+    /// Width and height in pixels (1–4096 each).
+    pub size_px: [u32; 2],
+    /// Disabled samples are kept but not used.
+    #[serde(default = "default_true")]
+    pub enabled: bool,
+}
+
+/// An object point and the point where its shadow falls, for the sun cross-check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunShadowPair {
+    /// Unique id.
+    pub id: String,
+    /// Id of the point that casts the shadow (control or tie point).
+    pub object_point: String,
+    /// Id of the point where its shadow falls.
+    pub shadow_point: String,
+    /// The photo whose time is checked.
+    pub photo: String,
+}
+
+/// The record of the last lighting fit (the fitted values themselves go into `[lighting]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitRecord {
+    /// When the fit ran (RFC 3339, UTC).
+    pub fitted_at: String,
+    /// Reference distance dₐ of `transmittance`, metres.
+    pub reference_distance_m: f64,
+    /// τₐ over the reference distance per channel (from eq. 7), when the atmosphere was fitted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmittance: Option<[f64; 3]>,
+    /// σ(τₐ) per channel (absent without redundancy).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmittance_sigma: Option<[f64; 3]>,
+    /// σ of `lighting.sun_weight` per channel (0 where the weight sits at its bound 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun_weight_sigma: Option<[f64; 3]>,
+    /// σ of `lighting.ambient_weight`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ambient_weight_sigma: Option<[f64; 3]>,
+    /// σ of `lighting.sky_weight`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sky_weight_sigma: Option<[f64; 3]>,
+    /// Whether the weights are relative (the material's reflectance unknown, ρ_d = 1 assumed).
+    #[serde(default)]
+    pub weights_relative: bool,
+    /// RMS residual of the daylight fit per channel (true colour, linear units).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_residual: Option<[f64; 3]>,
+    /// Samples dropped as outliers.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub flagged_samples: Vec<String>,
+    /// Warnings of the fit.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }

@@ -239,3 +239,54 @@ fn failed_save_cleans_up_and_reports() {
     assert_eq!(names, vec![std::ffi::OsString::from("site.toml")]);
     assert_eq!(std::fs::read_to_string(path.join("keep")).unwrap(), "x");
 }
+
+#[test]
+fn save_as_elsewhere_keeps_every_referenced_file_reachable() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(src.join("photos")).unwrap();
+    let path = src.join("site.toml");
+    let mut site = parse(EXAMPLE).unwrap();
+    site.lighting.material_library = Some("materials.toml".into());
+    site.models.push(CadModel {
+        id: "M".into(),
+        file: "model.obj".into(),
+        units: "m".into(),
+        up_axis: "z".into(),
+        placement: Placement::default(),
+        visible: true,
+    });
+    site.luminaires.push(SiteLuminaire {
+        id: "L".into(),
+        file: "lamp.ies".into(),
+        position_m: [0.0; 3],
+        rotation_z_deg: 0.0,
+        tilt_deg: 0.0,
+        colour_rgb: [1.0; 3],
+        scale: 1.0,
+        enabled: true,
+    });
+    site.save(&path).unwrap();
+    let mut doc = SiteDocument::load(&path).unwrap();
+    let before: Vec<PathBuf> = referenced_files(&doc);
+    let copy = dir.path().join("elsewhere").join("copy.toml");
+    std::fs::create_dir_all(dir.path().join("elsewhere")).unwrap();
+    doc.save_as(&copy).unwrap();
+    let again = SiteDocument::load(&copy).unwrap();
+    let after = referenced_files(&again);
+    assert_eq!(before.len(), 5);
+    assert_eq!(before, after);
+}
+
+/// Every file a site refers to, resolved against the site's folder.
+fn referenced_files(doc: &SiteDocument) -> Vec<PathBuf> {
+    let s = &doc.site;
+    s.photos
+        .iter()
+        .map(|p| &p.file)
+        .chain(s.models.iter().map(|m| &m.file))
+        .chain(s.luminaires.iter().map(|l| &l.file))
+        .chain(s.lighting.material_library.iter())
+        .map(|f| doc.resolve(f))
+        .collect()
+}

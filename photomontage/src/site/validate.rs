@@ -240,6 +240,9 @@ impl Site {
             }
         }
 
+        validate_luminaires(&self.luminaires, &mut issues);
+        self.validate_fit_inputs(&mut issues, &photo_ids, &point_ids, &observed);
+
         let lighting = &self.lighting;
         if !valid_sky_model(&lighting.sky_model) {
             issues.push(issue(
@@ -286,6 +289,135 @@ impl Site {
     }
 }
 
+impl Site {
+    /// Checks `[[samples]]`, `[[horizon_samples]]` and `[[sun_shadow_pairs]]`; every message
+    /// names the sample.
+    fn validate_fit_inputs(
+        &self,
+        issues: &mut Vec<SiteIssue>,
+        photo_ids: &HashSet<&str>,
+        point_ids: &HashSet<&str>,
+        observed: &HashSet<&str>,
+    ) {
+        let materials: HashSet<&str> = self.polygons.iter().map(|p| p.material.as_str()).collect();
+        let mut ids = HashSet::new();
+        for (i, s) in self.samples.iter().enumerate() {
+            let field = format!("samples[{i}]");
+            if s.id.trim().is_empty() {
+                issues.push(issue(format!("{field}.id"), "must not be empty"));
+            }
+            if !ids.insert(s.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!("duplicate sample id `{}`", s.id),
+                ));
+            }
+            if !photo_ids.contains(s.photo.as_str()) {
+                issues.push(issue(
+                    format!("{field}.photo"),
+                    format!("sample `{}`: no photo has id `{}`", s.id, s.photo),
+                ));
+            }
+            if !materials.contains(s.material.as_str()) {
+                issues.push(issue(
+                    format!("{field}.material"),
+                    format!(
+                        "sample `{}`: no polygon has material `{}`",
+                        s.id, s.material
+                    ),
+                ));
+            }
+            match (s.point, s.x_px, s.y_px) {
+                (Some(p), None, None) => check_finite(issues, format!("{field}.point"), &p),
+                (None, Some(x), Some(y)) => check_finite(issues, format!("{field}.x_px"), &[x, y]),
+                _ => issues.push(issue(
+                    format!("{field}.point"),
+                    format!(
+                        "sample `{}`: give either `point` or both `x_px` and `y_px`",
+                        s.id
+                    ),
+                )),
+            }
+            if s.window_px == 0 || s.window_px % 2 == 0 || s.window_px > 101 {
+                issues.push(issue(
+                    format!("{field}.window_px"),
+                    format!(
+                        "sample `{}`: window of {} px must be odd and 1–101",
+                        s.id, s.window_px
+                    ),
+                ));
+            }
+        }
+        let mut ids = HashSet::new();
+        for (i, h) in self.horizon_samples.iter().enumerate() {
+            let field = format!("horizon_samples[{i}]");
+            if !ids.insert(h.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!("duplicate horizon sample id `{}`", h.id),
+                ));
+            }
+            if !photo_ids.contains(h.photo.as_str()) {
+                issues.push(issue(
+                    format!("{field}.photo"),
+                    format!("horizon sample `{}`: no photo has id `{}`", h.id, h.photo),
+                ));
+            }
+            if h.size_px.iter().any(|s| *s == 0 || *s > 4096) {
+                issues.push(issue(
+                    format!("{field}.size_px"),
+                    format!(
+                        "horizon sample `{}`: width and height must be 1–4096 px",
+                        h.id
+                    ),
+                ));
+            }
+        }
+        let mut ids = HashSet::new();
+        for (i, pair) in self.sun_shadow_pairs.iter().enumerate() {
+            let field = format!("sun_shadow_pairs[{i}]");
+            if !ids.insert(pair.id.as_str()) {
+                issues.push(issue(
+                    format!("{field}.id"),
+                    format!("duplicate sun/shadow pair id `{}`", pair.id),
+                ));
+            }
+            for (name, point) in [
+                ("object_point", &pair.object_point),
+                ("shadow_point", &pair.shadow_point),
+            ] {
+                if !point_ids.contains(point.as_str()) && !observed.contains(point.as_str()) {
+                    issues.push(issue(
+                        format!("{field}.{name}"),
+                        format!(
+                            "sun/shadow pair `{}`: `{point}` is neither a control point nor an observed point",
+                            pair.id
+                        ),
+                    ));
+                }
+            }
+            if pair.object_point == pair.shadow_point {
+                issues.push(issue(
+                    format!("{field}.shadow_point"),
+                    format!(
+                        "sun/shadow pair `{}`: object and shadow are the same point",
+                        pair.id
+                    ),
+                ));
+            }
+            if !photo_ids.contains(pair.photo.as_str()) {
+                issues.push(issue(
+                    format!("{field}.photo"),
+                    format!(
+                        "sun/shadow pair `{}`: no photo has id `{}`",
+                        pair.id, pair.photo
+                    ),
+                ));
+            }
+        }
+    }
+}
+
 fn valid_sky_model(name: &str) -> bool {
     match name {
         "uniform" | "cie_overcast" => true,
@@ -293,5 +425,51 @@ fn valid_sky_model(name: &str) -> bool {
             .strip_prefix("cie_general:")
             .and_then(|n| n.parse::<u8>().ok())
             .is_some_and(|n| (1..=15).contains(&n)),
+    }
+}
+
+fn validate_luminaires(luminaires: &[super::SiteLuminaire], issues: &mut Vec<SiteIssue>) {
+    let mut ids = HashSet::new();
+    for (i, l) in luminaires.iter().enumerate() {
+        let field = format!("luminaires[{i}]");
+        if l.id.trim().is_empty() {
+            issues.push(issue(format!("{field}.id"), "must not be empty"));
+        }
+        if !ids.insert(l.id.as_str()) {
+            issues.push(issue(
+                format!("{field}.id"),
+                format!("duplicate luminaire id `{}`", l.id),
+            ));
+        }
+        if l.file.trim().is_empty() {
+            issues.push(issue(
+                format!("{field}.file"),
+                format!("luminaire `{}`: must not be empty", l.id),
+            ));
+        }
+        for (name, values) in [
+            ("position_m", &l.position_m[..]),
+            ("rotation_z_deg", &[l.rotation_z_deg][..]),
+            ("tilt_deg", &[l.tilt_deg][..]),
+        ] {
+            if values.iter().any(|v| !v.is_finite()) {
+                issues.push(issue(
+                    format!("{field}.{name}"),
+                    format!("luminaire `{}`: must be finite (not NaN or infinite)", l.id),
+                ));
+            }
+        }
+        if !l.colour_rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            issues.push(issue(
+                format!("{field}.colour_rgb"),
+                format!("luminaire `{}`: must be finite and ≥ 0", l.id),
+            ));
+        }
+        if !(l.scale.is_finite() && l.scale >= 0.0) {
+            issues.push(issue(
+                format!("{field}.scale"),
+                format!("luminaire `{}`: must be finite and ≥ 0", l.id),
+            ));
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! The `photomontage` command-line tool.
 
+mod fit;
 mod info;
 mod luminaire;
 mod render;
@@ -41,6 +42,9 @@ enum Command {
     Sky(sky::SkyArgs),
     /// Read an IES LM-63 or EULUMDAT file: format, flux, max intensity, symmetry, plot.
     Luminaire(luminaire::LuminaireArgs),
+    /// Fit the atmosphere and daylight weights to the site's colour samples (Durisch §4.2–4.3),
+    /// cross-check the sun against shadows, and write the lighting back atomically.
+    Fit(fit::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -53,5 +57,6 @@ fn main() -> anyhow::Result<()> {
         Command::Sun(args) => sun::run(&args),
         Command::Sky(args) => sky::run(&args),
         Command::Luminaire(args) => luminaire::run(&args),
+        Command::Fit(args) => fit::run(&args),
     }
 }

@@ -1,5 +1,6 @@
 //! `photomontage render SITE --view PHOTO --out FILE`: render the site's visible models into one
-//! solved photo with the differential ray tracer and write EXR or 8-bit sRGB.
+//! solved photo with the differential ray tracer and write EXR or 8-bit sRGB. Ctrl-C cancels
+//! the render between tiles; nothing is written then and the exit status is non-zero.
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -11,8 +12,11 @@ use photomontage::render::{DifferentialTracer, render_view_spectral, render_view
 use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+
+/// Set by the Ctrl-C handler; the renderer polls it between tiles.
+static CANCEL: AtomicBool = AtomicBool::new(false);
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -132,7 +136,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} tiles {elapsed} (eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let cancel = AtomicBool::new(false);
+    ctrlc::set_handler(|| CANCEL.store(true, Ordering::SeqCst))
+        .context("installing the Ctrl-C handler")?;
+    eprintln!("rendering {w}×{h} px (Ctrl-C cancels)");
+    let cancel = &CANCEL;
     let render = || -> anyhow::Result<_> {
         let on_tile = |_| bar.inc(1);
         if spectral {
@@ -141,7 +148,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 &job.settings,
                 SampleSet::Durisch9,
                 &on_tile,
-                &cancel,
+                cancel,
             )?;
             Ok((image, output::OutputLayers::default()))
         } else {
@@ -150,19 +157,26 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 &job.settings,
                 layers,
                 &on_tile,
-                &cancel,
+                cancel,
             )?)
         }
     };
-    let (image, out_layers) = match args.threads {
+    let result = match args.threads {
         Some(t) => rayon::ThreadPoolBuilder::new()
             .num_threads(t.max(1))
             .build()
             .context("building the thread pool")?
-            .install(render)?,
-        None => render()?,
+            .install(render),
+        None => render(),
     };
     bar.finish_and_clear();
+    if CANCEL.load(Ordering::SeqCst) {
+        bail!(
+            "cancelled (Ctrl-C): nothing written to {}",
+            args.out.display()
+        );
+    }
+    let (image, out_layers) = result?;
     let elapsed_s = start.elapsed().as_secs_f64();
 
     let tone_map = ToneMap {
