@@ -11,7 +11,9 @@
 //! The history lives in memory only; it is not part of the autosave sidecar, so after a crash
 //! the restored edits are kept but can no longer be undone one by one.
 
-use photomontage::site::{ControlPoint, Exterior, Interior, Observation, Site, TiePoint};
+use photomontage::site::{
+    ControlPoint, Exterior, Interior, Observation, Placement, Polygon, Site, TiePoint,
+};
 
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -22,6 +24,10 @@ pub enum CommandError {
     NoSuchControlPoint { id: String },
     #[error("no photo `{id}`")]
     NoSuchPhoto { id: String },
+    #[error("no CAD model `{id}`")]
+    NoSuchModel { id: String },
+    #[error("no polygon `{id}`")]
+    NoSuchPolygon { id: String },
     #[error("nothing to undo")]
     NothingToUndo,
     #[error("nothing to redo")]
@@ -54,6 +60,12 @@ pub enum Command {
     },
     /// Replaces the tie points.
     SetTiePoints(Vec<TiePoint>),
+    /// Inserts the scene polygon, or replaces the one with the same id in place.
+    PutPolygon { polygon: Polygon, at: Option<usize> },
+    /// Removes a scene polygon.
+    RemovePolygon { id: String },
+    /// Sets a CAD model's placement (translation, rotation about Z, scale).
+    SetModelPlacement { model: String, placement: Placement },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
 }
@@ -71,6 +83,9 @@ impl Command {
             Self::RemoveControlPoint { id } => format!("remove control point {id}"),
             Self::SetOrientation { photo, .. } => format!("orientation of {photo}"),
             Self::SetTiePoints(t) => format!("{} tie points", t.len()),
+            Self::SetModelPlacement { model, .. } => format!("place model {model}"),
+            Self::PutPolygon { polygon, .. } => format!("polygon {}", polygon.id),
+            Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
         }
     }
@@ -171,6 +186,45 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
         }
         Command::SetTiePoints(ties) => {
             Command::SetTiePoints(std::mem::replace(&mut site.tie_points, ties))
+        }
+        Command::PutPolygon { polygon, at } => {
+            match site.polygons.iter().position(|p| p.id == polygon.id) {
+                Some(i) => Command::PutPolygon {
+                    polygon: std::mem::replace(&mut site.polygons[i], polygon),
+                    at: Some(i),
+                },
+                None => {
+                    let inverse = Command::RemovePolygon {
+                        id: polygon.id.clone(),
+                    };
+                    let i = at.map_or(site.polygons.len(), |i| i.min(site.polygons.len()));
+                    site.polygons.insert(i, polygon);
+                    inverse
+                }
+            }
+        }
+        Command::RemovePolygon { id } => {
+            let i = site
+                .polygons
+                .iter()
+                .position(|p| p.id == id)
+                .ok_or(CommandError::NoSuchPolygon { id })?;
+            Command::PutPolygon {
+                polygon: site.polygons.remove(i),
+                at: Some(i),
+            }
+        }
+        Command::SetModelPlacement { model, placement } => {
+            let m = site
+                .models
+                .iter_mut()
+                .find(|m| m.id == model)
+                .ok_or(CommandError::NoSuchModel { id: model.clone() })?;
+            let old = std::mem::replace(&mut m.placement, placement);
+            Command::SetModelPlacement {
+                model,
+                placement: old,
+            }
         }
         Command::Batch(commands) => {
             let mut inverses = Vec::with_capacity(commands.len());

@@ -1,19 +1,24 @@
 //! The photomontage studio: view state and wiring over the `photomontage` library (which does
 //! all computation). [`Studio`] is the whole app, testable headless with egui_kittest: it
 //! opens a site (restoring an autosave sidecar newer than it), shows a photo strip, the photo
-//! view with zoom/pan/loupe, the control-point table, and solves on a worker thread.
+//! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
+//! montage preview ([`render_panel`]), places CAD models with a wireframe overlay
+//! ([`models_panel`]) and builds scene geometry ([`scene_panel`]).
 //!
 //! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
 //!
 //! # Known limitations
-//! Scene building (intersection, polygons), CAD placement and the render preview are not in
-//! this release. Files are chosen by typing a path; there is no native file dialog.
+//! Polygons are not drawn over the photo. Files are chosen by typing a path; there is no native
+//! file dialog.
 
 pub mod autosave;
 pub mod commands;
+pub mod models_panel;
 mod photo_view;
 pub mod points;
+pub mod render_panel;
+pub mod scene_panel;
 pub mod solve;
 pub mod state;
 pub mod viewport;
@@ -62,6 +67,9 @@ pub struct Message {
 enum SideTab {
     Points,
     Solve,
+    Render,
+    Models,
+    Scene,
 }
 
 /// The studio app.
@@ -88,6 +96,9 @@ pub struct Studio {
     open_path: String,
     new_point_id: String,
     pending: Vec<(Command, Option<String>)>,
+    render: render_panel::RenderPanel,
+    models: models_panel::ModelsPanel,
+    scene: scene_panel::ScenePanel,
 }
 
 impl Studio {
@@ -121,6 +132,9 @@ impl Studio {
             open_path: String::new(),
             new_point_id: String::new(),
             pending: Vec::new(),
+            render: render_panel::RenderPanel::default(),
+            models: models_panel::ModelsPanel::default(),
+            scene: scene_panel::ScenePanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -231,7 +245,7 @@ impl Studio {
             Some(PhotoView::Loading) => false,
             None => self.current_photo.is_none(),
         };
-        photo_ready && !self.solver.busy() && !self.loader.busy()
+        photo_ready && !self.solver.busy() && !self.loader.busy() && !self.render.busy()
     }
 
     /// Whether edits are not yet in the autosave sidecar.
@@ -383,6 +397,7 @@ impl Studio {
         if let Some(r) = self.solver.poll() {
             self.finish_solve(r);
         }
+        self.poll_render(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)
@@ -468,7 +483,12 @@ impl Studio {
         egui::Panel::right("side")
             .default_size(560.0)
             .show(ui, |ui| self.side_ui(ui));
-        egui::CentralPanel::default().show(ui, |ui| self.photo_view_ui(ui));
+        // No panel fill: the photo view paints its own background around the photo only (each
+        // full-window fill layer costs ~0.2 s per frame on a CPU rasteriser; docs/benchmarks.md).
+        let frame = egui::Frame::central_panel(ui.style()).fill(Color32::TRANSPARENT);
+        egui::CentralPanel::default()
+            .frame(frame)
+            .show(ui, |ui| self.photo_view_ui(ui));
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
         }
@@ -592,11 +612,17 @@ impl Studio {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut self.tab, SideTab::Points, "Points");
             ui.selectable_value(&mut self.tab, SideTab::Solve, "Results");
+            ui.selectable_value(&mut self.tab, SideTab::Render, "Render");
+            ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
+            ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
         });
         ui.separator();
         match self.tab {
             SideTab::Points => self.points_tab_ui(ui),
             SideTab::Solve => self.solve_tab_ui(ui),
+            SideTab::Render => self.render_tab_ui(ui),
+            SideTab::Models => self.models_tab_ui(ui),
+            SideTab::Scene => self.scene_tab_ui(ui),
         }
     }
 

@@ -14,6 +14,12 @@ use crate::commands::Command;
 use crate::viewport::{self, ViewTransform};
 use crate::{PhotoView, Studio, points, solve};
 
+/// Inner margin of the central panel's frame (`egui::Frame::central_panel`).
+const CENTRAL_MARGIN: f32 = 8.0;
+
+/// Colour around the photo.
+const BACKGROUND: Color32 = Color32::from_gray(20);
+
 impl Studio {
     pub(crate) fn photo_view_ui(&mut self, ui: &mut egui::Ui) {
         let Some(id) = self.current_photo.clone() else {
@@ -21,6 +27,16 @@ impl Studio {
             return;
         };
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        // The central panel has no fill (see `Studio::ui`): paint its margin ring here.
+        let panel = rect.expand(CENTRAL_MARGIN);
+        for band in viewport::outside(panel, rect) {
+            ui.painter()
+                .with_clip_rect(panel)
+                .rect_filled(band, 0.0, ui.visuals().panel_fill);
+        }
+        if !matches!(self.photos.get(&id), Some(PhotoView::Ready(_))) {
+            ui.painter().rect_filled(rect, 0.0, BACKGROUND);
+        }
         let size_px = match self.photos.get(&id) {
             Some(PhotoView::Ready(p)) => p.size_px,
             Some(PhotoView::Failed(e)) => {
@@ -67,13 +83,26 @@ impl Studio {
         self.observation_interaction(&response, &t, &id, space);
 
         let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 0.0, Color32::from_gray(20));
+        // Background only around the photo: overdraw under it costs fill rate on every frame.
+        let photo_rect = t.screen_rect(
+            [-0.5, -0.5],
+            [f64::from(size_px[0]) - 0.5, f64::from(size_px[1]) - 0.5],
+        );
+        for band in viewport::outside(rect, photo_rect) {
+            painter.rect_filled(band, 0.0, BACKGROUND);
+        }
         let ctx = ui.ctx().clone();
         if let Some(PhotoView::Ready(photo)) = self.photos.get_mut(&id)
             && photo.paint(&ctx, &painter, &t)
         {
             ctx.request_repaint();
         }
+        if let Some(doc) = self.doc.as_ref() {
+            let tone_map = crate::render_panel::site_tone_map(doc);
+            self.render
+                .paint(&ctx, &painter, &t, &id, size_px, &tone_map);
+        }
+        self.paint_wireframes(&painter, &t, &id);
         self.paint_marks(&painter, &t, &id);
         if self.ui_state.show_residuals
             && let (Some(sol), Some(doc)) = (&self.solution, &self.doc)

@@ -441,6 +441,28 @@ pub fn paint_loupe(
     );
 }
 
+/// The parts of `outer` not covered by `inner`: up to four bands (top, bottom, left, right).
+#[must_use]
+pub fn outside(outer: Rect, inner: Rect) -> Vec<Rect> {
+    let inner = inner.intersect(outer);
+    if !inner.is_positive() {
+        return vec![outer];
+    }
+    let bands = [
+        Rect::from_min_max(outer.min, Pos2::new(outer.max.x, inner.min.y)),
+        Rect::from_min_max(Pos2::new(outer.min.x, inner.max.y), outer.max),
+        Rect::from_min_max(
+            Pos2::new(outer.min.x, inner.min.y),
+            Pos2::new(inner.min.x, inner.max.y),
+        ),
+        Rect::from_min_max(
+            Pos2::new(inner.max.x, inner.min.y),
+            Pos2::new(outer.max.x, inner.max.y),
+        ),
+    ];
+    bands.into_iter().filter(|r| r.is_positive()).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -503,5 +525,25 @@ mod tests {
         assert_eq!(mip.size, [1250, 550]);
         // Alternate columns 255/0 average to 127 (integer division of 510/4).
         assert_eq!(mip.pixels[0].r(), 127);
+    }
+
+    #[test]
+    fn outside_bands_cover_exactly_the_outer_area_minus_the_inner() {
+        let outer = Rect::from_min_max(Pos2::new(0.0, 0.0), Pos2::new(100.0, 50.0));
+        let inner = Rect::from_min_max(Pos2::new(10.0, 5.0), Pos2::new(60.0, 45.0));
+        let bands = outside(outer, inner);
+        assert_eq!(bands.len(), 4);
+        // Areas are sums of small integers: exact in f32.
+        let area: f32 = bands.iter().map(|r| r.area()).sum();
+        assert_eq!(area.to_bits(), (5000.0f32 - 2000.0).to_bits());
+        for (a, b) in bands.iter().zip(bands.iter().skip(1)) {
+            assert!(!a.intersect(*b).is_positive());
+        }
+        assert!(bands.iter().all(|r| !r.intersect(inner).is_positive()));
+        // A photo covering the view leaves nothing; one outside it leaves the whole view.
+        let cover = Rect::from_min_max(Pos2::new(-5.0, -5.0), Pos2::new(200.0, 90.0));
+        assert!(outside(outer, cover).is_empty());
+        let away = Rect::from_min_max(Pos2::new(300.0, 0.0), Pos2::new(400.0, 50.0));
+        assert_eq!(outside(outer, away), vec![outer]);
     }
 }

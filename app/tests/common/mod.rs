@@ -87,3 +87,36 @@ pub fn click_photo_px(h: &mut Harness<'static, Studio>, p_px: [f64; 2]) {
         .expect("the photo view has been drawn");
     click_at(h, pos);
 }
+
+/// A 2 m cube, corner at the origin (z up), as OBJ.
+pub const BOX_OBJ: &str = "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 2\nv 2 0 2\nv 2 2 2\nv 0 2 2\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+/// The box stands 25 m in front of camera P1 (true centre 2683005, 1246978, 401.6, looking
+/// towards azimuth ≈ 21°), so it covers about 120 px of the 1600 × 1200 photo.
+pub const BOX_MODEL: &str = "\n[[models]]\nid = \"box\"\nfile = \"box.obj\"\nunits = \"m\"\n\
+up_axis = \"z\"\n\n[models.placement]\ntranslation = [2683014.0, 1247001.0, 400.0]\n\
+rotation_z_deg = 0.0\nscale = 1.0\n";
+
+/// Adds the box model ([`BOX_OBJ`], [`BOX_MODEL`]) to the site file `site` (a temp copy).
+pub fn add_box_model(site: &Path) {
+    let dir = site.parent().expect("site dir");
+    std::fs::write(dir.join("box.obj"), BOX_OBJ).expect("write box");
+    let mut text = std::fs::read_to_string(site).expect("read site");
+    text.push_str(BOX_MODEL);
+    std::fs::write(site, text).expect("write site");
+}
+
+/// Steps until `done` holds (workers finish), at most 300 s.
+pub fn step_until(h: &mut Harness<'static, Studio>, what: &str, done: impl Fn(&Studio) -> bool) {
+    let start = Instant::now();
+    while !done(h.state()) {
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "{what} did not finish"
+        );
+    }
+    h.run();
+}
