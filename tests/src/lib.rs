@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+pub mod street;
+
 /// The repository root (the folder holding the workspace `Cargo.toml`).
 #[must_use]
 pub fn repo_root() -> PathBuf {

@@ -11,13 +11,10 @@
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
-use image::Rgb32FImage;
-use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
-use photomontage::site::render::prepare_view;
 use photomontage::site::{SiteDocument, apply_solution, solve_site};
 use photomontage_tests::sample_site;
+use photomontage_tests::street::render_street_view;
 
 /// Box-filter factor (`STREET_RENDER_SCALE` overrides it, e.g. 1 for full size).
 const DEFAULT_SCALE: u32 = 4;
@@ -38,9 +35,6 @@ const SHADOW_MEAN_REL_TOL: f64 = 0.12;
 /// A view is only measured where the masks are big enough to mean something (pixels at 1/4
 /// scale); the building and its shadow are large in every view by construction of generate.py.
 const MIN_MASK_PX: usize = 300;
-/// A pixel is in the building's shadow when the truth is darker than the photo by this factor
-/// (summed RGB), as in `render_mitsuba.rs`.
-const SHADOW_DARKENING: f64 = 0.8;
 
 fn scale() -> u32 {
     std::env::var("STREET_RENDER_SCALE")
@@ -48,76 +42,6 @@ fn scale() -> u32 {
         .and_then(|s| s.parse().ok())
         .filter(|&s| s > 0)
         .unwrap_or(DEFAULT_SCALE)
-}
-
-fn downscale(img: &Rgb32FImage, scale: u32) -> Rgb32FImage {
-    let (w, h) = (img.width() / scale, img.height() / scale);
-    Rgb32FImage::from_fn(w, h, |x, y| {
-        let mut s = [0.0_f64; 3];
-        for dy in 0..scale {
-            for dx in 0..scale {
-                let p = img.get_pixel(x * scale + dx, y * scale + dy).0;
-                for k in 0..3 {
-                    s[k] += f64::from(p[k]);
-                }
-            }
-        }
-        let n = f64::from(scale * scale);
-        #[allow(clippy::cast_possible_truncation)]
-        image::Rgb(s.map(|v| (v / n) as f32))
-    })
-}
-
-fn load_linear(path: &Path) -> Rgb32FImage {
-    photomontage::render::linear_photo(&photomontage::photo::load(path).unwrap())
-}
-
-struct Measured {
-    building_px: usize,
-    building_mre: f64,
-    shadow_px: usize,
-    shadow_mre: f64,
-    rmse: f64,
-    rmse_photo: f64,
-}
-
-fn measure(out: &RenderedImage, truth: &Rgb32FImage, photo: &Rgb32FImage) -> Measured {
-    let (mut b_err, mut b_n, mut s_err, mut s_n, mut sq, mut sq_photo) = (0.0, 0, 0.0, 0, 0.0, 0.0);
-    let rel = |a: [f32; 3], t: [f32; 3]| {
-        (0..3)
-            .map(|k| (f64::from(a[k]) - f64::from(t[k])).abs() / f64::from(t[k]).max(1e-3))
-            .sum::<f64>()
-            / 3.0
-    };
-    let sq_err = |a: [f32; 3], t: [f32; 3]| {
-        (0..3)
-            .map(|k| (f64::from(a[k]) - f64::from(t[k])).powi(2))
-            .sum::<f64>()
-    };
-    let lum = |v: [f32; 3]| v.iter().map(|&c| f64::from(c)).sum::<f64>();
-    for ((o, t), p) in out.rgba.iter().zip(truth.pixels()).zip(photo.pixels()) {
-        let ours = [o[0], o[1], o[2]];
-        sq += sq_err(ours, t.0);
-        sq_photo += sq_err(p.0, t.0);
-        if o[3] >= 1.0 {
-            b_err += rel(ours, t.0);
-            b_n += 1;
-        } else if o[3] <= 0.0 && lum(t.0) < SHADOW_DARKENING * lum(p.0) {
-            s_err += rel(ours, t.0);
-            s_n += 1;
-        }
-    }
-    #[allow(clippy::cast_precision_loss)]
-    let n = (3 * out.rgba.len()) as f64;
-    #[allow(clippy::cast_precision_loss)]
-    Measured {
-        building_px: b_n,
-        building_mre: b_err / b_n.max(1) as f64,
-        shadow_px: s_n,
-        shadow_mre: s_err / s_n.max(1) as f64,
-        rmse: (sq / n).sqrt(),
-        rmse_photo: (sq_photo / n).sqrt(),
-    }
 }
 
 #[test]
@@ -132,31 +56,14 @@ fn street_montage_matches_mitsuba_truth() {
     assert!(ids.len() >= 3);
     let mut results = Vec::new();
     for id in &ids {
-        let mut job = prepare_view(&doc, id).unwrap();
-        let photo = downscale(&job.photo_linear, scale);
-        let truth_full = load_linear(&sample_site("street").join(format!("truth/{id}.png")));
-        let truth = downscale(&truth_full, scale);
-        // The camera of the box-filtered image: pixel centres x' = (x + 0.5) / s − 0.5.
-        let s = f64::from(scale);
-        let k = &mut job.camera.intrinsics;
-        k.focal_px /= s;
-        k.principal_point_px = k.principal_point_px.map(|c| (c + 0.5) / s - 0.5);
-        k.image_size_px = [photo.width(), photo.height()];
-        let tracer = DifferentialTracer::new(
-            &job.scene.scene,
-            &job.lighting,
-            &job.camera,
-            &photo,
-            job.settings.max_depth,
-        )
-        .unwrap();
-        let out = render_view(&tracer, &job.settings, &|_| {}, &AtomicBool::new(false)).unwrap();
+        let view = render_street_view(&doc, id, scale);
+        let (out, photo) = (&view.out, &view.photo);
         if let Some(dir) = std::env::var_os("STREET_RENDER_DUMP") {
             let tone = photomontage::colour::ToneMap::clamp();
             out.write_png(&Path::new(&dir).join(format!("{id}_ours.png")), &tone)
                 .unwrap();
         }
-        let m = measure(&out, &truth, &photo);
+        let m = view.measured;
         println!(
             "street {id} {}x{}: building {} px mean rel err {:.4}; shadow {} px mean rel err {:.4}; \
              RMSE {:.5} (photo vs truth {:.5}); changed px {}",
