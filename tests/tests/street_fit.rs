@@ -46,9 +46,13 @@ const SUN_WEIGHT_TOL: f64 = 0.10;
 /// are all horizontal, so eq. 9 cannot split sky from ambient (the fit warns) and only their sum
 /// is determined. Measured (2026-11-21) −5.0 / −4.3 / +0.2 %; bound a little above.
 const HORIZONTAL_DIFFUSE_TOL: f64 = 0.06;
-/// Montage with the fitted weights: whole-image RMSE vs the truth at most this multiple of the
-/// RMSE with the generator's weights (regression bound; see the printed numbers).
-const MONTAGE_RMSE_RATIO_TOL: f64 = 10.0;
+/// Montage with the (paving) fitted weights: whole-image RMSE vs the truth at most this multiple
+/// of the RMSE with the generator's weights. A regression bound, NOT the acceptance (± 1 %):
+/// measured (2026-11-21) 0.0180 vs 0.0029 (V1), 0.0203 vs 0.0035 (V2), 0.0263 vs 0.0047 (V3),
+/// ratios 6.1 / 5.8 / 5.5 (building mean rel err 24–40 % vs 2–4 %), because the horizontal
+/// samples leave k_h vs k_u undetermined and the fit puts most diffuse light into the isotropic
+/// k_u, over-lighting the building's vertical façades. Still far closer than the photo.
+const MONTAGE_RMSE_RATIO_TOL: f64 = 7.0;
 /// Median window of each sample (pixels): ≈ 0.4 m at 60 m, inside a 1.8 m band.
 const WINDOW_PX: u32 = 7;
 /// The fit must keep at least this many samples (the brief's minimum).
