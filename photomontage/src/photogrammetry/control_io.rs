@@ -189,13 +189,18 @@ pub struct PointsCsv {
     pub rows: Vec<PointRow>,
 }
 
-/// Parses `id,X,Y,Z,x,y[,sigma_px]`; a first row whose X is not a number is a header; blank
-/// lines and lines starting with `#` are skipped.
+/// The data rows of a comma-separated list: blank lines and `#` comments skipped, a first row
+/// whose second field is not a number taken as a header; each row `(line number, trimmed
+/// fields)` with a field count in `field_counts` and a non-empty first field (the id).
 ///
 /// # Errors
-/// `Parse` with the line for a wrong field count, a bad number or σ ≤ 0; `TooManyRows`.
-pub fn parse_points_csv(text: &str) -> Result<PointsCsv, ControlIoError> {
-    let mut rows = Vec::new();
+/// `Parse` naming the line for a wrong field count or an empty id; `TooManyRows`.
+fn csv_records<'a>(
+    text: &'a str,
+    field_counts: std::ops::RangeInclusive<usize>,
+    format: &str,
+) -> Result<Vec<(usize, Vec<&'a str>)>, ControlIoError> {
+    let mut records = Vec::new();
     let mut first = true;
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
@@ -208,16 +213,13 @@ pub fn parse_points_csv(text: &str) -> Result<PointsCsv, ControlIoError> {
         if is_first && fields.get(1).is_some_and(|f| f.parse::<f64>().is_err()) {
             continue; // header
         }
-        if rows.len() >= MAX_ROWS {
+        if records.len() >= MAX_ROWS {
             return Err(ControlIoError::TooManyRows { limit: MAX_ROWS });
         }
-        if !(6..=7).contains(&fields.len()) {
+        if !field_counts.contains(&fields.len()) {
             return Err(ControlIoError::Parse {
                 line,
-                message: format!(
-                    "expected `id,X,Y,Z,x,y[,sigma_px]`, found {} fields",
-                    fields.len()
-                ),
+                message: format!("expected `{format}`, found {} fields", fields.len()),
             });
         }
         if fields[0].is_empty() {
@@ -226,6 +228,19 @@ pub fn parse_points_csv(text: &str) -> Result<PointsCsv, ControlIoError> {
                 message: "empty id".to_owned(),
             });
         }
+        records.push((line, fields));
+    }
+    Ok(records)
+}
+
+/// Parses `id,X,Y,Z,x,y[,sigma_px]`; a first row whose X is not a number is a header; blank
+/// lines and lines starting with `#` are skipped.
+///
+/// # Errors
+/// `Parse` with the line for a wrong field count, a bad number or σ ≤ 0; `TooManyRows`.
+pub fn parse_points_csv(text: &str) -> Result<PointsCsv, ControlIoError> {
+    let mut rows = Vec::new();
+    for (line, fields) in csv_records(text, 6..=7, "id,X,Y,Z,x,y[,sigma_px]")? {
         let sigma_px = match fields.get(6) {
             Some(s) if !s.is_empty() => {
                 let v = number(s, line, "sigma_px")?;
@@ -298,36 +313,7 @@ pub fn parse_control_points_csv(
     default_sigma_m: [f64; 3],
 ) -> Result<Vec<ControlPoint>, ControlIoError> {
     let mut points: Vec<ControlPoint> = Vec::new();
-    let mut first = true;
-    for (index, raw) in text.lines().enumerate() {
-        let line = index + 1;
-        let t = raw.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
-        }
-        let fields: Vec<&str> = t.split(',').map(str::trim).collect();
-        let is_first = std::mem::replace(&mut first, false);
-        if is_first && fields.get(1).is_some_and(|f| f.parse::<f64>().is_err()) {
-            continue; // header
-        }
-        if points.len() >= MAX_ROWS {
-            return Err(ControlIoError::TooManyRows { limit: MAX_ROWS });
-        }
-        if !(4..=5).contains(&fields.len()) {
-            return Err(ControlIoError::Parse {
-                line,
-                message: format!(
-                    "expected `id,X,Y,Z[,sigma_m]`, found {} fields",
-                    fields.len()
-                ),
-            });
-        }
-        if fields[0].is_empty() {
-            return Err(ControlIoError::Parse {
-                line,
-                message: "empty id".to_owned(),
-            });
-        }
+    for (line, fields) in csv_records(text, 4..=5, "id,X,Y,Z[,sigma_m]")? {
         let sigma_m = match fields.get(4) {
             Some(s) if !s.is_empty() => {
                 let v = number(s, line, "sigma_m")?;
