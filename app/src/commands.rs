@@ -12,7 +12,7 @@
 //! the restored edits are kept but can no longer be undone one by one.
 
 use photomontage::site::{
-    ControlPoint, Exterior, Interior, Observation, Placement, Polygon, Site, TiePoint,
+    CadModel, ControlPoint, Exterior, Interior, Observation, Placement, Polygon, Site, TiePoint,
 };
 
 /// What can go wrong applying a command.
@@ -66,6 +66,10 @@ pub enum Command {
     RemovePolygon { id: String },
     /// Sets a CAD model's placement (translation, rotation about Z, scale).
     SetModelPlacement { model: String, placement: Placement },
+    /// Inserts the CAD model, or replaces the one with the same id in place.
+    PutModel { model: CadModel, at: Option<usize> },
+    /// Removes a CAD model.
+    RemoveModel { id: String },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
 }
@@ -85,6 +89,8 @@ impl Command {
             Self::SetTiePoints(t) => format!("{} tie points", t.len()),
             Self::SetModelPlacement { model, .. } => format!("place model {model}"),
             Self::PutPolygon { polygon, .. } => format!("polygon {}", polygon.id),
+            Self::PutModel { model, .. } => format!("model {}", model.id),
+            Self::RemoveModel { id } => format!("remove model {id}"),
             Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
         }
@@ -211,6 +217,33 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
                 .ok_or(CommandError::NoSuchPolygon { id })?;
             Command::PutPolygon {
                 polygon: site.polygons.remove(i),
+                at: Some(i),
+            }
+        }
+        Command::PutModel { model, at } => {
+            match site.models.iter().position(|m| m.id == model.id) {
+                Some(i) => Command::PutModel {
+                    model: std::mem::replace(&mut site.models[i], model),
+                    at: Some(i),
+                },
+                None => {
+                    let inverse = Command::RemoveModel {
+                        id: model.id.clone(),
+                    };
+                    let i = at.map_or(site.models.len(), |i| i.min(site.models.len()));
+                    site.models.insert(i, model);
+                    inverse
+                }
+            }
+        }
+        Command::RemoveModel { id } => {
+            let i = site
+                .models
+                .iter()
+                .position(|m| m.id == id)
+                .ok_or(CommandError::NoSuchModel { id })?;
+            Command::PutModel {
+                model: site.models.remove(i),
                 at: Some(i),
             }
         }
@@ -479,6 +512,38 @@ mod tests {
         ));
         assert_eq!(s, original);
         assert!(!h.can_undo());
+    }
+
+    #[test]
+    fn adding_a_model_undoes_to_the_exact_site() {
+        let original = site();
+        let mut s = original.clone();
+        let mut h = History::default();
+        let model = CadModel {
+            id: "box".into(),
+            file: "box.obj".into(),
+            units: "m".into(),
+            up_axis: "z".into(),
+            placement: Placement::default(),
+            visible: true,
+        };
+        h.apply(
+            &mut s,
+            Command::PutModel {
+                model: model.clone(),
+                at: None,
+            },
+        )
+        .expect("insert");
+        assert_eq!(s.models, vec![model.clone()]);
+        h.undo(&mut s).expect("undo");
+        assert_eq!(s, original);
+        h.redo(&mut s).expect("redo");
+        assert_eq!(s.models, vec![model]);
+        assert!(matches!(
+            apply(&mut s, Command::RemoveModel { id: "nope".into() }),
+            Err(CommandError::NoSuchModel { .. })
+        ));
     }
 
     #[test]

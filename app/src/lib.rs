@@ -2,23 +2,27 @@
 //! all computation). [`Studio`] is the whole app, testable headless with egui_kittest: it
 //! opens a site (restoring an autosave sidecar newer than it), shows a photo strip, the photo
 //! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
-//! montage preview ([`render_panel`]), places CAD models with a wireframe overlay
-//! ([`models_panel`]) and builds scene geometry ([`scene_panel`]).
+//! montage preview progressively ([`render_panel`]), places CAD models with a wireframe overlay
+//! ([`models_panel`]) and builds scene geometry ([`scene_panel`], vertices picked on the photo
+//! with [`scene_pick`]); the File menu opens native dialogs on a worker and lists recent sites
+//! ([`files`]).
 //!
 //! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
 //!
 //! # Known limitations
-//! Polygons are not drawn over the photo. Files are chosen by typing a path; there is no native
-//! file dialog.
+//! See each module's own list. Native file dialogs ([`files`]) cannot be driven by the
+//! headless tests, which use the typed-path fields and a substituted [`files::FilePicker`].
 
 pub mod autosave;
 pub mod commands;
+pub mod files;
 pub mod models_panel;
 mod photo_view;
 pub mod points;
 pub mod render_panel;
 pub mod scene_panel;
+pub mod scene_pick;
 pub mod solve;
 pub mod state;
 pub mod viewport;
@@ -99,6 +103,9 @@ pub struct Studio {
     render: render_panel::RenderPanel,
     models: models_panel::ModelsPanel,
     scene: scene_panel::ScenePanel,
+    dialogs: files::DialogWorker,
+    /// Enter was pressed on the photo in the Scene tab: close the polygon after the frame.
+    close_polygon: bool,
 }
 
 impl Studio {
@@ -135,6 +142,8 @@ impl Studio {
             render: render_panel::RenderPanel::default(),
             models: models_panel::ModelsPanel::default(),
             scene: scene_panel::ScenePanel::default(),
+            dialogs: files::DialogWorker::default(),
+            close_polygon: false,
         };
         s.open(&options.site_path);
         s
@@ -245,7 +254,11 @@ impl Studio {
             Some(PhotoView::Loading) => false,
             None => self.current_photo.is_none(),
         };
-        photo_ready && !self.solver.busy() && !self.loader.busy() && !self.render.busy()
+        photo_ready
+            && !self.solver.busy()
+            && !self.loader.busy()
+            && !self.render.busy()
+            && !self.dialogs.busy()
     }
 
     /// Whether edits are not yet in the autosave sidecar.
@@ -398,6 +411,7 @@ impl Studio {
             self.finish_solve(r);
         }
         self.poll_render(ctx);
+        self.poll_dialogs(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)
@@ -492,6 +506,9 @@ impl Studio {
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
         }
+        if std::mem::take(&mut self.close_polygon) {
+            self.create_polygon();
+        }
         self.autosave_tick(&ctx);
     }
 
@@ -501,6 +518,7 @@ impl Studio {
                 .doc
                 .as_ref()
                 .map_or_else(|| "no site".into(), |d| d.site.name.clone());
+            self.file_menu_ui(ui);
             ui.strong(name);
             ui.separator();
             if ui.button("Save").clicked() {
@@ -541,23 +559,6 @@ impl Studio {
             points::name_widget(ui, &r, "site path");
             if ui.button("Open").clicked() && !self.open_path.trim().is_empty() {
                 let p = PathBuf::from(self.open_path.trim());
-                self.open(&p);
-            }
-            let recent = self.ui_state.recent_sites.clone();
-            let mut chosen = None;
-            egui::ComboBox::from_label("Recent")
-                .selected_text("sites")
-                .show_ui(ui, |ui| {
-                    for p in &recent {
-                        if ui
-                            .selectable_label(false, p.display().to_string())
-                            .clicked()
-                        {
-                            chosen = Some(p.clone());
-                        }
-                    }
-                });
-            if let Some(p) = chosen {
                 self.open(&p);
             }
         });

@@ -10,6 +10,12 @@
 //! and placed here exactly as the importer places it: scale, then rotation about world Z, then
 //! translation.
 //!
+//! **Import model** (typed path or File → Import model…) adds a `[[models]]` entry as one
+//! undoable edit ([`crate::commands::Command::PutModel`]) after importing it once to check that it
+//! reads: id from the file name, path relative to the site file when it lies in the site's
+//! folder, units metres, up axis Y for glTF (its convention) and Z otherwise, placed at the
+//! centroid of the control points so that it lands in the surveyed area.
+//!
 //! # Known limitations
 //! Edges are drawn as straight screen segments between projected vertices (lens distortion
 //! bends the true image of a long edge slightly); edges with an end behind the camera are
@@ -20,6 +26,7 @@ use eframe::egui::{self, Color32};
 use photomontage::site::render::{site_camera, site_scene};
 use photomontage::site::{CadModel, Placement, SiteDocument};
 use std::collections::{HashMap, HashSet};
+use std::path::Path;
 
 use crate::commands::Command;
 
@@ -35,6 +42,8 @@ struct LocalEdges {
 pub struct ModelsPanel {
     /// Draw the wireframe overlay.
     pub show_wireframe: bool,
+    /// Model file path typed by the user (the fallback of File → Import model…).
+    pub model_path: String,
     cache: HashMap<String, Result<LocalEdges, String>>,
 }
 
@@ -50,6 +59,69 @@ pub fn place(p_m: [f64; 3], placement: &Placement) -> [f64; 3] {
     let [x, y, z] = p_m.map(|c| c * placement.scale);
     let [tx, ty, tz] = placement.translation;
     [cos * x - sin * y + tx, sin * x + cos * y + ty, z + tz]
+}
+
+/// The `[[models]]` entry that importing the file `path` into `doc` adds (see the module doc).
+#[must_use]
+pub fn model_entry(doc: &SiteDocument, path: &Path) -> CadModel {
+    let stem: String = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let stem = if stem.is_empty() {
+        "model".into()
+    } else {
+        stem
+    };
+    let taken = |id: &str| doc.site.models.iter().any(|m| m.id == id);
+    let id = (1..)
+        .map(|n| {
+            if n == 1 {
+                stem.clone()
+            } else {
+                format!("{stem}_{n}")
+            }
+        })
+        .find(|id| !taken(id))
+        .unwrap_or(stem);
+    let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let file = std::fs::canonicalize(doc.base_dir())
+        .ok()
+        .and_then(|base| absolute.strip_prefix(base).ok().map(Path::to_path_buf))
+        .unwrap_or(absolute);
+    let gltf = path.extension().is_some_and(|e| {
+        let e = e.to_string_lossy().to_ascii_lowercase();
+        e == "gltf" || e == "glb"
+    });
+    let points = &doc.site.control_points;
+    let mut centroid = [0.0; 3];
+    if !points.is_empty() {
+        for c in points {
+            for k in 0..3 {
+                centroid[k] += c.xyz[k] / points.len() as f64;
+            }
+        }
+    }
+    CadModel {
+        id,
+        file: file.to_string_lossy().into_owned(),
+        units: "m".into(),
+        up_axis: if gltf { "y" } else { "z" }.into(),
+        placement: Placement {
+            translation: centroid,
+            ..Placement::default()
+        },
+        visible: true,
+    }
 }
 
 fn load_edges(doc: &SiteDocument, model: &CadModel) -> Result<LocalEdges, String> {
@@ -139,6 +211,30 @@ impl crate::Studio {
         self.models.wireframe_px(doc, photo_id, model_id)
     }
 
+    /// Adds the CAD model file `path` to the site (one undoable edit) after checking that it
+    /// imports; errors become messages and change nothing.
+    pub fn import_model(&mut self, path: &Path) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let model = model_entry(doc, path);
+        match load_edges(doc, &model) {
+            Ok(edges) => {
+                let text = format!(
+                    "added model {} from {} (placed at the control points' centroid; move it \
+                     in the Models tab)",
+                    model.id,
+                    path.display()
+                );
+                self.models.cache.insert(model.id.clone(), Ok(edges));
+                self.models.show_wireframe = true;
+                self.apply(Command::PutModel { model, at: None }, None);
+                self.say(text, false);
+            }
+            Err(e) => self.say(format!("cannot import {}: {e}", path.display()), true),
+        }
+    }
+
     pub(crate) fn paint_wireframes(
         &mut self,
         painter: &egui::Painter,
@@ -164,6 +260,20 @@ impl crate::Studio {
     pub(crate) fn models_tab_ui(&mut self, ui: &mut egui::Ui) {
         let r = ui.checkbox(&mut self.models.show_wireframe, "wireframe overlay");
         crate::points::name_widget(ui, &r, "wireframe overlay");
+        let mut add = false;
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.models.model_path)
+                    .hint_text("model file (.obj, .gltf, .glb, .dxf)")
+                    .desired_width(260.0),
+            );
+            crate::points::name_widget(ui, &r, "model path");
+            add = ui.button("Add model").clicked();
+        });
+        if add && !self.models.model_path.trim().is_empty() {
+            let path = std::path::PathBuf::from(self.models.model_path.trim());
+            self.import_model(&path);
+        }
         let Some(doc) = self.doc.as_ref() else {
             return;
         };

@@ -80,7 +80,13 @@ impl Studio {
         }
         let t = self.viewport.transform(rect);
         self.last_transform = Some(t);
-        self.observation_interaction(&response, &t, &id, space);
+        if self.tab == crate::SideTab::Scene {
+            if !space {
+                self.vertex_pick_interaction(&response, &t, &id);
+            }
+        } else {
+            self.observation_interaction(&response, &t, &id, space);
+        }
 
         let painter = ui.painter_at(rect);
         // Background only around the photo: overdraw under it costs fill rate on every frame.
@@ -104,6 +110,9 @@ impl Studio {
         }
         self.paint_wireframes(&painter, &t, &id);
         self.paint_marks(&painter, &t, &id);
+        if self.tab == crate::SideTab::Scene {
+            self.paint_scene_overlay(&painter, &t, &id, response.hover_pos());
+        }
         if self.ui_state.show_residuals
             && let (Some(sol), Some(doc)) = (&self.solution, &self.doc)
             && let Some(ps) = sol.photos.iter().find(|p| p.id == id)

@@ -1,17 +1,18 @@
 //! The studio's render preview: renders the current (solved) photo's montage on a worker thread
 //! with the library's own pipeline (`photomontage::site::render::prepare_view` →
 //! `photomontage::render::DifferentialTracer` → `photomontage::render::render_view`, the same
-//! calls as `photomontage render`), shows progress tile by tile over the photo, the finished
-//! montage with an A/B split (photo left, montage right), and exports it through
+//! calls as `photomontage render`), shows the render progressively (each finished tile's pixels,
+//! which the library's tile callback delivers, are blitted into the preview texture with a
+//! partial texture update, over the photo as the renderer sees it), the finished montage with an
+//! A/B split (photo left, montage right), and exports it through
 //! `photomontage::render::output::write_output` (EXR or 8-bit by extension).
 //!
 //! Tone mapping for display and 8-bit export is the site's `render.exposure` with a clamp, as in
 //! the CLI.
 //!
 //! # Known limitations
-//! The library's tile callback reports which tile finished, not its pixels, so during the render
-//! the view shows the finished tiles as outlined regions and a progress bar; the montage's pixels
-//! appear when the whole render is done. The display texture is subsampled to at most
+//! During the render the preview covers the whole photo (the A/B split applies to the finished
+//! montage). The display texture is subsampled (nearest pixel) to at most
 //! [`MAX_DISPLAY_SIDE_PX`] on its long side (export is at full resolution). Spectral mode and the
 //! auxiliary EXR layers are not offered here (use the CLI).
 
@@ -22,7 +23,7 @@ use photomontage::render::{
     DifferentialTracer, OutputLayers, RenderError, RenderedImage, TileProgress, output, render_view,
 };
 use photomontage::site::SiteDocument;
-use photomontage::site::render::prepare_view;
+use photomontage::site::render::{ViewJob, prepare_view};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -83,6 +84,11 @@ pub enum RenderPanelError {
 }
 
 enum WorkerMsg {
+    /// The photo (linear, as the renderer sees it) tone-mapped for display: the preview's base.
+    Photo {
+        size_px: [u32; 2],
+        image: egui::ColorImage,
+    },
     Tile(TileProgress),
     Done(Result<RenderedImage, RenderPanelError>),
 }
@@ -114,6 +120,99 @@ pub struct RenderPanel {
     tiles_done: Vec<TileProgress>,
     tile_count: usize,
     montage: Option<Montage>,
+    preview: Option<Preview>,
+    tone_map: ToneMap,
+}
+
+/// The progressive preview of a running render: the photo's display image with each finished
+/// tile's pixels written in, uploaded to the GPU by partial texture updates.
+pub struct Preview {
+    /// The photo rendered.
+    pub photo_id: String,
+    /// Full-resolution size of the render.
+    pub size_px: [u32; 2],
+    step: u32,
+    image: egui::ColorImage,
+    texture: Option<egui::TextureHandle>,
+    /// Regions changed since the last upload: (display-pixel origin, pixels).
+    dirty: Vec<([usize; 2], egui::ColorImage)>,
+}
+
+impl Preview {
+    /// A preview of `photo_id` (full size `size_px`) starting from `base`, the photo's display
+    /// image made with [`display_rgb`].
+    #[must_use]
+    pub fn new(photo_id: &str, size_px: [u32; 2], base: egui::ColorImage) -> Self {
+        Self {
+            photo_id: photo_id.to_owned(),
+            size_px,
+            step: display_step(size_px),
+            image: base,
+            texture: None,
+            dirty: Vec::new(),
+        }
+    }
+
+    /// The preview's pixels now (display resolution).
+    #[must_use]
+    pub fn image(&self) -> &egui::ColorImage {
+        &self.image
+    }
+
+    /// Writes a finished tile's pixels (tone-mapped with `tone_map`) into the preview and
+    /// queues the changed region for upload.
+    pub fn apply_tile(&mut self, tile: &TileProgress, tone_map: &ToneMap) {
+        let step = self.step;
+        let [x0, y0] = tile.origin_px;
+        let [tw, th] = tile.size_px;
+        if tile.rgb_linear.len() != (tw * th) as usize
+            || x0 + tw > self.size_px[0]
+            || y0 + th > self.size_px[1]
+        {
+            return;
+        }
+        // Display pixels whose sample (d·step) falls inside the tile.
+        let (dx0, dx1) = (x0.div_ceil(step), (x0 + tw).div_ceil(step));
+        let (dy0, dy1) = (y0.div_ceil(step), (y0 + th).div_ceil(step));
+        if dx0 >= dx1 || dy0 >= dy1 {
+            return;
+        }
+        let (dw, dh) = ((dx1 - dx0) as usize, (dy1 - dy0) as usize);
+        let mut pixels = Vec::with_capacity(dw * dh);
+        let width = self.image.size[0];
+        for dy in dy0..dy1 {
+            for dx in dx0..dx1 {
+                let (x, y) = (dx * step - x0, dy * step - y0);
+                let [r, g, b] = encode_srgb8(tile.rgb_linear[(y * tw + x) as usize], tone_map);
+                let c = Color32::from_rgb(r, g, b);
+                if let Some(p) = self.image.pixels.get_mut(dy as usize * width + dx as usize) {
+                    *p = c;
+                }
+                pixels.push(c);
+            }
+        }
+        self.dirty.push((
+            [dx0 as usize, dy0 as usize],
+            egui::ColorImage::new([dw, dh], pixels),
+        ));
+    }
+
+    /// Uploads the changed regions (the whole image the first time) and returns the texture.
+    fn texture(&mut self, ctx: &egui::Context) -> &egui::TextureHandle {
+        let dirty = std::mem::take(&mut self.dirty);
+        if let Some(t) = &mut self.texture {
+            for (pos, img) in dirty {
+                t.set_partial(pos, img, egui::TextureOptions::LINEAR);
+            }
+        }
+        self.texture.get_or_insert_with(|| {
+            ctx.load_texture(
+                format!("preview {}", self.photo_id),
+                self.image.clone(),
+                egui::TextureOptions::LINEAR,
+            )
+        })
+    }
 }
 
 impl Default for RenderPanel {
@@ -126,6 +225,11 @@ impl Default for RenderPanel {
             tiles_done: Vec::new(),
             tile_count: 0,
             montage: None,
+            preview: None,
+            tone_map: ToneMap {
+                exposure_stops: 0.0,
+                curve: ToneCurve::Clamp,
+            },
         }
     }
 }
@@ -151,6 +255,20 @@ pub fn render_photo(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderPanelError> {
+    let job = prepare_photo(doc, photo_id, quality)?;
+    trace_photo(&job, photo_id, on_tile, cancel)
+}
+
+/// Prepares the render of `photo_id` as the panel does (site → scene, lighting, camera,
+/// linear photo; quality override).
+///
+/// # Errors
+/// [`RenderPanelError`] variants `NotSolved`, `BadQuality`, `Prepare`.
+pub fn prepare_photo(
+    doc: &SiteDocument,
+    photo_id: &str,
+    quality: Quality,
+) -> Result<ViewJob, RenderPanelError> {
     let photo = photo_id.to_owned();
     if !doc
         .site
@@ -175,6 +293,20 @@ pub fn render_photo(
     job.settings.min_rays_per_pixel = spp_min;
     job.settings.max_rays_per_pixel = spp_max;
     job.settings.seed = seed;
+    Ok(job)
+}
+
+/// Traces a prepared job, calling `on_tile` per finished tile.
+///
+/// # Errors
+/// [`RenderPanelError`] variants `Prepare`, `Render`, `Cancelled`.
+pub fn trace_photo(
+    job: &ViewJob,
+    photo_id: &str,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<RenderedImage, RenderPanelError> {
+    let photo = photo_id.to_owned();
     let tracer = DifferentialTracer::new(
         &job.scene.scene,
         &job.lighting,
@@ -195,19 +327,59 @@ pub fn render_photo(
     })
 }
 
-fn display_image(image: &RenderedImage, tone_map: &ToneMap) -> egui::ColorImage {
-    let [w, h] = image.size_px;
-    let step = w.max(h).div_ceil(MAX_DISPLAY_SIDE_PX).max(1);
+/// Subsampling step of the display image of a `size_px` render (1 up to
+/// [`MAX_DISPLAY_SIDE_PX`]).
+#[must_use]
+pub fn display_step(size_px: [u32; 2]) -> u32 {
+    size_px[0]
+        .max(size_px[1])
+        .div_ceil(MAX_DISPLAY_SIDE_PX)
+        .max(1)
+}
+
+/// The display image (nearest-pixel subsampled by [`display_step`], sRGB through `tone_map`)
+/// of linear RGB pixels `rgb_at(x, y)` of a `size_px` image.
+#[must_use]
+pub fn display_rgb(
+    size_px: [u32; 2],
+    rgb_at: impl Fn(u32, u32) -> [f32; 3],
+    tone_map: &ToneMap,
+) -> egui::ColorImage {
+    let [w, h] = size_px;
+    let step = display_step(size_px);
     let (dw, dh) = (w.div_ceil(step), h.div_ceil(step));
     let mut pixels = Vec::with_capacity((dw * dh) as usize);
     for y in 0..dh {
         for x in 0..dw {
-            let p = image.rgba[((y * step) * w + x * step) as usize];
-            let [r, g, b] = encode_srgb8([p[0], p[1], p[2]], tone_map);
+            let [r, g, b] = encode_srgb8(rgb_at(x * step, y * step), tone_map);
             pixels.push(Color32::from_rgb(r, g, b));
         }
     }
     egui::ColorImage::new([dw as usize, dh as usize], pixels)
+}
+
+/// The display image of a finished render.
+#[must_use]
+pub fn display_image(image: &RenderedImage, tone_map: &ToneMap) -> egui::ColorImage {
+    let w = image.size_px[0];
+    display_rgb(
+        image.size_px,
+        |x, y| {
+            let p = image.rgba[(y * w + x) as usize];
+            [p[0], p[1], p[2]]
+        },
+        tone_map,
+    )
+}
+
+/// The display image of the (linear) photo a render starts from.
+#[must_use]
+pub fn display_photo(photo_linear: &image::Rgb32FImage, tone_map: &ToneMap) -> egui::ColorImage {
+    display_rgb(
+        [photo_linear.width(), photo_linear.height()],
+        |x, y| photo_linear.get_pixel(x, y).0,
+        tone_map,
+    )
 }
 
 impl RenderPanel {
@@ -227,6 +399,12 @@ impl RenderPanel {
     #[must_use]
     pub fn montage(&self) -> Option<&Montage> {
         self.montage.as_ref()
+    }
+
+    /// The progressive preview of the running (or last) render.
+    #[must_use]
+    pub fn preview(&self) -> Option<&Preview> {
+        self.preview.as_ref()
     }
 
     /// Starts rendering `photo_id` of `doc` on a worker thread.
@@ -258,6 +436,8 @@ impl RenderPanel {
         }
         let (tx, rx): (Sender<WorkerMsg>, Receiver<WorkerMsg>) = channel();
         let cancel = Arc::new(AtomicBool::new(false));
+        self.tone_map = site_tone_map(doc);
+        let tone_map = self.tone_map;
         let (doc, id, quality, ctx) = (doc.clone(), photo_id.to_owned(), self.quality, ctx.clone());
         let flag = Arc::clone(&cancel);
         std::thread::spawn(move || {
@@ -268,12 +448,20 @@ impl RenderPanel {
                 let _ = tile_tx.send(WorkerMsg::Tile(t));
                 tile_ctx.request_repaint();
             };
-            let result = render_photo(&doc, &id, quality, &on_tile, &flag);
+            let result = prepare_photo(&doc, &id, quality).and_then(|job| {
+                let photo = &job.photo_linear;
+                let _ = tx.send(WorkerMsg::Photo {
+                    size_px: [photo.width(), photo.height()],
+                    image: display_photo(photo, &tone_map),
+                });
+                trace_photo(&job, &id, &on_tile, &flag)
+            });
             let _ = tx.send(WorkerMsg::Done(result));
             ctx.request_repaint();
         });
         self.tiles_done.clear();
         self.tile_count = 0;
+        self.preview = None;
         self.worker = Some(Worker {
             photo_id: photo_id.to_owned(),
             cancel,
@@ -295,8 +483,16 @@ impl RenderPanel {
         let mut done = None;
         while let Ok(msg) = worker.rx.try_recv() {
             match msg {
-                WorkerMsg::Tile(t) => {
+                WorkerMsg::Photo { size_px, image } => {
+                    self.preview = Some(Preview::new(&worker.photo_id, size_px, image));
+                }
+                WorkerMsg::Tile(mut t) => {
                     self.tile_count = t.tile_count;
+                    if let Some(p) = self.preview.as_mut() {
+                        p.apply_tile(&t, &self.tone_map);
+                    }
+                    // The pixels are in the preview now; keep the record small.
+                    t.rgb_linear = Vec::new();
                     self.tiles_done.push(t);
                 }
                 WorkerMsg::Done(r) => done = Some(r),
@@ -351,6 +547,16 @@ impl RenderPanel {
         tone_map: &ToneMap,
     ) {
         if self.worker.as_ref().is_some_and(|w| w.photo_id == photo_id) {
+            if let Some(p) = self
+                .preview
+                .as_mut()
+                .filter(|p| p.photo_id == photo_id && p.size_px == size_px)
+            {
+                let [w, h] = size_px.map(f64::from);
+                let rect = t.screen_rect([0.0, 0.0], [w, h]);
+                let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+                painter.image(p.texture(ctx).id(), rect, uv, Color32::WHITE);
+            }
             let stroke = egui::Stroke::new(1.0, Color32::from_rgb(80, 200, 255));
             for tile in &self.tiles_done {
                 let [x, y] = tile.origin_px.map(f64::from);

@@ -1,15 +1,15 @@
 //! The studio's Scene panel (Durisch 1992 §4.1, scene geometry): spatial intersection of a
 //! point observed in two or more solved photos (`photomontage::photogrammetry::intersect`,
 //! least-squares rays with σ XYZ) stored as a tie point, and scene polygons built by picking
-//! their vertex points in order with a material from the site's library. Both edits go through
+//! their vertex points in order (from the list here or by clicking them on the photo,
+//! [`crate::scene_pick`]) with a material from the site's library. Both edits go through
 //! the one command path ([`crate::commands::Command::SetTiePoints`],
 //! [`crate::commands::Command::PutPolygon`]).
 //!
 //! # Known limitations
 //! The intersection takes the stored cameras as error-free (as the library does); the bundle
-//! adjustment of a Solve re-estimates tie points jointly and replaces these values. Vertices are
-//! picked from the point list, not by clicking 3D positions in the photo; polygons are not
-//! drawn over the photo yet.
+//! adjustment of a Solve re-estimates tie points jointly and replaces these values. The vertices
+//! picked so far are view state, not an edit: only closing the polygon is undoable.
 
 use eframe::egui::{self, Color32};
 use photomontage::camera::Camera;
@@ -192,6 +192,7 @@ impl crate::Studio {
         });
         ui.separator();
         ui.strong("Build a polygon: pick its vertices in order");
+        ui.label("click the points on the photo (or in this list); Enter closes the polygon");
         ui.horizontal(|ui| {
             let r = ui.add(
                 egui::TextEdit::singleline(&mut self.scene.polygon_id)

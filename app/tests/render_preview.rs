@@ -2,6 +2,8 @@
 //! an unsolved photo gives a readable message; after Solve, a low-spp render on the worker
 //! equals the library's `render_view` on the same site bit for bit; the A/B split moves the
 //! montage's edge to the photo column it names; EXR and PNG exports read back to the montage.
+//! The progressive preview: after any set of finished tiles it shows the final render inside
+//! those tiles' rects and the photo elsewhere, and after the last tile the whole montage.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -10,8 +12,11 @@ mod common;
 use common::{WINDOW, add_box_model, copy_sample, harness, step_until};
 use egui_kittest::kittest::Queryable;
 use photomontage::colour::encode_srgb8;
+use photomontage::render::TileProgress;
 use photomontage::render::{DifferentialTracer, render_view};
 use photomontage::site::render::prepare_view;
+use photomontage_studio::render_panel::{Preview, display_image, display_photo, site_tone_map};
+use std::sync::Mutex;
 use std::sync::atomic::AtomicBool;
 
 /// Screen positions are f32; the split line is compared to the transform of the same photo
@@ -73,8 +78,24 @@ fn render_preview_matches_the_library_and_exports() {
         job.settings.max_depth,
     )
     .unwrap();
-    let library = render_view(&tracer, &job.settings, &|_| {}, &AtomicBool::new(false)).unwrap();
+    let tiles = Mutex::new(Vec::new());
+    let library = render_view(
+        &tracer,
+        &job.settings,
+        &|t| tiles.lock().unwrap().push(t),
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let tiles = tiles.into_inner().unwrap();
     let montage = &h.state().render_panel().montage().unwrap().image;
+    check_progressive_preview(&doc, &job.photo_linear, &library, &tiles);
+    // The studio's own preview after its last tile is the montage's display image.
+    let tone_map = site_tone_map(&doc);
+    assert!(
+        h.state().render_panel().preview().unwrap().image().pixels
+            == display_image(montage, &tone_map).pixels,
+        "preview after all tiles differs from the montage"
+    );
     assert_eq!(montage.size_px, [1600, 1200]);
     assert!(library.changed_pixels > 1000, "the box is in view");
     let bits = |im: &photomontage::render::RenderedImage| -> Vec<u32> {
@@ -121,4 +142,51 @@ fn render_preview_matches_the_library_and_exports() {
             }
         }
     }
+}
+
+/// The preview after every other tile (in the order they finished) equals the final render's
+/// display pixels inside those tiles and the photo's outside them.
+fn check_progressive_preview(
+    doc: &photomontage::site::SiteDocument,
+    photo_linear: &image::Rgb32FImage,
+    library: &photomontage::render::RenderedImage,
+    tiles: &[TileProgress],
+) {
+    let tone_map = site_tone_map(doc);
+    let size_px = library.size_px;
+    let photo = display_photo(photo_linear, &tone_map);
+    let finished = display_image(library, &tone_map);
+    let mut preview = Preview::new("P1", size_px, photo.clone());
+    let applied: Vec<&TileProgress> = tiles.iter().step_by(2).collect();
+    for t in &applied {
+        preview.apply_tile(t, &tone_map);
+    }
+    // Display step 1 (1600 px < 2048): display pixels are photo pixels.
+    assert_eq!(preview.image().size, [1600, 1200]);
+    let inside = |x: u32, y: u32| {
+        applied.iter().any(|t| {
+            (t.origin_px[0]..t.origin_px[0] + t.size_px[0]).contains(&x)
+                && (t.origin_px[1]..t.origin_px[1] + t.size_px[1]).contains(&y)
+        })
+    };
+    let (mut changed_in, mut changed_out) = (0, 0);
+    for y in 0..size_px[1] {
+        for x in 0..size_px[0] {
+            let k = (y * size_px[0] + x) as usize;
+            let differs = finished.pixels[k] != photo.pixels[k];
+            let want = if inside(x, y) {
+                changed_in += usize::from(differs);
+                finished.pixels[k]
+            } else {
+                changed_out += usize::from(differs);
+                photo.pixels[k]
+            };
+            assert_eq!(preview.image().pixels[k], want, "pixel {x},{y}");
+        }
+    }
+    // Both cases are exercised: the montage differs from the photo inside and outside.
+    assert!(
+        changed_in > 100 && changed_out > 100,
+        "{changed_in} {changed_out}"
+    );
 }

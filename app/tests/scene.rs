@@ -1,15 +1,19 @@
 //! The Scene panel on the courtyard sample: intersecting tie point T1 (observed in all three
 //! photos) after Solve lands within a stated bound of its seeded true position (truth.json) as
 //! one undoable edit; a polygon built by picking four control points in order becomes a natural
-//! scene object of two triangles on exactly those points; undo removes it.
+//! scene object of two triangles on exactly those points; undo removes it. The same polygon
+//! picked by clicking the control points' projected pixels on the photo, closed with Enter,
+//! undone and redone.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 
-use common::{WINDOW, copy_sample, harness, sample_dir, step_until};
+use common::{WINDOW, click_photo_px, copy_sample, harness, sample_dir, step_until};
+use eframe::egui;
 use egui_kittest::kittest::Queryable;
 use photomontage::site::render::{ObjectSource, site_scene};
+use photomontage::site::stored_camera;
 
 /// T1 lies ≈ 40 m from the cameras; σ 0.5 px at f 1500 px is ≈ 0.013 m across each ray, the
 /// 20–40° intersection angles make depth ≈ 2–3× worse, and the solved cameras carry their own
@@ -121,4 +125,65 @@ fn intersect_a_tie_point_and_build_a_polygon_through_the_command_path() {
             .iter()
             .all(|p| p.id != "wall")
     );
+}
+
+#[test]
+fn polygon_vertices_picked_by_clicking_the_photo() {
+    let (_dir, site) = copy_sample();
+    let mut h = harness(&site, WINDOW);
+    h.get_by_label("Solve").click();
+    step_until(&mut h, "solve", |s| s.solution().is_some() && s.is_idle());
+    h.get_by_label("Scene").click();
+    h.run();
+    assert_eq!(h.state().current_photo(), Some("P1"));
+    h.state_mut().scene_panel_mut().polygon_id = "wall".into();
+    h.state_mut().scene_panel_mut().material = "default".into();
+
+    // The projected pixels of the four corners, with the solved camera of P1.
+    let doc = h.state().document().unwrap().clone();
+    let camera = stored_camera(&doc.site, "P1").expect("P1 solved");
+    let order = ["A1", "A2", "A4", "A3"];
+    for id in order {
+        let c = doc.site.control_points.iter().find(|c| c.id == id).unwrap();
+        let p = camera.project(&c.xyz.into()).expect("in front of P1");
+        // A click 2 px (photo) off the projected point: within the pick radius at the fitted
+        // zoom (< 1 screen point), nearest wins.
+        click_photo_px(&mut h, [p.x + 2.0, p.y - 1.0]);
+    }
+    assert_eq!(h.state_mut().scene_panel_mut().vertices, order);
+    // A click far from every point picks nothing.
+    click_photo_px(&mut h, [5.0, 5.0]);
+    assert_eq!(h.state_mut().scene_panel_mut().vertices.len(), 4);
+    assert!(
+        h.state()
+            .document()
+            .unwrap()
+            .site
+            .polygons
+            .iter()
+            .all(|p| p.id != "wall"),
+        "picking is not an edit"
+    );
+
+    h.key_press(egui::Key::Enter);
+    h.run();
+    let wall = |h: &egui_kittest::Harness<'static, photomontage_studio::Studio>| {
+        h.state()
+            .document()
+            .unwrap()
+            .site
+            .polygons
+            .iter()
+            .find(|p| p.id == "wall")
+            .cloned()
+    };
+    let made = wall(&h).unwrap_or_else(|| panic!("wall closed: {:?}", h.state().messages()));
+    assert_eq!(made.vertices, order);
+    assert!(h.state_mut().scene_panel_mut().vertices.is_empty());
+    h.get_by_label("Undo").click();
+    h.run();
+    assert!(wall(&h).is_none(), "undo removes the polygon");
+    h.get_by_label("Redo").click();
+    h.run();
+    assert_eq!(wall(&h).unwrap().vertices, order, "redo restores it");
 }

@@ -39,6 +39,11 @@ pub fn harness(site: &Path, size: [f32; 2]) -> Harness<'static, Studio> {
         site_path: site.to_path_buf(),
         state_path: None,
     });
+    harness_for(studio, size)
+}
+
+/// A harness running `studio` (made by the test, e.g. with a UI state file).
+pub fn harness_for(studio: Studio, size: [f32; 2]) -> Harness<'static, Studio> {
     let mut h = Harness::builder()
         .with_size(egui::vec2(size[0], size[1]))
         .with_max_steps(400)

@@ -122,8 +122,9 @@ impl Default for RenderSettings {
     }
 }
 
-/// A finished tile, reported to the progress callback.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A finished tile, reported to the progress callback with its pixels (so that a viewer can
+/// show the render progressively).
+#[derive(Debug, Clone, PartialEq)]
 pub struct TileProgress {
     /// Index of the tile (row-major).
     pub tile_index: usize,
@@ -133,6 +134,14 @@ pub struct TileProgress {
     pub origin_px: [u32; 2],
     /// Tile width and height.
     pub size_px: [u32; 2],
+    /// The tile's final linear RGB, row-major over the tile rect (`size_px[0] × size_px[1]`
+    /// values): exactly what the finished [`RenderedImage`] holds there.
+    pub rgb_linear: Vec<[f32; 3]>,
+}
+
+/// The RGB of linear RGBA pixels (a tile's pixels for [`TileProgress::rgb_linear`]).
+pub(crate) fn rgb_of(rgba: &[[f32; 4]]) -> Vec<[f32; 3]> {
+    rgba.iter().map(|p| [p[0], p[1], p[2]]).collect()
 }
 
 /// The rendered view.
@@ -243,6 +252,7 @@ pub fn render_view_with_layers(
                 tile_count,
                 origin_px,
                 size_px,
+                rgb_linear: rgb_of(&out.rgba),
             });
             Some(out)
         })

@@ -285,6 +285,7 @@ pub fn render_view_spectral(
                 tile_count,
                 origin_px,
                 size_px,
+                rgb_linear: super::rgb_of(&out.rgba),
             });
             Some(out)
         })

@@ -344,6 +344,46 @@ fn a_mirror_reflects_the_horizon_colour_case_b() {
 }
 
 #[test]
+fn tile_progress_carries_the_final_pixels_of_its_rect() {
+    let scene = site(true);
+    let cam = camera();
+    let photo = uniform_photo(ground_radiance());
+    let tracer = DifferentialTracer::new(&scene, &sun_and_ambient(), &cam, &photo, 1).unwrap();
+    let settings = RenderSettings {
+        tile_size_px: 16,
+        ..RenderSettings::default()
+    };
+    let tiles = Mutex::new(Vec::new());
+    let img = render_view(
+        &tracer,
+        &settings,
+        &|t| tiles.lock().unwrap().push(t),
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let tiles = tiles.into_inner().unwrap();
+    let w = img.size_px[0];
+    let mut covered = 0;
+    for t in &tiles {
+        let [tw, th] = t.size_px;
+        assert_eq!(t.rgb_linear.len(), (tw * th) as usize);
+        for y in 0..th {
+            for x in 0..tw {
+                let full = img.rgba[((t.origin_px[1] + y) * w + t.origin_px[0] + x) as usize];
+                let tile = t.rgb_linear[(y * tw + x) as usize];
+                assert_eq!(
+                    tile.map(f32::to_bits),
+                    [full[0], full[1], full[2]].map(f32::to_bits)
+                );
+                covered += 1;
+            }
+        }
+    }
+    assert_eq!(covered, img.rgba.len(), "the tiles cover the image once");
+    assert!(img.changed_pixels > 0, "the box changes some pixels");
+}
+
+#[test]
 fn one_and_two_threads_give_identical_images_and_every_tile_is_reported() {
     let scene = site(true);
     let dome = crate::sky_dome::durisch_facets::durisch_dome(4).unwrap();
