@@ -163,12 +163,15 @@ fn check_progressive_preview(
     }
     // Display step 1 (1600 px < 2048): display pixels are photo pixels.
     assert_eq!(preview.image().size, [1600, 1200]);
-    let inside = |x: u32, y: u32| {
-        applied.iter().any(|t| {
-            (t.origin_px[0]..t.origin_px[0] + t.size_px[0]).contains(&x)
-                && (t.origin_px[1]..t.origin_px[1] + t.size_px[1]).contains(&y)
-        })
-    };
+    let mut mask = vec![false; (size_px[0] * size_px[1]) as usize];
+    for t in &applied {
+        for y in t.origin_px[1]..t.origin_px[1] + t.size_px[1] {
+            for x in t.origin_px[0]..t.origin_px[0] + t.size_px[0] {
+                mask[(y * size_px[0] + x) as usize] = true;
+            }
+        }
+    }
+    let inside = |x: u32, y: u32| mask[(y * size_px[0] + x) as usize];
     let (mut changed_in, mut changed_out) = (0, 0);
     for y in 0..size_px[1] {
         for x in 0..size_px[0] {
