@@ -101,7 +101,7 @@ impl FilePicker for NativePicker {
     fn pick(&self, request: &DialogRequest) -> Option<PathBuf> {
         let mut dialog = rfd::FileDialog::new().set_title(request.purpose.title());
         for (name, extensions) in request.purpose.filters() {
-            dialog = dialog.add_filter(*name, *extensions);
+            dialog = dialog.add_filter(*name, extensions);
         }
         if let Some(dir) = &request.start_dir {
             dialog = dialog.set_directory(dir);

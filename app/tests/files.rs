@@ -149,7 +149,11 @@ fn recent_sites_typed_path_and_dialogs() {
         .iter()
         .find(|c| c.id == "NEW1")
         .unwrap_or_else(|| panic!("NEW1 imported: {:?}", h.state().messages()));
-    assert_eq!(new.xyz, [2_683_000.0, 1_247_000.0, 400.0]);
+    // Integers in metres parse exactly.
+    assert_eq!(
+        new.xyz.map(f64::to_bits),
+        [2_683_000.0, 1_247_000.0, 400.0].map(f64::to_bits)
+    );
 
     // Import model through the dialog: relative path, metres, Z up, at the control points'
     // centroid; one undoable edit.

@@ -348,7 +348,8 @@ fn tile_progress_carries_the_final_pixels_of_its_rect() {
     let scene = site(true);
     let cam = camera();
     let photo = uniform_photo(ground_radiance());
-    let tracer = DifferentialTracer::new(&scene, &sun_and_ambient(), &cam, &photo, 1).unwrap();
+    let lighting = sun_and_ambient();
+    let tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 1).unwrap();
     let settings = RenderSettings {
         tile_size_px: 16,
         ..RenderSettings::default()
