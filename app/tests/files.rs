@@ -189,6 +189,23 @@ fn recent_sites_typed_path_and_dialogs() {
     h.get_by_label("Undo").click();
     h.run();
     assert!(h.state().document().unwrap().site.models.is_empty());
+    // The typed-path fallback in the Models tab adds the same entry; a file that does not
+    // import adds nothing and says why.
+    h.get_by_label("Models").click();
+    h.run();
+    for (file, added) in [("missing.obj", false), ("my box.obj", true)] {
+        h.get_by_label("model path").click();
+        h.run();
+        h.state_mut().models_panel_mut().model_path = dir.path().join(file).display().to_string();
+        h.get_by_label("Add model").click();
+        h.run();
+        let models = &h.state().document().unwrap().site.models;
+        assert_eq!(models.iter().any(|m| m.id == "my_box"), added, "{file}");
+        if !added {
+            assert!(models.is_empty());
+            assert!(h.state().messages().last().unwrap().is_error);
+        }
+    }
     assert_eq!(
         *picker.asked.lock().unwrap(),
         vec![
