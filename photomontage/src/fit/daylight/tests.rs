@@ -291,6 +291,8 @@ fn synthetic_fit(
                 true_colour_rgb: l0,
                 components: e,
                 normal_in_world: n,
+                diffuse_reflectance_rgb: None,
+                interreflection_rgb: [0.0; 3],
             }
         })
         .collect();
@@ -369,6 +371,8 @@ fn relative_weights_without_the_albedo() {
                 true_colour_rgb: true_colour(&e, t),
                 components: e,
                 normal_in_world: n,
+                diffuse_reflectance_rgb: None,
+                interreflection_rgb: [0.0; 3],
             }
         })
         .collect();
@@ -394,6 +398,8 @@ fn bad_designs_are_errors_or_named_warnings() {
                     true_colour_rgb: true_colour(&e, t),
                     components: e,
                     normal_in_world: *n,
+                    diffuse_reflectance_rgb: None,
+                    interreflection_rgb: [0.0; 3],
                 }
             })
             .collect()
