@@ -103,8 +103,8 @@ pub fn scene_with_probe(natural: &Scene) -> Result<Scene, InterreflectionError> 
 
 /// E_r (linear RGB, photo units) at each point, gathered with its photo's camera and the
 /// lighting `doc` gives that photo (`[lighting]` weights and atmosphere: they shade the surfaces
-/// the photo does not show) over a photo-bounce dome of `bounce_m_h` (4·m_h² facets and their
-/// mirror images). `scene` is [`scene_with_probe`]'s; `photo_linear` returns a photo as linear
+/// the photo does not show, the sky over a dome of `sky_m_h`) over a photo-bounce dome of
+/// `bounce_m_h` (4·m_h² facets and their mirror images). `scene` is [`scene_with_probe`]'s; `photo_linear` returns a photo as linear
 /// RGB by id.
 ///
 /// # Errors
@@ -114,6 +114,7 @@ pub fn gather_interreflection(
     doc: &SiteDocument,
     scene: &Scene,
     points: &[GatherPoint<'_>],
+    sky_m_h: u32,
     bounce_m_h: u32,
     mut photo_linear: impl FnMut(&str) -> Result<Rgb32FImage, String>,
 ) -> Result<Vec<[f64; 3]>, InterreflectionError> {
@@ -121,9 +122,9 @@ pub fn gather_interreflection(
     let mut doc = doc.clone();
     doc.site.luminaires.clear();
     let options = SiteLightingOptions {
+        sky_dome_m_h: sky_m_h,
         photo_bounce_m_h: Some(bounce_m_h),
         photo_bounce_nested_m_h: None,
-        ..SiteLightingOptions::default()
     };
     let mut by_photo: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for (i, p) in points.iter().enumerate() {

@@ -737,6 +737,7 @@ fn run_fits(
                     &gather_doc,
                     probe_scene,
                     &points,
+                    options.sky_m_h,
                     options.interreflection_m_h,
                     |id| photos.get(id).map(crate::render::linear_photo),
                 )
@@ -825,4 +826,4 @@ fn run_fits(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -116,6 +116,9 @@ fn base_site() -> Site {
     site.lighting.time = Some("2024-06-21T10:30:00+02:00".into());
     site.lighting.sky_model = "cie_general:12".into();
     site.lighting.material_library = Some("materials.toml".into());
+    // The photos hold eq. 9's colours without interreflection (the rest of the image is the
+    // horizon colour, not a rendering of the surroundings): eq. 9 as in the paper.
+    site.fit_settings.interreflection = false;
     site.photos.push(Photo {
         id: "P1".into(),
         file: "p1.exr".into(),
@@ -458,7 +461,8 @@ fn bad_samples_are_named() {
         "{:?}",
         r.warnings
     );
-    // A daylight sample on the wall, with the wall's material changed: two materials.
+    // A daylight sample on the wall, with the wall's material changed to one the library does
+    // not have: two materials, one without ρ_d.
     let mut mixed = syn.doc.clone();
     let wall_sample = mixed
         .site
@@ -479,8 +483,9 @@ fn bad_samples_are_named() {
     }
     let err = fit_site(&mixed, &SiteFitOptions::default(), None).unwrap_err();
     assert!(
-        matches!(err, SiteFitError::MixedMaterials { .. })
-            && err.to_string().contains(&format!("`{wall_sample}`")),
+        matches!(err, SiteFitError::NoReflectance { .. })
+            && err.to_string().contains(&format!("`{wall_sample}`"))
+            && err.to_string().contains("`render`"),
         "{err}"
     );
     // Atmosphere samples at one distance.
