@@ -21,12 +21,12 @@ const ACCEPTANCE_REL: f64 = 0.02;
 const SYNTHETIC_SITE_REL: f64 = 1e-3;
 
 const TAU_1KM: [f64; 3] = [0.80, 0.74, 0.62];
-const HORIZON: [f64; 3] = [0.60, 0.68, 0.84];
-const K_S: [f64; 3] = [3.1, 2.9, 2.5];
-const K_U: [f64; 3] = [0.04, 0.045, 0.06];
-const K_H: [f64; 3] = [0.6, 0.7, 0.95];
-const RHO: [f64; 3] = [0.42, 0.38, 0.30];
-const SIZE_PX: [u32; 2] = [400, 300];
+pub(crate) const HORIZON: [f64; 3] = [0.60, 0.68, 0.84];
+pub(crate) const K_S: [f64; 3] = [3.1, 2.9, 2.5];
+pub(crate) const K_U: [f64; 3] = [0.04, 0.045, 0.06];
+pub(crate) const K_H: [f64; 3] = [0.6, 0.7, 0.95];
+pub(crate) const RHO: [f64; 3] = [0.42, 0.38, 0.30];
+pub(crate) const SIZE_PX: [u32; 2] = [400, 300];
 const FOCAL_PX: f64 = 400.0;
 
 fn camera_centre() -> Point3<f64> {
@@ -102,7 +102,7 @@ fn geometry() -> Vec<(&'static str, Vec<[f64; 3]>)> {
     ]
 }
 
-fn base_site() -> Site {
+pub(crate) fn base_site() -> Site {
     let mut site = Site {
         location: Some(Location {
             latitude_deg: 47.37,
