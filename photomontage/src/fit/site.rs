@@ -304,18 +304,28 @@ fn locate_sample(
         )
     })?;
     let mut point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+    let n = hit.hit.normal_geometric;
+    let mut normal = Vector3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2])).normalize();
+    if normal.dot(&dir) > 0.0 {
+        normal = -normal;
+    }
     if let Some(p) = sample.point {
-        let gap = (point - Point3::from(p)).norm();
+        let p = Point3::from(p);
+        let off_plane_m = (p - point).dot(&normal);
         let limit = POINT_ON_POLYGON_M.max(1e-3 * (point - centre).norm());
-        if gap > limit {
+        if off_plane_m.abs() > limit {
             return Err(format!(
                 "the point is not on a polygon visible in photo `{}`: the line of sight meets a \
-                 polygon {gap:.2} m from it",
-                sample.photo
+                 polygon {:.2} m from it",
+                sample.photo,
+                (point - p).norm()
             ));
         }
-        // The given point, not the f32 hit (which a grazing ray moves along the surface).
-        point = Point3::from(p);
+        // The given point moved along the normal onto the polygon's plane: not the f32 hit
+        // (which a grazing ray moves along the surface), and not the point itself (survey noise
+        // puts it up to `limit` behind the surface, where shadow and gather rays would start
+        // inside the object).
+        point = p - normal * off_plane_m;
     }
     let material = scene
         .materials()
@@ -326,11 +336,6 @@ fn locate_sample(
             "lies on a polygon of material `{material}`, not `{}`",
             sample.material
         ));
-    }
-    let n = hit.hit.normal_geometric;
-    let mut normal = Vector3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2])).normalize();
-    if normal.dot(&dir) > 0.0 {
-        normal = -normal;
     }
     let photo = photos.get(&sample.photo)?;
     let read = read_window(photo, [pixel.x, pixel.y], sample.window_px, &options.colour)
