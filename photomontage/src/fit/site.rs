@@ -49,11 +49,13 @@ use crate::sun::SpaParams;
 pub const REPORT_REFERENCE_DISTANCE_M: f64 = 1000.0;
 
 /// Most fits of the interreflection iteration (E_r gathered with the previous pass's weights).
-pub const INTERREFLECTION_MAX_PASSES: usize = 4;
+/// Each pass shrinks the weights' error by the share of E_r that comes from surfaces the photo
+/// does not show (typically ≪ 1/2); a pass costs one gather per sample.
+pub const INTERREFLECTION_MAX_PASSES: usize = 12;
 
 /// The iteration stops when no weight moves by more than this fraction of the largest weight of
-/// its kind: 0.1 %, well below the colour noise of a photo sample.
-pub const INTERREFLECTION_SETTLED_REL: f64 = 1e-3;
+/// its kind: 0.01 %, far below the colour noise of a photo sample.
+pub const INTERREFLECTION_SETTLED_REL: f64 = 1e-4;
 
 /// A world-point sample counts as on the polygon the ray meets when they are this close
 /// (metres), or 0.1 % of the distance when larger: survey and intersection accuracy.

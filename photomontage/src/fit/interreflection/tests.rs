@@ -54,7 +54,7 @@ fn worst_rel(r: &crate::fit::site::SiteFitReport) -> f64 {
 #[test]
 fn weights_of_a_photo_with_interreflection_are_recovered() {
     use crate::render::DifferentialTracer;
-    use crate::scene::{Material, ObjectKind, Scene, SceneObject};
+    use crate::scene::{ObjectKind, Scene, SceneObject};
     use crate::site::render::{SiteLightingOptions, site_lighting};
     let dir = tempfile::tempdir().unwrap();
     let mut site = base_site();
