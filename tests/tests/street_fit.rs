@@ -229,8 +229,7 @@ fn street_daylight_fit_matches_generator() {
     // the site's library (the other materials shade the surfaces the photos do not show).
     let dir = tempfile::tempdir().unwrap();
     let lib_path = dir.path().join("materials.toml");
-    let site_lib =
-        std::fs::read_to_string(sample_site("street").join("materials.toml")).unwrap();
+    let site_lib = std::fs::read_to_string(sample_site("street").join("materials.toml")).unwrap();
     let mut lib = String::new();
     for block in site_lib.split("[[material]]").skip(1) {
         if block.contains("\"paving\"") || block.contains("\"plaster_facade\"") {
@@ -238,8 +237,15 @@ fn street_daylight_fit_matches_generator() {
         }
         write!(lib, "[[material]]{block}").unwrap();
     }
-    for (name, rho) in [("paving", PAVING_ALBEDO), ("plaster_facade", PLASTER_ALBEDO)] {
-        writeln!(lib, "\n[[material]]\nname = \"{name}\"\ndiffuse_rgb = {rho:?}").unwrap();
+    for (name, rho) in [
+        ("paving", PAVING_ALBEDO),
+        ("plaster_facade", PLASTER_ALBEDO),
+    ] {
+        writeln!(
+            lib,
+            "\n[[material]]\nname = \"{name}\"\ndiffuse_rgb = {rho:?}"
+        )
+        .unwrap();
     }
     std::fs::write(&lib_path, lib).unwrap();
     let mut fit_doc = doc.clone();
@@ -294,17 +300,15 @@ fn street_daylight_fit_matches_generator() {
     println!(
         "worst |rel err| with k_u fitted: k_s {:.4}, k_h {:.4}, k_s/k_h {:.4}; without \
          interreflection: k_s {:.4}, k_h {:.4}, k_s/k_h {:.4}",
-        free_worst[0],
-        free_worst[1],
-        free_worst[2],
-        plain_worst[0],
-        plain_worst[1],
-        plain_worst[2]
+        free_worst[0], free_worst[1], free_worst[2], plain_worst[0], plain_worst[1], plain_worst[2]
     );
     assert!(report.samples.len() >= MIN_SAMPLES);
     assert!(!report.weights_relative);
     assert!(
-        report.samples.iter().all(|s| s.interreflection_rgb.is_some()),
+        report
+            .samples
+            .iter()
+            .all(|s| s.interreflection_rgb.is_some()),
         "E_r gathered for every sample"
     );
     for (name, w) in ["k_s", "k_h", "k_s/k_h"].iter().zip(worst) {

@@ -430,7 +430,10 @@ pub fn fit_daylight(
         });
     }
     let n = samples.len();
-    let rho_of = |s: &DaylightSample| s.diffuse_reflectance_rgb.or(options.diffuse_reflectance_rgb);
+    let rho_of = |s: &DaylightSample| {
+        s.diffuse_reflectance_rgb
+            .or(options.diffuse_reflectance_rgb)
+    };
     let relative = match (
         samples.iter().find(|s| rho_of(s).is_none()),
         samples.iter().find(|s| rho_of(s).is_some()),
@@ -600,7 +603,12 @@ pub fn fit_daylight(
     }
     for (name, free) in [
         ("sun", fits.iter().map(|f| f.free[0]).collect::<Vec<_>>()),
-        ("ambient", fits.iter().map(|f| f.free[1] || !options.fit_ambient).collect()),
+        (
+            "ambient",
+            fits.iter()
+                .map(|f| f.free[1] || !options.fit_ambient)
+                .collect(),
+        ),
         ("sky", fits.iter().map(|f| f.free[2]).collect()),
     ] {
         if free.iter().any(|f| !f) {

@@ -91,13 +91,19 @@ pub fn scene_with_probe(natural: &Scene) -> Result<Scene, InterreflectionError> 
     let material = scene
         .add_material(Material::diffuse("probe", [0.0; 3]))
         .map_err(scene_err)?;
-    let c = Point3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), lo.z - PROBE_DEPTH_M);
+    let c = Point3::new(
+        0.5 * (lo.x + hi.x),
+        0.5 * (lo.y + hi.y),
+        lo.z - PROBE_DEPTH_M,
+    );
     let tri = [
         c,
         c + Vector3::new(0.01, 0.0, 0.0),
         c + Vector3::new(0.0, 0.01, 0.0),
     ];
-    scene.add_polygon(&tri, material, object).map_err(scene_err)?;
+    scene
+        .add_polygon(&tri, material, object)
+        .map_err(scene_err)?;
     Ok(scene)
 }
 
@@ -132,11 +138,10 @@ pub fn gather_interreflection(
     }
     let mut out = vec![[0.0; 3]; points.len()];
     for (photo, indices) in by_photo {
-        let camera = stored_camera(&doc.site, photo).ok_or_else(|| {
-            InterreflectionError::NoCamera {
+        let camera =
+            stored_camera(&doc.site, photo).ok_or_else(|| InterreflectionError::NoCamera {
                 photo: photo.to_owned(),
-            }
-        })?;
+            })?;
         let image = photo_linear(photo).map_err(|message| InterreflectionError::Photo {
             photo: photo.to_owned(),
             message,
@@ -167,7 +172,10 @@ pub fn gather_interreflection(
                 let p = &points[i];
                 (
                     i,
-                    tracer.natural_interreflection_irradiance(&p.point_in_world_m, &p.normal_in_world),
+                    tracer.natural_interreflection_irradiance(
+                        &p.point_in_world_m,
+                        &p.normal_in_world,
+                    ),
                 )
             })
             .collect();

@@ -722,7 +722,8 @@ fn run_fits(
         gather_doc.site.lighting.atmosphere.horizon_colour = horizon_colour;
         let probe_scene = if gather {
             Some(
-                scene_with_probe(scene).map_err(|e| SiteFitError::Interreflection(e.to_string()))?,
+                scene_with_probe(scene)
+                    .map_err(|e| SiteFitError::Interreflection(e.to_string()))?,
             )
         } else {
             None
@@ -759,9 +760,7 @@ fn run_fits(
                     source,
                 }
             })?;
-            let settled = previous
-                .as_ref()
-                .is_some_and(|p| weights_settled(p, &fit));
+            let settled = previous.as_ref().is_some_and(|p| weights_settled(p, &fit));
             if !gather || settled || passes >= INTERREFLECTION_MAX_PASSES {
                 if gather && !settled {
                     warnings.push(format!(

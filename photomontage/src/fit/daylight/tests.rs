@@ -507,7 +507,11 @@ fn two_materials_with_interreflection_share_the_weights_exactly() {
     let t = &TRUTH;
     let samples = two_material_samples(5, 25, t.k_u);
     let fit = fit_daylight(&samples, &DaylightFitOptions::default(), None).unwrap();
-    assert!(!fit.relative && fit.flagged.is_empty(), "{:?}", fit.warnings);
+    assert!(
+        !fit.relative && fit.flagged.is_empty(),
+        "{:?}",
+        fit.warnings
+    );
     for k in 0..3 {
         assert!(rel(fit.sun_weight[k], t.k_s[k]) < EXACT_REL, "{fit:?}");
         assert!(rel(fit.ambient_weight[k], t.k_u[k]) < EXACT_REL, "{fit:?}");

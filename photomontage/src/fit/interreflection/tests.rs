@@ -191,13 +191,15 @@ fn weights_of_a_photo_with_interreflection_are_recovered() {
             let e = t.natural_interreflection_irradiance(point, normal);
             largest_e_r = largest_e_r.max(e[0]);
             let d = direct.get_pixel(c[0], c[1]).0;
-            let v = [0, 1, 2]
-                .map(|k| f64::from(d[k]) + rho[k] / std::f64::consts::PI * e[k]);
+            let v = [0, 1, 2].map(|k| f64::from(d[k]) + rho[k] / std::f64::consts::PI * e[k]);
             next.put_pixel(c[0], c[1], Rgb(v.map(|x| x as f32)));
         }
         photo = next;
     }
-    assert!(largest_e_r > 0.1, "the scene has interreflection: {largest_e_r}");
+    assert!(
+        largest_e_r > 0.1,
+        "the scene has interreflection: {largest_e_r}"
+    );
     for (i, (c, _, _, rho)) in picked.iter().enumerate() {
         site.samples.push(Sample {
             id: format!("r{i}"),
@@ -240,7 +242,12 @@ fn weights_of_a_photo_with_interreflection_are_recovered() {
         report.ambient_weight,
         report.sky_weight
     );
-    assert!(report.samples.iter().all(|s| s.interreflection_rgb.is_some()));
+    assert!(
+        report
+            .samples
+            .iter()
+            .all(|s| s.interreflection_rgb.is_some())
+    );
     // The same photo fitted by eq. 9 without E_r.
     let mut plain = doc.clone();
     plain.site.fit_settings.interreflection = false;
