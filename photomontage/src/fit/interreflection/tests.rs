@@ -32,6 +32,9 @@ const RECOVERED_REL: f64 = 1e-3;
 /// weight off by more than 2 %.
 const WITHOUT_MIN_REL: f64 = 0.02;
 
+/// A sample of the test: pixel, located point, normal facing the camera, albedo.
+type Picked = ([u32; 2], Point3<f64>, Vector3<f64>, [f64; 3]);
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
@@ -126,7 +129,7 @@ fn weights_of_a_photo_with_interreflection_are_recovered() {
     // Samples: ground around the box (sun and shadow), the box's south and west faces, the wall.
     let natural_tracer = SceneTracer::new(&natural, crate::bvh::BuildQuality::default()).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(41);
-    let mut picked: Vec<([u32; 2], Point3<f64>, Vector3<f64>, [f64; 3])> = Vec::new();
+    let mut picked: Vec<Picked> = Vec::new();
     while picked.len() < 28 {
         let (p, rho) = match picked.len() % 4 {
             0 => (
