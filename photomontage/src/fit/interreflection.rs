@@ -20,6 +20,7 @@ use image::Rgb32FImage;
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
+use super::daylight::DaylightFit;
 use crate::render::DifferentialTracer;
 use crate::scene::{Material, ObjectKind, Scene, SceneObject};
 use crate::site::SiteDocument;
@@ -29,6 +30,15 @@ use crate::site::stored_camera;
 /// Depth of the probe triangle below the lowest point of the natural scene, metres: far enough
 /// that no surface offset or f32 rounding reaches it, near enough not to widen the tracing frame.
 pub const PROBE_DEPTH_M: f64 = 100.0;
+
+/// Most fits of the interreflection iteration (E_r gathered with the previous pass's weights).
+/// Each pass shrinks the weights' error by the share of E_r that comes from surfaces the photo
+/// does not show (typically ≪ 1/2); a pass costs one gather per sample.
+pub const INTERREFLECTION_MAX_PASSES: usize = 12;
+
+/// The iteration stops when no weight moves by more than this fraction of the largest weight of
+/// its kind: 0.01 %, far below the colour noise of a photo sample.
+pub const INTERREFLECTION_SETTLED_REL: f64 = 1e-4;
 
 /// Errors of the interreflection gather.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -184,6 +194,22 @@ pub fn gather_interreflection(
         }
     }
     Ok(out)
+}
+
+/// Whether every weight of `b` is within [`INTERREFLECTION_SETTLED_REL`] of `a`'s, relative to
+/// the largest weight of its kind.
+#[must_use]
+pub fn weights_settled(a: &DaylightFit, b: &DaylightFit) -> bool {
+    [
+        (a.sun_weight, b.sun_weight),
+        (a.ambient_weight, b.ambient_weight),
+        (a.sky_weight, b.sky_weight),
+    ]
+    .iter()
+    .all(|(x, y)| {
+        let scale = x.iter().chain(y).fold(0.0_f64, |m, v| m.max(v.abs()));
+        (0..3).all(|k| (x[k] - y[k]).abs() <= INTERREFLECTION_SETTLED_REL * scale)
+    })
 }
 
 #[cfg(test)]

@@ -4,6 +4,10 @@
 //! the photo ([`super::colour`]), L∞ taken from the `[[horizon_samples]]`, then the atmosphere
 //! (eq. 7, [`super::atmosphere`]) and the daylight weights (eq. 9, [`super::daylight`]) are
 //! fitted and the `[[sun_shadow_pairs]]` cross-checked against the SPA ([`super::sun_check`]).
+//! Daylight samples of several materials share absolute weights when the library gives every
+//! material's ρ_d; with `[fit_settings] interreflection` the light their photographed
+//! surroundings reflect onto them is gathered ([`super::interreflection`]) and the fit repeated
+//! with the fitted weights until they settle; `[fit_settings] ambient = false` fixes k_u = 0.
 //! [`apply_fit`] writes the result into `[lighting]` and the `[fit]` record; the caller saves the
 //! document (atomically, [`crate::site::SiteDocument::save`]).
 //!
@@ -33,7 +37,10 @@ use super::daylight::{
     DaylightFit, DaylightFitOptions, DaylightSample, fit_daylight, irradiance_components,
     normalised_sky_facets,
 };
-use super::interreflection::{GatherPoint, gather_interreflection, scene_with_probe};
+use super::interreflection::{
+    GatherPoint, INTERREFLECTION_MAX_PASSES, INTERREFLECTION_SETTLED_REL, gather_interreflection,
+    scene_with_probe, weights_settled,
+};
 pub use super::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport, apply_fit};
 use super::sun_check::{DEFAULT_TOLERANCE_DEG, check_sun};
 use crate::atmosphere::{AtmosphereError, schachter::true_radiance};
@@ -47,15 +54,6 @@ use crate::sun::SpaParams;
 /// Reference distance dₐ of the reported transmittance: 1 km, so τₐ reads as "the fraction of
 /// light left after a kilometre" (0.5–0.95 in ordinary haze).
 pub const REPORT_REFERENCE_DISTANCE_M: f64 = 1000.0;
-
-/// Most fits of the interreflection iteration (E_r gathered with the previous pass's weights).
-/// Each pass shrinks the weights' error by the share of E_r that comes from surfaces the photo
-/// does not show (typically ≪ 1/2); a pass costs one gather per sample.
-pub const INTERREFLECTION_MAX_PASSES: usize = 12;
-
-/// The iteration stops when no weight moves by more than this fraction of the largest weight of
-/// its kind: 0.01 %, far below the colour noise of a photo sample.
-pub const INTERREFLECTION_SETTLED_REL: f64 = 1e-4;
 
 /// A world-point sample counts as on the polygon the ray meets when they are this close
 /// (metres), or 0.1 % of the distance when larger: survey and intersection accuracy.
@@ -150,21 +148,6 @@ pub enum SiteFitError {
     /// The interreflection gather failed.
     #[error("interreflection: {0}")]
     Interreflection(String),
-}
-
-/// Whether every weight of `b` is within [`INTERREFLECTION_SETTLED_REL`] of `a`'s, relative to
-/// the largest weight of its kind.
-fn weights_settled(a: &DaylightFit, b: &DaylightFit) -> bool {
-    [
-        (a.sun_weight, b.sun_weight),
-        (a.ambient_weight, b.ambient_weight),
-        (a.sky_weight, b.sky_weight),
-    ]
-    .iter()
-    .all(|(x, y)| {
-        let scale = x.iter().chain(y).fold(0.0_f64, |m, v| m.max(v.abs()));
-        (0..3).all(|k| (x[k] - y[k]).abs() <= INTERREFLECTION_SETTLED_REL * scale)
-    })
 }
 
 /// The natural scene of a site: its polygons with their materials (library definitions where
