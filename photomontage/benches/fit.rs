@@ -104,6 +104,8 @@ fn bench_fit(c: &mut Criterion) {
                 true_colour_rgb: l,
                 components: e,
                 normal_in_world: n,
+                diffuse_reflectance_rgb: None,
+                interreflection_rgb: [0.0; 3],
             }
         })
         .collect();

@@ -1,8 +1,9 @@
-//! The first inversion of the illumination model, Durisch 1992 §4.3 eq. 9:
+//! The first inversion of the illumination model, Durisch 1992 §4.3 eq. 9, extended by the
+//! light the photographed surroundings reflect onto each sample:
 //!
-//! `L₀ᵢ = ρ_d/π · (k_s E_sᵢ + k_u E_uᵢ + k_h E_hᵢ)`,   i = 1…n, n ≥ 3
+//! `L₀ᵢ = ρ_dᵢ/π · (k_s E_sᵢ + k_u E_uᵢ + k_h E_hᵢ + E_rᵢ)`,   i = 1…n, n ≥ 3
 //!
-//! for n samples of one opaque diffuse material under different illumination, their true colours
+//! for n samples of opaque diffuse materials under different illumination, their true colours
 //! L₀ᵢ known from the atmosphere's second inversion (eq. 8). Per sample the *unit* irradiance
 //! components are computed with the scene's visibility ([`irradiance_components`]):
 //! `E_s = max(0, n·d_s)·δ_s` (eq. 3 for a sun of unit normal irradiance, δ_s by an any-hit shadow
@@ -10,10 +11,25 @@
 //! the site's sky model normalised to unit unobstructed horizontal irradiance,
 //! [`normalised_sky_facets`]). With the project's lighting units (k_s normal irradiance of the
 //! sun, k_u ambient radiance, k_h horizontal sky irradiance) the system is linear in
-//! `x = ρ_d/π · (k_s, k_u, k_h)`, solved per channel by non-negative least squares
-//! ([`nnls3`], exact active-set enumeration for three unknowns). As the paper says, ρ_d is known
-//! up to a factor only: the weights are relative (ρ_d = 1 assumed, as Durisch §7 did for grey and
-//! white materials) unless the material library gives ρ_d, when they are absolute.
+//! `k = (k_s, k_u, k_h)`: row i is `ρ_dᵢ/π·(E_sᵢ, π, E_hᵢ)·k = L₀ᵢ − ρ_dᵢ/π·E_rᵢ` (the
+//! residuals stay in true-colour units, so samples of dark and light materials weigh alike),
+//! solved per channel by non-negative least squares ([`nnls3`], exact active-set enumeration for
+//! three unknowns).
+//!
+//! **Reflectance and materials.** When every sample has its material's ρ_d (material library)
+//! the weights are absolute and samples of *several* materials share them: vertical façades see
+//! half the sky and horizontal ground all of it, which separates k_h from the isotropic k_u. When
+//! no sample has ρ_d, the weights are relative as in the paper (ρ_d = 1 assumed, as Durisch §7 did
+//! for grey and white materials; one material only) and E_r is **not** subtracted: E_r is in
+//! absolute photo units, and `ρ_d/π·E_r` cannot be formed without ρ_d.
+//!
+//! **Interreflection** E_rᵢ (photo units, not scaled by the weights) is the irradiance the
+//! photographed natural surfaces reflect onto the sample, gathered by the caller (the renderer's
+//! gather, [`crate::render::DifferentialTracer::natural_interreflection_irradiance`]); without it
+//! the light of sunlit façades and street reaching a shaded sample is absorbed into k_h and k_u.
+//!
+//! **Fixed components**: [`DaylightFitOptions::fit_ambient`] `= false` fixes k_u = 0 (the sky
+//! model then carries all diffuse light).
 //!
 //! **Robustness**: after each fit the sample with the largest normalised residual
 //! `|r|/σ̂` (σ̂ = 1.4826·MAD of the residuals, floored at [`NOISE_FLOOR_REL`] of the signal) is
@@ -22,11 +38,12 @@
 //! from `(AᵀA)⁻¹ s²` over the free weights of the final fit.
 //!
 //! # Known limitations
-//! Diffuse materials only (specular samples bias the result); one material per fit; the sky's
-//! angular distribution is taken from the site's sky model (only its strength is fitted); light
-//! reflected by the surroundings onto the samples is not modelled (it is absorbed into k_u, as in
-//! the paper); sky visibility is sampled at facet centres.
+//! Diffuse materials only (specular samples bias the result); relative weights need one material;
+//! the sky's angular distribution is taken from the site's sky model (only its strength is
+//! fitted); E_r is taken as known (the caller gathers it from the photo with the current
+//! weights for surfaces the photo does not show); sky visibility is sampled at facet centres.
 
+use std::f64::consts::PI;
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector, Point3, Vector3};
@@ -68,6 +85,18 @@ pub enum DaylightError {
     /// The sky model gives no light on a horizontal plane (cannot be normalised).
     #[error("the sky model gives no light on a horizontal plane")]
     DarkSky,
+    /// Some samples have a diffuse reflectance and others not: absolute and relative weights
+    /// cannot be mixed.
+    #[error(
+        "sample `{sample}` has no diffuse reflectance but sample `{other}` has one: give every \
+         sample's material a reflectance, or none"
+    )]
+    MixedReflectance {
+        /// A sample without ρ_d.
+        sample: String,
+        /// A sample with ρ_d.
+        other: String,
+    },
 }
 
 /// A sky facet weighted so that the unobstructed horizontal irradiance of all facets is 1.
@@ -158,7 +187,7 @@ pub fn irradiance_components(
         .sum();
     IrradianceComponents {
         sun,
-        ambient: std::f64::consts::PI,
+        ambient: PI,
         sky: sky_sum,
         sun_visible,
     }
@@ -175,6 +204,12 @@ pub struct DaylightSample {
     pub components: IrradianceComponents,
     /// Unit surface normal, world frame.
     pub normal_in_world: Vector3<f64>,
+    /// The sample's diffuse reflectance ρ_d when known (its material's); `None` falls back to
+    /// [`DaylightFitOptions::diffuse_reflectance_rgb`].
+    pub diffuse_reflectance_rgb: Option<[f64; 3]>,
+    /// E_r: irradiance reflected onto the sample by its surroundings, photo units (not scaled by
+    /// the weights); zeros for eq. 9 as in the paper. Ignored for relative weights.
+    pub interreflection_rgb: [f64; 3],
 }
 
 /// Settings of the daylight fit.
@@ -182,16 +217,20 @@ pub struct DaylightSample {
 pub struct DaylightFitOptions {
     /// Normalised residual above which the worst sample is dropped.
     pub outlier_threshold: f64,
-    /// The material's diffuse reflectance (albedo) when known: absolute weights.
+    /// Diffuse reflectance (albedo) of samples that have none of their own: absolute weights.
     pub diffuse_reflectance_rgb: Option<[f64; 3]>,
+    /// Fit the ambient weight k_u; `false` fixes k_u = 0.
+    pub fit_ambient: bool,
 }
 
 impl Default for DaylightFitOptions {
-    /// Threshold 3.5 (the site's usual outlier threshold), relative weights.
+    /// Threshold 3.5 (the site's usual outlier threshold), relative weights, k_u fitted (as the
+    /// paper).
     fn default() -> Self {
         Self {
             outlier_threshold: 3.5,
             diffuse_reflectance_rgb: None,
+            fit_ambient: true,
         }
     }
 }
@@ -226,6 +265,8 @@ pub struct DaylightFit {
     pub sky_weight_sigma: [Option<f64>; 3],
     /// Whether the weights are relative (ρ_d = 1 assumed) rather than absolute.
     pub relative: bool,
+    /// Whether k_u was fixed at 0 ([`DaylightFitOptions::fit_ambient`] off).
+    pub ambient_fixed: bool,
     /// Residuals of every sample (flagged ones included).
     pub residuals: Vec<SampleResidual>,
     /// Ids of the samples dropped as outliers.
@@ -292,11 +333,18 @@ struct ChannelFit {
     sigma: [Option<f64>; 3],
 }
 
-fn fit_channel(design: &DMatrix<f64>, b: &[f64], active: &[bool]) -> ChannelFit {
+/// NNLS over the columns `fitted` of `design` (the others fixed at 0), rows where `active`.
+fn fit_channel(design: &DMatrix<f64>, b: &[f64], active: &[bool], fitted: &[usize]) -> ChannelFit {
     let rows: Vec<usize> = (0..b.len()).filter(|&i| active[i]).collect();
-    let a = design.select_rows(&rows);
+    let a = design.select_rows(&rows).select_columns(fitted);
     let bv = DVector::from_iterator(rows.len(), rows.iter().map(|&i| b[i]));
-    let (x, free) = nnls3(&a, &bv);
+    let (x_sub, free_sub) = nnls3(&a, &bv);
+    let (mut x, mut free) = (DVector::zeros(3), vec![false; 3]);
+    for (j, &c) in fitted.iter().enumerate() {
+        x[c] = x_sub[j];
+        free[c] = free_sub[j];
+    }
+    let a = design.select_rows(&rows);
     let residuals: Vec<f64> = (0..b.len())
         .map(|i| (design.row(i) * &x)[0] - b[i])
         .collect();
@@ -350,10 +398,11 @@ fn names(samples: &[DaylightSample], pick: impl Fn(&DaylightSample) -> bool) -> 
         .join(", ")
 }
 
-/// Durisch eq. 9 per channel with robust rejection; see the module doc.
+/// Durisch eq. 9 (with E_r) per channel with robust rejection; see the module doc.
 ///
 /// # Errors
-/// Fewer than three samples (before or after rejection) or non-finite input.
+/// Fewer than three samples (before or after rejection), non-finite input, or some samples with
+/// and some without a diffuse reflectance.
 pub fn fit_daylight(
     samples: &[DaylightSample],
     options: &DaylightFitOptions,
@@ -364,6 +413,9 @@ pub fn fit_daylight(
         let c = &s.components;
         if !(s.true_colour_rgb.iter().all(|v| v.is_finite())
             && [c.sun, c.ambient, c.sky].iter().all(|v| v.is_finite())
+            && s.interreflection_rgb.iter().all(|v| v.is_finite())
+            && s.diffuse_reflectance_rgb
+                .is_none_or(|r| r.iter().all(|v| v.is_finite() && *v > 0.0))
             && s.normal_in_world.iter().all(|v| v.is_finite()))
         {
             return Err(DaylightError::NonFinite {
@@ -378,16 +430,52 @@ pub fn fit_daylight(
         });
     }
     let n = samples.len();
-    let design = DMatrix::from_fn(n, 3, |i, c| {
-        let e = &samples[i].components;
-        [e.sun, e.ambient, e.sky][c]
+    let rho_of = |s: &DaylightSample| {
+        s.diffuse_reflectance_rgb
+            .or(options.diffuse_reflectance_rgb)
+    };
+    let relative = match (
+        samples.iter().find(|s| rho_of(s).is_none()),
+        samples.iter().find(|s| rho_of(s).is_some()),
+    ) {
+        (Some(without), Some(with)) => {
+            return Err(DaylightError::MixedReflectance {
+                sample: without.id.clone(),
+                other: with.id.clone(),
+            });
+        }
+        (without, _) => without.is_some(),
+    };
+    // Row i of channel k: ρᵢ/π·(E_s, π, E_h) · k = L₀ᵢ − ρᵢ/π·E_rᵢ (ρ = 1, E_r unused: relative).
+    let rho = |i: usize, k: usize| rho_of(&samples[i]).map_or(1.0, |r| r[k]) / PI;
+    let designs: [DMatrix<f64>; 3] = [0, 1, 2].map(|k| {
+        DMatrix::from_fn(n, 3, |i, c| {
+            let e = &samples[i].components;
+            rho(i, k) * [e.sun, e.ambient, e.sky][c]
+        })
     });
-    let channels: [Vec<f64>; 3] =
-        [0, 1, 2].map(|k| samples.iter().map(|s| s.true_colour_rgb[k]).collect());
+    let channels: [Vec<f64>; 3] = [0, 1, 2].map(|k| {
+        (0..n)
+            .map(|i| {
+                let s = &samples[i];
+                let reflected = if relative {
+                    0.0
+                } else {
+                    rho(i, k) * s.interreflection_rgb[k]
+                };
+                s.true_colour_rgb[k] - reflected
+            })
+            .collect()
+    });
+    let fitted: &[usize] = if options.fit_ambient {
+        &[0, 1, 2]
+    } else {
+        &[0, 2]
+    };
     let mut active = vec![true; n];
     let mut round = 0_u64;
     let fits = loop {
-        let fits = [0, 1, 2].map(|k| fit_channel(&design, &channels[k], &active));
+        let fits = [0, 1, 2].map(|k| fit_channel(&designs[k], &channels[k], &active, fitted));
         if let Some(o) = &observer {
             for (k, f) in fits.iter().enumerate() {
                 let cost = (0..n)
@@ -429,9 +517,6 @@ pub fn fit_daylight(
             found: remaining,
         });
     }
-    // x = ρ/π · k  ⇒  k = π x / ρ.
-    let rho = options.diffuse_reflectance_rgb.unwrap_or([1.0; 3]);
-    let to_weight = |k: usize, v: f64| std::f64::consts::PI * v / rho[k];
     let mut out = DaylightFit {
         sun_weight: [0.0; 3],
         sun_weight_sigma: [None; 3],
@@ -439,18 +524,20 @@ pub fn fit_daylight(
         ambient_weight_sigma: [None; 3],
         sky_weight: [0.0; 3],
         sky_weight_sigma: [None; 3],
-        relative: options.diffuse_reflectance_rgb.is_none(),
+        relative,
+        ambient_fixed: !options.fit_ambient,
         residuals: Vec::with_capacity(n),
         flagged: Vec::new(),
         warnings: Vec::new(),
     };
     for (k, f) in fits.iter().enumerate() {
-        out.sun_weight[k] = to_weight(k, f.x[0]);
-        out.ambient_weight[k] = to_weight(k, f.x[1]);
-        out.sky_weight[k] = to_weight(k, f.x[2]);
-        out.sun_weight_sigma[k] = f.sigma[0].map(|s| to_weight(k, s));
-        out.ambient_weight_sigma[k] = f.sigma[1].map(|s| to_weight(k, s));
-        out.sky_weight_sigma[k] = f.sigma[2].map(|s| to_weight(k, s));
+        // The unknowns are the weights themselves (the rows carry ρ/π).
+        out.sun_weight[k] = f.x[0];
+        out.ambient_weight[k] = f.x[1];
+        out.sky_weight[k] = f.x[2];
+        out.sun_weight_sigma[k] = f.sigma[0];
+        out.ambient_weight_sigma[k] = f.sigma[1];
+        out.sky_weight_sigma[k] = f.sigma[2];
     }
     for (i, s) in samples.iter().enumerate() {
         out.residuals.push(SampleResidual {
@@ -492,9 +579,10 @@ pub fn fit_daylight(
         ));
     }
     let first = kept[0].normal_in_world;
-    if kept
-        .iter()
-        .all(|s| s.normal_in_world.angle(&first) < SAME_ORIENTATION_RAD)
+    if options.fit_ambient
+        && kept
+            .iter()
+            .all(|s| s.normal_in_world.angle(&first) < SAME_ORIENTATION_RAD)
     {
         out.warnings.push(format!(
             "all samples have the same orientation ({}): ambient and sky light cannot be told \
@@ -502,7 +590,10 @@ pub fn fit_daylight(
             names(&kept, |_| true)
         ));
     }
-    let cond = condition_number(&design, &active);
+    let cond = designs
+        .iter()
+        .map(|d| condition_number(&d.select_columns(fitted), &active))
+        .fold(0.0, f64::max);
     if cond > CONDITION_WARNING {
         out.warnings.push(format!(
             "the samples ({}) determine the weights poorly (condition number {cond:.3e}): the \
@@ -512,7 +603,12 @@ pub fn fit_daylight(
     }
     for (name, free) in [
         ("sun", fits.iter().map(|f| f.free[0]).collect::<Vec<_>>()),
-        ("ambient", fits.iter().map(|f| f.free[1]).collect()),
+        (
+            "ambient",
+            fits.iter()
+                .map(|f| f.free[1] || !options.fit_ambient)
+                .collect(),
+        ),
         ("sky", fits.iter().map(|f| f.free[2]).collect()),
     ] {
         if free.iter().any(|f| !f) {

@@ -5,9 +5,11 @@
 //! - [`atmosphere`]: τₐ and L₀ per channel from samples of one material at different distances
 //!   (eq. 7), argmin's Gauss–Newton with a line search on a supplied Jacobian, σ(τₐ) from
 //!   (JᵀJ)⁻¹·s². [`crate::atmosphere::schachter::fit_transmittance`] calls it.
-//! - [`daylight`]: k_s, k_u, k_h per channel from samples of one diffuse material under different
-//!   illumination (eq. 9): the irradiance components E_s, E_u, E_h per sample with the scene's
+//! - [`daylight`]: k_s, k_u, k_h per channel from samples of diffuse materials under different
+//!   illumination (eq. 9, with interreflection; several materials share absolute weights): the irradiance components E_s, E_u, E_h per sample with the scene's
 //!   visibility, non-negative least squares, robust flagging of outlying samples.
+//! - [`interreflection`]: the light the photographed surroundings reflect onto a daylight
+//!   sample (E_r), gathered from its photo as the renderer does, subtracted in eq. 9.
 //! - [`colour`]: a sample's colour read robustly from the photo (median over a window, saturated
 //!   and underexposed pixels rejected), linearised.
 //! - [`sun_check`]: the sun direction measured from an object/shadow pair against the SPA sun for
@@ -26,6 +28,7 @@
 pub mod atmosphere;
 pub mod colour;
 pub mod daylight;
+pub mod interreflection;
 pub mod report;
 pub mod site;
 pub mod sun_check;

@@ -40,6 +40,9 @@ pub struct SampleReading {
     pub apparent_rgb: [f64; 3],
     /// Pixels rejected as saturated / underexposed.
     pub rejected_px: [usize; 2],
+    /// E_r, the irradiance the photographed surroundings reflect onto a daylight sample (linear
+    /// RGB, photo units), when the fit subtracted it.
+    pub interreflection_rgb: Option<[f64; 3]>,
 }
 
 /// A sun cross-check with its pair id.

@@ -4,6 +4,10 @@
 //! the photo ([`super::colour`]), L∞ taken from the `[[horizon_samples]]`, then the atmosphere
 //! (eq. 7, [`super::atmosphere`]) and the daylight weights (eq. 9, [`super::daylight`]) are
 //! fitted and the `[[sun_shadow_pairs]]` cross-checked against the SPA ([`super::sun_check`]).
+//! Daylight samples of several materials share absolute weights when the library gives every
+//! material's ρ_d; with `[fit_settings] interreflection` the light their photographed
+//! surroundings reflect onto them is gathered ([`super::interreflection`]) and the fit repeated
+//! with the fitted weights until they settle; `[fit_settings] ambient = false` fixes k_u = 0.
 //! [`apply_fit`] writes the result into `[lighting]` and the `[fit]` record; the caller saves the
 //! document (atomically, [`crate::site::SiteDocument::save`]).
 //!
@@ -33,6 +37,10 @@ use super::daylight::{
     DaylightFit, DaylightFitOptions, DaylightSample, fit_daylight, irradiance_components,
     normalised_sky_facets,
 };
+use super::interreflection::{
+    GatherPoint, INTERREFLECTION_MAX_PASSES, INTERREFLECTION_SETTLED_REL, gather_interreflection,
+    scene_with_probe, weights_settled,
+};
 pub use super::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport, apply_fit};
 use super::sun_check::{DEFAULT_TOLERANCE_DEG, check_sun};
 use crate::atmosphere::{AtmosphereError, schachter::true_radiance};
@@ -60,15 +68,20 @@ pub struct SiteFitOptions {
     pub sun_tolerance_deg: f64,
     /// Pixel acceptance of the colour reads.
     pub colour: ColourReadOptions,
+    /// m_h of the gather dome of the interreflection term (4·m_h² facets and their mirror
+    /// images), used when `[fit_settings].interreflection` is on.
+    pub interreflection_m_h: u32,
 }
 
 impl Default for SiteFitOptions {
-    /// m_h = 8 (256 facets, the sky term's visibility to ≈ 1 %), 2° sun tolerance.
+    /// m_h = 8 (256 facets, the sky term's visibility to ≈ 1 %), 2° sun tolerance, the
+    /// renderer's photo-bounce dome (m_h = 6) for the interreflection.
     fn default() -> Self {
         Self {
             sky_m_h: 8,
             sun_tolerance_deg: DEFAULT_TOLERANCE_DEG,
             colour: ColourReadOptions::default(),
+            interreflection_m_h: 6,
         }
     }
 }
@@ -85,7 +98,7 @@ pub enum SiteFitError {
     /// The material library could not be read.
     #[error("material library: {0}")]
     MaterialLibrary(String),
-    /// Samples of one fit are on different materials.
+    /// Atmosphere samples are on different materials.
     #[error(
         "{fit} samples must share one material: sample `{sample}` is `{material}`, sample `{first}` is `{expected}`"
     )]
@@ -120,6 +133,21 @@ pub enum SiteFitError {
     /// The sun direction is unknown.
     #[error("sun direction: {0}")]
     Sun(String),
+    /// Daylight samples are on several materials and one has no diffuse reflectance: the
+    /// weights they share are absolute and need every material's ρ_d.
+    #[error(
+        "daylight samples on several materials need each material's diffuse reflectance: sample \
+         `{sample}` is `{material}`, which the material library does not give one"
+    )]
+    NoReflectance {
+        /// The sample.
+        sample: String,
+        /// Its material.
+        material: String,
+    },
+    /// The interreflection gather failed.
+    #[error("interreflection: {0}")]
+    Interreflection(String),
 }
 
 /// The natural scene of a site: its polygons with their materials (library definitions where
@@ -261,18 +289,28 @@ fn locate_sample(
         )
     })?;
     let mut point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+    let n = hit.hit.normal_geometric;
+    let mut normal = Vector3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2])).normalize();
+    if normal.dot(&dir) > 0.0 {
+        normal = -normal;
+    }
     if let Some(p) = sample.point {
-        let gap = (point - Point3::from(p)).norm();
+        let p = Point3::from(p);
+        let off_plane_m = (p - point).dot(&normal);
         let limit = POINT_ON_POLYGON_M.max(1e-3 * (point - centre).norm());
-        if gap > limit {
+        if off_plane_m.abs() > limit {
             return Err(format!(
                 "the point is not on a polygon visible in photo `{}`: the line of sight meets a \
-                 polygon {gap:.2} m from it",
-                sample.photo
+                 polygon {:.2} m from it",
+                sample.photo,
+                (point - p).norm()
             ));
         }
-        // The given point, not the f32 hit (which a grazing ray moves along the surface).
-        point = Point3::from(p);
+        // The given point moved along the normal onto the polygon's plane: not the f32 hit
+        // (which a grazing ray moves along the surface), and not the point itself (survey noise
+        // puts it up to `limit` behind the surface, where shadow and gather rays would start
+        // inside the object).
+        point = p - normal * off_plane_m;
     }
     let material = scene
         .materials()
@@ -283,11 +321,6 @@ fn locate_sample(
             "lies on a polygon of material `{material}`, not `{}`",
             sample.material
         ));
-    }
-    let n = hit.hit.normal_geometric;
-    let mut normal = Vector3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2])).normalize();
-    if normal.dot(&dir) > 0.0 {
-        normal = -normal;
     }
     let photo = photos.get(&sample.photo)?;
     let read = read_window(photo, [pixel.x, pixel.y], sample.window_px, &options.colour)
@@ -371,6 +404,7 @@ pub fn fit_site(
         }
         let mut report = run_fits(
             doc,
+            &scene,
             &located,
             &horizons,
             &mut photos,
@@ -509,6 +543,7 @@ fn sun_checks(
 #[allow(clippy::too_many_lines)]
 fn run_fits(
     doc: &SiteDocument,
+    scene: &Scene,
     located: &[Located],
     horizons: &[&crate::site::HorizonSample],
     photos: &mut Photos<'_>,
@@ -589,11 +624,25 @@ fn run_fits(
         AtmosphereFit::extinction_per_m,
     );
     // Daylight (eq. 9).
+    let mut gathered: HashMap<String, [f64; 3]> = HashMap::new();
     let daylight: Option<DaylightFit> = if day_samples.is_empty() {
         warnings.push("no daylight samples: the weights in [lighting] are kept".into());
         None
     } else {
-        one_material("daylight", &day_samples)?;
+        let rho_of = |s: &Located| {
+            library
+                .and_then(|l| l.get(&s.material))
+                .map(Material::diffuse_reflectance_rgb)
+        };
+        let several = day_samples
+            .iter()
+            .any(|s| s.material != day_samples[0].material);
+        if several && let Some(s) = day_samples.iter().find(|s| rho_of(s).is_none()) {
+            return Err(SiteFitError::NoReflectance {
+                sample: s.id.clone(),
+                material: s.material.clone(),
+            });
+        }
         let model = parse_sky_model(&site.lighting.sky_model)
             .map_err(|e| SiteFitError::Sun(e.to_string()))?;
         let sun_dir = site_sun_dir(doc, &day_samples[0].photo)
@@ -610,7 +659,7 @@ fn run_fits(
                 source,
             }
         })?;
-        let samples: Vec<DaylightSample> = day_samples
+        let mut samples: Vec<DaylightSample> = day_samples
             .iter()
             .map(|s| DaylightSample {
                 id: s.id.clone(),
@@ -632,21 +681,89 @@ fn run_fits(
                     &sky,
                 ),
                 normal_in_world: s.normal,
+                diffuse_reflectance_rgb: rho_of(s),
+                interreflection_rgb: [0.0; 3],
             })
             .collect();
-        let rho = library
-            .and_then(|l| l.get(&day_samples[0].material))
-            .map(Material::diffuse_reflectance_rgb);
         let fit_options = DaylightFitOptions {
             outlier_threshold: site.solve.outlier_threshold_sigma,
-            diffuse_reflectance_rgb: rho,
+            diffuse_reflectance_rgb: None,
+            fit_ambient: site.fit_settings.ambient,
         };
-        let fit = fit_daylight(&samples, &fit_options, observer).map_err(|source| {
-            SiteFitError::Daylight {
-                samples: id_list(&day_samples),
-                source,
+        let absolute = samples.iter().all(|s| s.diffuse_reflectance_rgb.is_some());
+        let gather = site.fit_settings.interreflection && absolute;
+        if site.fit_settings.interreflection && !absolute {
+            warnings.push(
+                "interreflection is not subtracted: it needs the samples' diffuse reflectance"
+                    .into(),
+            );
+        }
+        // E_r depends on the weights only through surfaces the photos do not show (shaded by
+        // their library material): refit with the fitted weights until they settle.
+        let mut gather_doc = doc.clone();
+        gather_doc.site.lighting.atmosphere.extinction_per_m = extinction_per_m;
+        gather_doc.site.lighting.atmosphere.horizon_colour = horizon_colour;
+        let probe_scene = if gather {
+            Some(
+                scene_with_probe(scene)
+                    .map_err(|e| SiteFitError::Interreflection(e.to_string()))?,
+            )
+        } else {
+            None
+        };
+        let mut previous: Option<DaylightFit> = None;
+        let mut passes = 0_usize;
+        let fit = loop {
+            passes += 1;
+            if let Some(probe_scene) = &probe_scene {
+                let points: Vec<GatherPoint<'_>> = day_samples
+                    .iter()
+                    .map(|s| GatherPoint {
+                        photo: &s.photo,
+                        point_in_world_m: s.point,
+                        normal_in_world: s.normal,
+                    })
+                    .collect();
+                let e_r = gather_interreflection(
+                    &gather_doc,
+                    probe_scene,
+                    &points,
+                    options.sky_m_h,
+                    options.interreflection_m_h,
+                    |id| photos.get(id).map(crate::render::linear_photo),
+                )
+                .map_err(|e| SiteFitError::Interreflection(e.to_string()))?;
+                for (s, e) in samples.iter_mut().zip(e_r) {
+                    s.interreflection_rgb = e;
+                }
             }
-        })?;
+            let fit = fit_daylight(&samples, &fit_options, observer.clone()).map_err(|source| {
+                SiteFitError::Daylight {
+                    samples: id_list(&day_samples),
+                    source,
+                }
+            })?;
+            let settled = previous.as_ref().is_some_and(|p| weights_settled(p, &fit));
+            if !gather || settled || passes >= INTERREFLECTION_MAX_PASSES {
+                if gather && !settled {
+                    warnings.push(format!(
+                        "the daylight weights changed by more than {INTERREFLECTION_SETTLED_REL} \
+                         between the last two interreflection passes"
+                    ));
+                }
+                break fit;
+            }
+            let l = &mut gather_doc.site.lighting;
+            l.sun_weight = fit.sun_weight;
+            l.ambient_weight = fit.ambient_weight;
+            l.sky_weight = fit.sky_weight;
+            previous = Some(fit);
+        };
+        if gather {
+            for s in &samples {
+                gathered.insert(s.id.clone(), s.interreflection_rgb);
+            }
+        }
         if fit.relative {
             warnings.push(format!(
                 "material `{}` has no diffuse reflectance in the material library: the weights \
@@ -690,6 +807,7 @@ fn run_fits(
                 distance_m: s.distance_m,
                 apparent_rgb: s.apparent,
                 rejected_px: s.rejected_px,
+                interreflection_rgb: gathered.get(&s.id).copied(),
             })
             .collect(),
         extinction_per_m: atmosphere.as_ref().map(AtmosphereFit::extinction_per_m),
@@ -697,4 +815,4 @@ fn run_fits(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -957,6 +957,22 @@ impl<'a> DifferentialTracer<'a> {
         }
         Some((bilinear(self.photo_linear, pixel), dist))
     }
+
+    /// Irradiance at a natural point (`point_in_world_m`, unit `normal_in_world` on the side
+    /// looked at) from the natural surfaces around it, their radiance taken from the photo (the
+    /// library material shaded by eq. 6 where the photo does not show them), gathered over
+    /// [`Lighting::photo_bounce_dome`] against the natural geometry only: the scene as
+    /// photographed, the term E_r of the daylight fit ([`crate::fit::daylight`]). Zero without a
+    /// dome.
+    #[must_use]
+    pub fn natural_interreflection_irradiance(
+        &self,
+        point_in_world_m: &Point3<f64>,
+        normal_in_world: &Vector3<f64>,
+    ) -> Rgb {
+        let origin = point_in_world_m + normal_in_world * SURFACE_OFFSET_M;
+        self.natural_interreflection(&origin, normal_in_world).0
+    }
 }
 
 /// Bilinear lookup in pixel-centre coordinates, clamped at the borders.

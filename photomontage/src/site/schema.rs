@@ -73,6 +73,9 @@ pub struct Site {
     /// Record of the last lighting fit, written by `fit`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fit: Option<FitRecord>,
+    /// Settings of the lighting fit (`[fit_settings]`).
+    #[serde(default, skip_serializing_if = "FitSettings::is_default")]
+    pub fit_settings: FitSettings,
 }
 
 impl Default for Site {
@@ -95,6 +98,7 @@ impl Default for Site {
             horizon_samples: Vec::new(),
             sun_shadow_pairs: Vec::new(),
             fit: None,
+            fit_settings: FitSettings::default(),
         }
     }
 }
@@ -541,6 +545,37 @@ pub struct SunShadowPair {
     pub shadow_point: String,
     /// The photo whose time is checked.
     pub photo: String,
+}
+
+/// Settings of the daylight fit (`[fit_settings]`; the record of a fit is `[fit]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FitSettings {
+    /// Subtract the light the photographed surroundings reflect onto each daylight sample
+    /// (gathered from its photo) before fitting eq. 9; used only with absolute weights (every
+    /// sample's material has a diffuse reflectance in the library).
+    pub interreflection: bool,
+    /// Fit the ambient weight k_u (Durisch eq. 4); `false` fixes k_u = 0, the sky model then
+    /// carrying all diffuse light.
+    pub ambient: bool,
+}
+
+impl Default for FitSettings {
+    /// Interreflection on, ambient fitted (as the paper).
+    fn default() -> Self {
+        Self {
+            interreflection: true,
+            ambient: true,
+        }
+    }
+}
+
+impl FitSettings {
+    /// Whether these are the defaults (not written to the site file then).
+    #[must_use]
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 /// The record of the last lighting fit (the fitted values themselves go into `[lighting]`).

@@ -291,6 +291,8 @@ fn synthetic_fit(
                 true_colour_rgb: l0,
                 components: e,
                 normal_in_world: n,
+                diffuse_reflectance_rgb: None,
+                interreflection_rgb: [0.0; 3],
             }
         })
         .collect();
@@ -369,6 +371,8 @@ fn relative_weights_without_the_albedo() {
                 true_colour_rgb: true_colour(&e, t),
                 components: e,
                 normal_in_world: n,
+                diffuse_reflectance_rgb: None,
+                interreflection_rgb: [0.0; 3],
             }
         })
         .collect();
@@ -394,6 +398,8 @@ fn bad_designs_are_errors_or_named_warnings() {
                     true_colour_rgb: true_colour(&e, t),
                     components: e,
                     normal_in_world: *n,
+                    diffuse_reflectance_rgb: None,
+                    interreflection_rgb: [0.0; 3],
                 }
             })
             .collect()
@@ -460,6 +466,140 @@ fn bad_designs_are_errors_or_named_warnings() {
         fit_daylight(&bad, &DaylightFitOptions::default(), None),
         Err(DaylightError::NonFinite {
             sample: "q2".into()
+        })
+    );
+}
+
+/// Albedo of the second material of the joint fits (the box and the wall).
+const RHO_B: [f64; 3] = [0.62, 0.56, 0.45];
+
+/// Samples of `daylight_points` with the truth's weights, k_u = `k_u`: ground samples of albedo
+/// `TRUTH.rho`, vertical ones of `RHO_B`, each with a seeded E_r (0.05…0.6, photo units) added as
+/// `ρ/π·E_r`, so the colours follow the extended eq. 9 exactly.
+fn two_material_samples(seed: u64, count: usize, k_u: [f64; 3]) -> Vec<DaylightSample> {
+    let s = test_scene();
+    let t = &TRUTH;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    daylight_points(&mut rng, count)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (p, n))| {
+            let e = irradiance_components(&s.tracer, &p, &n, Some(&s.sun_dir), &s.sky);
+            let rho = if n.z > 0.5 { t.rho } else { RHO_B };
+            let e_r: [f64; 3] = [0, 1, 2].map(|_| rng.random_range(0.05..0.6));
+            DaylightSample {
+                id: format!("m{i}"),
+                true_colour_rgb: [0, 1, 2].map(|k| {
+                    rho[k] / std::f64::consts::PI
+                        * (t.k_s[k] * e.sun + k_u[k] * e.ambient + t.k_h[k] * e.sky + e_r[k])
+                }),
+                components: e,
+                normal_in_world: n,
+                diffuse_reflectance_rgb: Some(rho),
+                interreflection_rgb: e_r,
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn two_materials_with_interreflection_share_the_weights_exactly() {
+    let t = &TRUTH;
+    let samples = two_material_samples(5, 25, t.k_u);
+    let fit = fit_daylight(&samples, &DaylightFitOptions::default(), None).unwrap();
+    assert!(
+        !fit.relative && fit.flagged.is_empty(),
+        "{:?}",
+        fit.warnings
+    );
+    for k in 0..3 {
+        assert!(rel(fit.sun_weight[k], t.k_s[k]) < EXACT_REL, "{fit:?}");
+        assert!(rel(fit.ambient_weight[k], t.k_u[k]) < EXACT_REL, "{fit:?}");
+        assert!(rel(fit.sky_weight[k], t.k_h[k]) < EXACT_REL, "{fit:?}");
+    }
+    // Without E_r the same colours need more diffuse light: k_u and k_h are no longer the truth.
+    let ignored: Vec<DaylightSample> = samples
+        .iter()
+        .map(|s| DaylightSample {
+            interreflection_rgb: [0.0; 3],
+            ..s.clone()
+        })
+        .collect();
+    let biased = fit_daylight(&ignored, &DaylightFitOptions::default(), None).unwrap();
+    assert!(biased.ambient_weight[0] > t.k_u[0] * 1.5, "{biased:?}");
+}
+
+#[test]
+fn horizontal_samples_of_two_materials_do_not_split_sky_from_ambient_but_fixed_ambient_does() {
+    let t = &TRUTH;
+    let no_ambient = [0.0; 3];
+    let horizontal: Vec<DaylightSample> = two_material_samples(6, 40, no_ambient)
+        .into_iter()
+        .filter(|s| s.normal_in_world.z > 0.5)
+        .enumerate()
+        // Half of them painted in the second material: the reflectance alone adds no equation.
+        .map(|(i, mut s)| {
+            if i % 2 == 1 {
+                s.true_colour_rgb = [0, 1, 2].map(|k| s.true_colour_rgb[k] / t.rho[k] * RHO_B[k]);
+                s.diffuse_reflectance_rgb = Some(RHO_B);
+            }
+            s
+        })
+        .collect();
+    assert!(horizontal.len() >= 8);
+    let fit = fit_daylight(&horizontal, &DaylightFitOptions::default(), None).unwrap();
+    assert!(
+        fit.warnings.iter().any(|w| w.contains("same orientation")),
+        "{:?}",
+        fit.warnings
+    );
+    let fixed = DaylightFitOptions {
+        fit_ambient: false,
+        ..DaylightFitOptions::default()
+    };
+    let fit = fit_daylight(&horizontal, &fixed, None).unwrap();
+    assert!(fit.ambient_fixed && fit.ambient_weight.iter().all(|k| *k == 0.0));
+    assert!(fit.ambient_weight_sigma.iter().all(Option::is_none));
+    assert!(
+        !fit.warnings
+            .iter()
+            .any(|w| w.contains("same orientation") || w.contains("ambient weight")),
+        "{:?}",
+        fit.warnings
+    );
+    for k in 0..3 {
+        assert!(rel(fit.sun_weight[k], t.k_s[k]) < EXACT_REL, "{fit:?}");
+        assert!(rel(fit.sky_weight[k], t.k_h[k]) < EXACT_REL, "{fit:?}");
+    }
+}
+
+#[test]
+fn relative_weights_ignore_interreflection_and_reflectance_cannot_be_mixed() {
+    let mut samples = two_material_samples(7, 15, TRUTH.k_u);
+    // Relative: no sample has ρ_d; E_r is not subtracted (zeroing it changes nothing).
+    for s in &mut samples {
+        s.diffuse_reflectance_rgb = None;
+    }
+    let with = fit_daylight(&samples, &DaylightFitOptions::default(), None).unwrap();
+    let zeroed: Vec<DaylightSample> = samples
+        .iter()
+        .map(|s| DaylightSample {
+            interreflection_rgb: [0.0; 3],
+            ..s.clone()
+        })
+        .collect();
+    let without = fit_daylight(&zeroed, &DaylightFitOptions::default(), None).unwrap();
+    assert!(with.relative);
+    let bits = |v: [f64; 3]| v.map(f64::to_bits);
+    assert_eq!(bits(with.sun_weight), bits(without.sun_weight));
+    assert_eq!(bits(with.sky_weight), bits(without.sky_weight));
+    // One sample with ρ_d among samples without.
+    samples[4].diffuse_reflectance_rgb = Some(RHO_B);
+    assert_eq!(
+        fit_daylight(&samples, &DaylightFitOptions::default(), None),
+        Err(DaylightError::MixedReflectance {
+            sample: "m0".into(),
+            other: "m4".into()
         })
     );
 }

@@ -21,12 +21,12 @@ const ACCEPTANCE_REL: f64 = 0.02;
 const SYNTHETIC_SITE_REL: f64 = 1e-3;
 
 const TAU_1KM: [f64; 3] = [0.80, 0.74, 0.62];
-const HORIZON: [f64; 3] = [0.60, 0.68, 0.84];
-const K_S: [f64; 3] = [3.1, 2.9, 2.5];
-const K_U: [f64; 3] = [0.04, 0.045, 0.06];
-const K_H: [f64; 3] = [0.6, 0.7, 0.95];
-const RHO: [f64; 3] = [0.42, 0.38, 0.30];
-const SIZE_PX: [u32; 2] = [400, 300];
+pub(crate) const HORIZON: [f64; 3] = [0.60, 0.68, 0.84];
+pub(crate) const K_S: [f64; 3] = [3.1, 2.9, 2.5];
+pub(crate) const K_U: [f64; 3] = [0.04, 0.045, 0.06];
+pub(crate) const K_H: [f64; 3] = [0.6, 0.7, 0.95];
+pub(crate) const RHO: [f64; 3] = [0.42, 0.38, 0.30];
+pub(crate) const SIZE_PX: [u32; 2] = [400, 300];
 const FOCAL_PX: f64 = 400.0;
 
 fn camera_centre() -> Point3<f64> {
@@ -102,7 +102,7 @@ fn geometry() -> Vec<(&'static str, Vec<[f64; 3]>)> {
     ]
 }
 
-fn base_site() -> Site {
+pub(crate) fn base_site() -> Site {
     let mut site = Site {
         location: Some(Location {
             latitude_deg: 47.37,
@@ -116,6 +116,9 @@ fn base_site() -> Site {
     site.lighting.time = Some("2024-06-21T10:30:00+02:00".into());
     site.lighting.sky_model = "cie_general:12".into();
     site.lighting.material_library = Some("materials.toml".into());
+    // The photos hold eq. 9's colours without interreflection (the rest of the image is the
+    // horizon colour, not a rendering of the surroundings): eq. 9 as in the paper.
+    site.fit_settings.interreflection = false;
     site.photos.push(Photo {
         id: "P1".into(),
         file: "p1.exr".into(),
@@ -458,7 +461,8 @@ fn bad_samples_are_named() {
         "{:?}",
         r.warnings
     );
-    // A daylight sample on the wall, with the wall's material changed: two materials.
+    // A daylight sample on the wall, with the wall's material changed to one the library does
+    // not have: two materials, one without ρ_d.
     let mut mixed = syn.doc.clone();
     let wall_sample = mixed
         .site
@@ -479,8 +483,9 @@ fn bad_samples_are_named() {
     }
     let err = fit_site(&mixed, &SiteFitOptions::default(), None).unwrap_err();
     assert!(
-        matches!(err, SiteFitError::MixedMaterials { .. })
-            && err.to_string().contains(&format!("`{wall_sample}`")),
+        matches!(err, SiteFitError::NoReflectance { .. })
+            && err.to_string().contains(&format!("`{wall_sample}`"))
+            && err.to_string().contains("`render`"),
         "{err}"
     );
     // Atmosphere samples at one distance.
