@@ -5,7 +5,8 @@
 //! nested gather of their own) is far dearer than the rest of a ray sample, and the irradiance it
 //! returns varies slowly over a surface: it changes on the scale of the distance to the geometry
 //! the gather rays hit. Ward's cache stores each computed irradiance as a **record** (point,
-//! normal, value, validity radius R = harmonic mean distance of the gather rays' hits) and
+//! normal, value, validity radius R = harmonic mean distance of the gather rays' hits, misses
+//! left out) and
 //! answers a later gather at point p with normal n from the records whose error estimate
 //! (Ward 1988 eq. 3, the `ε_i = ‖p − p_i‖ / R_i + √(1 − n·n_i)` form)
 //! is below the accuracy `a`, weighted `w_i = 1 − ε_i / a` (the smooth weight of Tabellion &
@@ -41,16 +42,16 @@ use nalgebra::{Point3, Vector3};
 use super::illumination::Rgb;
 
 /// Ward's accuracy `a`: a record answers for points whose error estimate `ε` is below it.
-/// 0.25 keeps the interpolated irradiance within a few per cent of a fresh gather in the
+/// 0.2 keeps the interpolated irradiance within a few per cent of a fresh gather in the
 /// accuracy scenes (Ward 1988 used 0.1–0.2 for final frames of indoor scenes with far more
 /// variation in the indirect light than a one-bounce outdoor gather).
-pub const DEFAULT_ACCURACY: f64 = 0.25;
+pub const DEFAULT_ACCURACY: f64 = 0.2;
 
-/// Smallest validity radius, pixel footprints at the record's distance: `a·R_min` = 0.5 px, so
+/// Smallest validity radius, pixel footprints at the record's distance: `a·R_min` = 0.4 px, so
 /// near contact edges almost every pixel gathers afresh (the smoothing stays below a pixel).
 pub const DEFAULT_MIN_RADIUS_PX: f64 = 2.0;
 
-/// Largest validity radius, pixel footprints: `a·R_max` = 12 px reach in open areas, where bounce
+/// Largest validity radius, pixel footprints: `a·R_max` ≈ 10 px reach in open areas, where bounce
 /// light from surfaces metres away is smooth over many pixels; a 32-px tile then needs a few
 /// dozen gathers instead of thousands.
 pub const DEFAULT_MAX_RADIUS_PX: f64 = 48.0;
@@ -101,7 +102,10 @@ pub(super) enum GatherKind {
 
 const KINDS: usize = 3;
 
-/// Harmonic mean of the hit distances of a gather's rays (a miss counts as infinitely far).
+/// Harmonic mean of the hit distances of a gather's rays that hit something. Misses are left
+/// out (Radiance counts them as infinitely far): outdoors most gather rays escape to the sky, and
+/// counting them would stretch the radius of a point a metre from a wall to several metres,
+/// while the wall's share of its irradiance changes on the scale of that metre.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(super) struct MeanDistance {
     inverse_sum_per_m: f64,
@@ -109,10 +113,10 @@ pub(super) struct MeanDistance {
 }
 
 impl MeanDistance {
-    /// Counts one traced ray that hit at `distance_m` (`f64::INFINITY` for a miss).
+    /// Counts one traced ray that hit at `distance_m` (`f64::INFINITY` for a miss, not counted).
     pub(super) fn add(&mut self, distance_m: f64) {
-        self.count += 1;
         if distance_m.is_finite() && distance_m > 0.0 {
+            self.count += 1;
             self.inverse_sum_per_m += 1.0 / distance_m;
         }
     }
@@ -368,13 +372,13 @@ mod tests {
     }
 
     #[test]
-    fn harmonic_mean_of_hits_counts_misses_as_far() {
+    fn harmonic_mean_of_hits_leaves_misses_out() {
         let mut d = MeanDistance::default();
         d.add(1.0);
         d.add(3.0);
         d.add(f64::INFINITY);
-        // 3 / (1 + 1/3) = 2.25 m.
-        assert!((d.harmonic_mean_m() - 2.25).abs() <= 1e-12);
+        // 2 / (1 + 1/3) = 1.5 m.
+        assert!((d.harmonic_mean_m() - 1.5).abs() <= 1e-12);
         assert!(MeanDistance::default().harmonic_mean_m().is_infinite());
     }
 }
