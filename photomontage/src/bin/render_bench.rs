@@ -202,7 +202,15 @@ fn main() -> Result<()> {
     );
     println!(
         "{:>5} {:>7} {:>7} {:>9} {:>10} {:>12} {:>9} {:>11} {:>9}",
-        "cache", "threads", "spp", "setup s", "render s", "render CPU s", "rays/px", "changed px", "RMSE"
+        "cache",
+        "threads",
+        "spp",
+        "setup s",
+        "render s",
+        "render CPU s",
+        "rays/px",
+        "changed px",
+        "RMSE"
     );
     let caches = args
         .cache

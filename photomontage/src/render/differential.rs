@@ -30,7 +30,10 @@
 //! geometry (part of the natural irradiance that the eq. 10 inversion divides by: without it a
 //! point in a street lit by sunny façades gets too high an albedo and its new shadow comes out
 //! too dark) and once against all geometry with the sun removed where only artificial objects
-//! block it; the difference is added like D1/D3.
+//! block it; the difference is added like D1/D3. Inside a render these gathers go through the
+//! tile's irradiance cache ([`super::irradiance_cache`], Ward 1988): a gather runs once per small
+//! surface region and nearby ray samples interpolate its records
+//! ([`DifferentialTracer::set_irradiance_cache`] turns it off).
 //!
 //! Because eq. 2 is affine in L₀, the apparent colour of a changed natural point is computed as
 //! `L_photo + τ(d)·ΔL₀`: an unchanged point returns the photo value unaltered, bit for bit.

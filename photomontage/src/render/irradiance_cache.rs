@@ -240,7 +240,7 @@ pub(super) fn cached_gather(
     };
     // Computed without holding the cache: the gather may itself look up nested records.
     let (value, distance) = compute();
-    if !in_scope || !(footprint_m.is_finite() && footprint_m > 0.0) {
+    if !(in_scope && footprint_m.is_finite() && footprint_m > 0.0) {
         return value;
     }
     let radius_m = distance.harmonic_mean_m().clamp(
@@ -323,10 +323,16 @@ mod tests {
         assert!((first[0][0]).abs() <= EXACT);
         // R = 1 m clamped to the largest radius (48 footprints = 0.48 m).
         let r_m = DEFAULT_MAX_RADIUS_PX * footprint();
-        let near = gather_at(&Point3::new(0.5 * DEFAULT_ACCURACY * r_m, 0.0, 0.0), &mut calls);
+        let near = gather_at(
+            &Point3::new(0.5 * DEFAULT_ACCURACY * r_m, 0.0, 0.0),
+            &mut calls,
+        );
         assert_eq!(calls, 1, "a point within reach reuses the record");
         assert!(near[0][0].abs() <= EXACT, "one record: its value");
-        let _far = gather_at(&Point3::new(2.0 * DEFAULT_ACCURACY * r_m, 0.0, 0.0), &mut calls);
+        let _far = gather_at(
+            &Point3::new(2.0 * DEFAULT_ACCURACY * r_m, 0.0, 0.0),
+            &mut calls,
+        );
         assert_eq!(calls, 2, "a point beyond reach gathers afresh");
     }
 
@@ -368,7 +374,10 @@ mod tests {
         run(Vector3::x(), 1);
         run(Vector3::z(), 2);
         run(Vector3::z(), 1);
-        assert_eq!(calls, 3, "perpendicular normal and another tracer gather afresh");
+        assert_eq!(
+            calls, 3,
+            "perpendicular normal and another tracer gather afresh"
+        );
     }
 
     #[test]
