@@ -10,7 +10,8 @@
 //! the pixels changed, and the RMSE against the 1024-spp `with_box` truth. Then the peers' render
 //! times and RMSE of the same scene read from `peers/results/{mitsuba,blender}_*.json`.
 //!
-//! Usage: `render_bench [BENCH_DIR] [--reps N] [--threads 1,2] [--spp 4-4,4-8,...]`.
+//! Usage: `render_bench [BENCH_DIR] [--reps N] [--threads 1,2] [--spp 4-4,4-8,...]
+//! [--cache on,off]`.
 //! `BENCH_DIR` (or `PHOTOMONTAGE_BENCH_DATA`) is the shared bench folder holding
 //! `data/mitsuba/`; without it the program prints a notice and exits 0.
 //!
@@ -42,6 +43,10 @@ struct Args {
     /// Rays per pixel as MIN-MAX (multiples of 4), comma-separated.
     #[arg(long, default_value = "4-4,4-8,8-8,4-16,16-16", value_delimiter = ',')]
     spp: Vec<String>,
+    /// Irradiance cache of the gathers, comma-separated `on` / `off` (off: every ray sample
+    /// gathers afresh, the renderer before the cache).
+    #[arg(long, default_value = "on", value_delimiter = ',')]
+    cache: Vec<String>,
     /// Folder with the peers' results JSON (default: BENCH_DIR/peers/results).
     #[arg(long)]
     peer_results: Option<PathBuf>,
@@ -196,10 +201,31 @@ fn main() -> Result<()> {
         )
     );
     println!(
-        "{:>7} {:>7} {:>9} {:>10} {:>12} {:>9} {:>11} {:>9}",
-        "threads", "spp", "setup s", "render s", "render CPU s", "rays/px", "changed px", "RMSE"
+        "{:>5} {:>7} {:>7} {:>9} {:>10} {:>12} {:>9} {:>11} {:>9}",
+        "cache",
+        "threads",
+        "spp",
+        "setup s",
+        "render s",
+        "render CPU s",
+        "rays/px",
+        "changed px",
+        "RMSE"
     );
-    for &threads in &args.threads {
+    let caches = args
+        .cache
+        .iter()
+        .map(|c| match c.trim() {
+            "on" => Ok(true),
+            "off" => Ok(false),
+            other => bail!("--cache {other}: on or off"),
+        })
+        .collect::<Result<Vec<bool>>>()?;
+    for (&threads, &cache) in args
+        .threads
+        .iter()
+        .flat_map(|t| caches.iter().map(move |c| (t, c)))
+    {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()?;
@@ -216,13 +242,16 @@ fn main() -> Result<()> {
                 let t0 = Instant::now();
                 let mut cpu0 = None;
                 let out = pool.install(|| -> Result<_> {
-                    let tracer = DifferentialTracer::new(
+                    let mut tracer = DifferentialTracer::new(
                         &peer.scene,
                         &peer.lighting,
                         &peer.camera,
                         &photo,
                         MAX_DEPTH,
                     )?;
+                    if !cache {
+                        tracer.set_irradiance_cache(None);
+                    }
                     let t1 = Instant::now();
                     cpu0 = process_cpu_s();
                     let out = render_view(&tracer, &settings, &|_| {}, &AtomicBool::new(false))?;
@@ -241,7 +270,8 @@ fn main() -> Result<()> {
             let rays_per_px =
                 image.primary_rays as f64 / (f64::from(size_px[0]) * f64::from(size_px[1]));
             println!(
-                "{threads:>7} {:>7} {:>9.3} {:>10.3} {:>12} {rays_per_px:>9.2} {:>11} {:>9.5}",
+                "{:>5} {threads:>7} {:>7} {:>9.3} {:>10.3} {:>12} {rays_per_px:>9.2} {:>11} {:>9.5}",
+                if cache { "on" } else { "off" },
                 format!("{min}-{max}"),
                 median(setup_s),
                 median(render_s),

@@ -30,7 +30,10 @@
 //! geometry (part of the natural irradiance that the eq. 10 inversion divides by: without it a
 //! point in a street lit by sunny façades gets too high an albedo and its new shadow comes out
 //! too dark) and once against all geometry with the sun removed where only artificial objects
-//! block it; the difference is added like D1/D3.
+//! block it; the difference is added like D1/D3. Inside a render these gathers go through the
+//! tile's irradiance cache ([`super::irradiance_cache`], Ward 1988): a gather runs once per small
+//! surface region and nearby ray samples interpolate its records
+//! ([`DifferentialTracer::set_irradiance_cache`] turns it off).
 //!
 //! Because eq. 2 is affine in L₀, the apparent colour of a changed natural point is computed as
 //! `L_photo + τ(d)·ΔL₀`: an unchanged point returns the photo value unaltered, bit for bit.
@@ -48,6 +51,8 @@
 //! points is only added where a natural light is already changed (D1/D3). Below-horizon
 //! secondary misses return black.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use image::Rgb32FImage;
 use nalgebra::{Point2, Point3, Vector3};
 
@@ -56,6 +61,7 @@ use super::illumination::{
     Daylight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour, mul,
     natural_irradiance_rgb, scale,
 };
+use super::irradiance_cache::{GatherKind, IrradianceCacheSettings, MeanDistance, cached_gather};
 use super::luminaire_light::ArtificialLight;
 use super::specular::{SurfaceFrame, reflect_above};
 use super::water::shading_normal;
@@ -145,6 +151,18 @@ pub struct DifferentialTracer<'a> {
     pub(super) materials: &'a [Material],
     /// Noise of each material's water waves (index = material id).
     pub(super) water_noise: Vec<Option<GradientNoise>>,
+    /// Irradiance caching of the gathers inside a tile ([`super::irradiance_cache`]); `None`
+    /// gathers every time.
+    irradiance_cache: Option<IrradianceCacheSettings>,
+    /// Identifies this tracer's records in a tile cache (unique per set of inputs).
+    cache_id: u64,
+}
+
+/// Source of [`DifferentialTracer::cache_id`].
+static NEXT_CACHE_ID: AtomicU64 = AtomicU64::new(0);
+
+fn next_cache_id() -> u64 {
+    NEXT_CACHE_ID.fetch_add(1, Ordering::Relaxed)
 }
 
 fn water_noise_of(materials: &[Material]) -> Vec<Option<GradientNoise>> {
@@ -215,6 +233,8 @@ impl<'a> DifferentialTracer<'a> {
             max_depth,
             materials: scene.materials(),
             water_noise: water_noise_of(scene.materials()),
+            irradiance_cache: Some(IrradianceCacheSettings::default()),
+            cache_id: next_cache_id(),
         })
     }
 
@@ -242,7 +262,21 @@ impl<'a> DifferentialTracer<'a> {
             max_depth: self.max_depth,
             materials,
             water_noise: water_noise_of(materials),
+            irradiance_cache: self.irradiance_cache,
+            cache_id: next_cache_id(),
         }
+    }
+
+    /// Sets the irradiance caching of the gathers (`None`: every gather traced; default: on
+    /// with [`IrradianceCacheSettings::default`]). It only acts inside a render's tiles.
+    pub fn set_irradiance_cache(&mut self, settings: Option<IrradianceCacheSettings>) {
+        self.irradiance_cache = settings;
+    }
+
+    /// The irradiance cache settings (`None` when off).
+    #[must_use]
+    pub fn irradiance_cache(&self) -> Option<IrradianceCacheSettings> {
+        self.irradiance_cache
     }
 
     /// The material of a hit (`None` for an unknown id).
@@ -539,11 +573,7 @@ impl<'a> DifferentialTracer<'a> {
         if depth < self.max_depth {
             e = add(
                 e,
-                self.photo_bounce_irradiance(
-                    self.lighting.photo_bounce_dome.as_ref(),
-                    &origin,
-                    &shading_normal,
-                ),
+                self.cached_photo_bounce(GatherKind::ArtificialPoint, &origin, &shading_normal),
             );
         }
         let mut l0 = diffuse_radiance_rgb(rho, e);
@@ -647,7 +677,8 @@ impl<'a> DifferentialTracer<'a> {
         });
         // Light the photographed surroundings reflect onto the point, before and after the
         // artificial objects arrive (they block some of it and shade the surfaces it comes from).
-        let (e_inter_before, e_inter_after) = self.natural_interreflection(&origin, &normal);
+        let [e_inter_before, e_inter_after, e_reflected] =
+            self.natural_point_gathers(&origin, &normal);
         let e_natural = add(e_natural, e_inter_before);
         let Some(rho) = diffuse_reflectance_from_true_colour(l0, e_natural) else {
             // No natural light reaches the point: nothing to remove; D1 needs ρ_d from the
@@ -666,8 +697,7 @@ impl<'a> DifferentialTracer<'a> {
         for &i in &sky_d3 {
             e_d3 = add(e_d3, daylight.sky[i].irradiance_rgb(&normal));
         }
-        // D1 for the light the artificial objects reflect onto the point.
-        let e_reflected = self.artificial_bounce_irradiance(&origin, &normal);
+        // D1 for the light the artificial objects reflect onto the point: `e_reflected`.
         let e_inter_change = add(e_inter_after, scale(e_inter_before, -1.0));
         let delta = diffuse_radiance_rgb(
             rho,
@@ -742,6 +772,7 @@ impl<'a> DifferentialTracer<'a> {
         dome: Option<&crate::sky_dome::SkyDome>,
         origin: &Point3<f64>,
         normal: &Vector3<f64>,
+        distances: &mut MeanDistance,
     ) -> Rgb {
         let Some(dome) = dome else {
             return [0.0; 3];
@@ -754,12 +785,78 @@ impl<'a> DifferentialTracer<'a> {
             ObjectKind::Natural,
             |_| true,
             |hit, point, dir, t| self.natural_radiance_for_bounce(hit, point, dir, t),
+            distances,
+        )
+    }
+
+    /// [`Self::photo_bounce_irradiance`] over the main (`ArtificialPoint`) or nested
+    /// (`ArtificialNested`) dome, through the tile's irradiance cache.
+    fn cached_photo_bounce(
+        &self,
+        kind: GatherKind,
+        origin: &Point3<f64>,
+        normal: &Vector3<f64>,
+    ) -> Rgb {
+        let dome = match kind {
+            GatherKind::ArtificialNested => self.lighting.photo_bounce_nested_dome.as_ref(),
+            _ => self.lighting.photo_bounce_dome.as_ref(),
+        };
+        if dome.is_none() {
+            return [0.0; 3];
+        }
+        let compute = || {
+            let mut distances = MeanDistance::default();
+            let e = self.photo_bounce_irradiance(dome, origin, normal, &mut distances);
+            ([e, [0.0; 3], [0.0; 3]], distances)
+        };
+        self.cached(kind, origin, normal, compute)[0]
+    }
+
+    /// The gathers at a changed natural point (`origin`, unit `normal`), through the tile's
+    /// irradiance cache: interreflection before and after the artificial objects arrive
+    /// ([`Self::natural_interreflection`]) and the light the artificial objects reflect onto it
+    /// ([`Self::artificial_bounce_irradiance`]).
+    fn natural_point_gathers(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> [Rgb; 3] {
+        if self.lighting.photo_bounce_dome.is_none() {
+            return [[0.0; 3]; 3];
+        }
+        let compute = || {
+            let mut distances = MeanDistance::default();
+            let (before, after) = self.natural_interreflection(origin, normal, &mut distances);
+            let reflected = self.artificial_bounce_irradiance(origin, normal, &mut distances);
+            ([before, after, reflected], distances)
+        };
+        self.cached(GatherKind::NaturalPoint, origin, normal, compute)
+    }
+
+    /// `compute` through the tile cache when caching is on.
+    fn cached(
+        &self,
+        kind: GatherKind,
+        origin: &Point3<f64>,
+        normal: &Vector3<f64>,
+        compute: impl FnOnce() -> ([Rgb; 3], MeanDistance),
+    ) -> [Rgb; 3] {
+        let Some(settings) = &self.irradiance_cache else {
+            return compute().0;
+        };
+        let footprint_m = (origin - self.camera.pose.camera_center_in_world).norm()
+            / self.camera.intrinsics.focal_px;
+        cached_gather(
+            settings,
+            self.cache_id,
+            kind,
+            origin,
+            normal,
+            footprint_m,
+            compute,
         )
     }
 
     /// Irradiance at `origin` gathered over the facets of `dome` and their mirror images below
     /// the horizon: each direction with a positive cosine that `worth_tracing` admits is traced,
-    /// and the first hit, if it is of `kind`, contributes `radiance · cos · solid angle`.
+    /// and the first hit, if it is of `kind`, contributes `radiance · cos · solid angle`. Each
+    /// traced ray's hit distance goes into `distances` (the irradiance cache's record radius).
     #[allow(clippy::too_many_arguments)]
     fn gather_over_dome(
         &self,
@@ -770,6 +867,7 @@ impl<'a> DifferentialTracer<'a> {
         kind: ObjectKind,
         worth_tracing: impl Fn(&Vector3<f64>) -> bool,
         radiance: impl Fn(&SceneHit, &Point3<f64>, &Vector3<f64>, f64) -> Rgb,
+        distances: &mut MeanDistance,
     ) -> Rgb {
         let mut e = [0.0; 3];
         for facet in &dome.facets {
@@ -782,8 +880,10 @@ impl<'a> DifferentialTracer<'a> {
                 }
                 let ray = tracer.ray_from_world(origin, &dir, 0.0, f32::INFINITY);
                 let Some(hit) = tracer.closest_hit(&ray) else {
+                    distances.add(f64::INFINITY);
                     continue;
                 };
+                distances.add(f64::from(hit.hit.t));
                 if hit.kind != kind {
                     continue;
                 }
@@ -797,7 +897,12 @@ impl<'a> DifferentialTracer<'a> {
 
     /// Irradiance at a natural point from light reflected by artificial objects, gathered over
     /// the facets of [`Lighting::photo_bounce_dome`] (upper and mirrored lower hemisphere).
-    fn artificial_bounce_irradiance(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
+    fn artificial_bounce_irradiance(
+        &self,
+        origin: &Point3<f64>,
+        normal: &Vector3<f64>,
+        distances: &mut MeanDistance,
+    ) -> Rgb {
         let Some(dome) = &self.lighting.photo_bounce_dome else {
             return [0.0; 3];
         };
@@ -809,6 +914,7 @@ impl<'a> DifferentialTracer<'a> {
             ObjectKind::Artificial,
             |dir| self.may_hit_artificial(origin, dir, f64::INFINITY),
             |hit, point, dir, t| self.artificial_radiance_for_bounce(hit, point, dir, t),
+            distances,
         )
     }
 
@@ -834,11 +940,7 @@ impl<'a> DifferentialTracer<'a> {
         });
         let e = add(
             natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true),
-            self.photo_bounce_irradiance(
-                self.lighting.photo_bounce_nested_dome.as_ref(),
-                &origin,
-                &normal,
-            ),
+            self.cached_photo_bounce(GatherKind::ArtificialNested, &origin, &normal),
         );
         self.apparent(diffuse_radiance_rgb(rho, e), distance_m)
     }
@@ -864,7 +966,12 @@ impl<'a> DifferentialTracer<'a> {
     /// it belongs in the denominator of the eq. 10 inversion). After: traced against all
     /// geometry (artificial objects block some directions) with the surfaces' radiance less the
     /// sun the artificial objects take from them. Both zero without a dome.
-    fn natural_interreflection(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> (Rgb, Rgb) {
+    fn natural_interreflection(
+        &self,
+        origin: &Point3<f64>,
+        normal: &Vector3<f64>,
+        distances: &mut MeanDistance,
+    ) -> (Rgb, Rgb) {
         let (Some(dome), Some(natural)) = (&self.lighting.photo_bounce_dome, &self.natural) else {
             return ([0.0; 3], [0.0; 3]);
         };
@@ -876,8 +983,9 @@ impl<'a> DifferentialTracer<'a> {
             ObjectKind::Natural,
             |_| true,
             |hit, point, dir, t| self.natural_radiance_towards(hit, point, dir, t, false),
+            distances,
         );
-        let after = self.photo_bounce_irradiance(Some(dome), origin, normal);
+        let after = self.photo_bounce_irradiance(Some(dome), origin, normal, distances);
         (before, after)
     }
 

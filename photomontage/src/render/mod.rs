@@ -34,6 +34,7 @@
 pub mod differential;
 pub mod glass;
 pub mod illumination;
+pub mod irradiance_cache;
 pub mod luminaire_light;
 pub mod output;
 pub mod spectral;
@@ -51,6 +52,7 @@ use rayon::prelude::*;
 
 pub use differential::{DifferentialError, DifferentialTracer, Lighting, PrimaryHit, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
+pub use irradiance_cache::IrradianceCacheSettings;
 pub use luminaire_light::{ArtificialLight, LuminaireLight};
 pub use output::{LayerSet, OutputError, OutputFormat, OutputLayers};
 pub use spectral::{SpectralError, render_view_spectral};
@@ -332,6 +334,8 @@ fn render_tile(
 ) -> TileOut {
     let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
     rng.set_stream(tile_index as u64);
+    // The tile's own irradiance cache: same records for any thread count.
+    let _cache = irradiance_cache::TileScope::enter();
     let photo = tracer.photo();
     let camera = tracer.camera();
     let mut out = TileOut {

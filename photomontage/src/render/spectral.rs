@@ -363,6 +363,8 @@ impl Job<'_, '_> {
         let settings = self.settings;
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         rng.set_stream(tile_index as u64);
+        // The tile's own irradiance cache (records kept per pass tracer).
+        let _cache = super::irradiance_cache::TileScope::enter();
         let mut bands = vec![0.0; self.conv.len()];
         let mut out = TileOut {
             rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),

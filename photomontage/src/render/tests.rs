@@ -634,3 +634,75 @@ fn output_layers_give_depth_object_and_the_exact_shadow_change() {
     let i = (top.y.round() as u32 * SIZE_PX[0] + top.x.round() as u32) as usize;
     assert_eq!(ids[i].to_bits(), 1.0_f32.to_bits());
 }
+
+/// The irradiance cache ([`irradiance_cache`]) on the box scene with the photo bounce (main and
+/// nested dome): the image is the same bits on 1 and 2 threads (per-tile records), the same
+/// pixels change as without the cache, and every pixel is within `CACHE_REL_TOL` of the render
+/// that gathers at every ray sample (the known answer the cache approximates).
+#[test]
+fn irradiance_cache_is_thread_independent_and_close_to_gathering_every_sample() {
+    /// This image is coarse (64 × 48 px, a pixel ≈ 0.5 m on the ground), so a record reaches
+    /// at least a·R_min = 0.4 px ≈ 0.2 m and up to ~10 px ≈ 5 m of open ground. In the box's
+    /// shadow the pixel holds only ambient light plus the bounce, so the bounce is up to ~40 %
+    /// of it, and Ward's estimate at a = 0.2 bounds the interpolated irradiance's error at
+    /// ~a·(its change over R), i.e. up to ~20 % of that share: ≤ 10 % of the worst pixel.
+    /// A cache returning another kind's or a far point's gather would be off by the whole share.
+    const CACHE_REL_TOL: f64 = 0.10;
+    /// The mean over the channel values the cache alters: most sit close to a record, where
+    /// the error goes to zero; 1.5 % is a sixth of the worst bound.
+    const CACHE_MEAN_REL_TOL: f64 = 0.015;
+    let scene = site(true);
+    let lighting = Lighting {
+        photo_bounce_dome: Some(crate::sky_dome::durisch_facets::durisch_dome(4).unwrap()),
+        photo_bounce_nested_dome: Some(crate::sky_dome::durisch_facets::durisch_dome(2).unwrap()),
+        ..sun_and_ambient()
+    };
+    let cam = camera();
+    let photo = uniform_photo(ground_radiance());
+    let mut tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 2).unwrap();
+    let settings = RenderSettings {
+        tile_size_px: 16,
+        min_rays_per_pixel: 4,
+        max_rays_per_pixel: 4,
+        seed: 3,
+        ..RenderSettings::default()
+    };
+    let run = |tracer: &DifferentialTracer<'_>, threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| render(tracer, &settings))
+    };
+    let bits = |img: &RenderedImage| {
+        img.rgba
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    let cached_one = run(&tracer, 1);
+    let cached_two = run(&tracer, 2);
+    assert_eq!(bits(&cached_one), bits(&cached_two));
+    tracer.set_irradiance_cache(None);
+    let exact = run(&tracer, 2);
+    assert_eq!(cached_one.changed_pixels, exact.changed_pixels);
+    assert!(exact.changed_pixels > 100, "{}", exact.changed_pixels);
+    let (mut worst, mut sum, mut n) = (0.0_f64, 0.0, 0);
+    for (c, e) in cached_one.rgba.iter().zip(&exact.rgba) {
+        assert_eq!(c[3].to_bits(), e[3].to_bits(), "coverage");
+        if c.map(f32::to_bits) == e.map(f32::to_bits) {
+            continue;
+        }
+        for k in 0..3 {
+            let rel = (f64::from(c[k]) - f64::from(e[k])).abs() / f64::from(e[k]).max(1e-6);
+            worst = worst.max(rel);
+            sum += rel;
+            n += 1;
+        }
+    }
+    assert!(n > 0, "the cache changed nothing: it did not interpolate");
+    let mean = sum / f64::from(n);
+    println!("cache vs exact: worst {worst}, mean {mean} over {n} channel values");
+    assert!(worst <= CACHE_REL_TOL, "worst {worst}, mean {mean}");
+    assert!(mean <= CACHE_MEAN_REL_TOL, "worst {worst}, mean {mean}");
+}
