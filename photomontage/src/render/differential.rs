@@ -1079,7 +1079,10 @@ impl<'a> DifferentialTracer<'a> {
         normal_in_world: &Vector3<f64>,
     ) -> Rgb {
         let origin = point_in_world_m + normal_in_world * SURFACE_OFFSET_M;
-        self.natural_interreflection(&origin, normal_in_world).0
+        // Exact gather (no cache): the daylight fit calls this outside any render tile.
+        let mut distances = MeanDistance::default();
+        self.natural_interreflection(&origin, normal_in_world, &mut distances)
+            .0
     }
 }
 
