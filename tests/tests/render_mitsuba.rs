@@ -6,6 +6,7 @@
 //! point scaled to match) to keep the test within seconds in the dev profile.
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
+use photomontage_tests::street::downscale;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
@@ -34,25 +35,6 @@ const BOX_MEAN_REL_TOL: f64 = 0.03;
 /// bounce that lights the box walls facing the shadow, 11 % without any bounce from the box).
 const SHADOW_MEAN_REL_TOL: f64 = 0.03;
 
-fn downscale(img: &image::Rgb32FImage) -> image::Rgb32FImage {
-    let scale = scale();
-    let (w, h) = (img.width() / scale, img.height() / scale);
-    image::Rgb32FImage::from_fn(w, h, |x, y| {
-        let mut s = [0.0_f64; 3];
-        for dy in 0..scale {
-            for dx in 0..scale {
-                let p = img.get_pixel(x * scale + dx, y * scale + dy).0;
-                for k in 0..3 {
-                    s[k] += f64::from(p[k]);
-                }
-            }
-        }
-        let n = f64::from(scale * scale);
-        #[allow(clippy::cast_possible_truncation)]
-        image::Rgb(s.map(|v| (v / n) as f32))
-    })
-}
-
 fn load(path: &Path) -> image::Rgb32FImage {
     photomontage::photo::load(path).unwrap().pixels
 }
@@ -67,8 +49,8 @@ fn box_and_shadow_match_mitsuba_1024spp() {
         return;
     };
     let spec: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
-    let photo = downscale(&load(&photo_path));
-    let truth = downscale(&load(&truth_path));
+    let photo = downscale(&load(&photo_path), scale());
+    let truth = downscale(&load(&truth_path), scale());
 
     // Scene, camera and lights: shared with the render-speed bench (`render_bench`).
     let (w, h) = (photo.width(), photo.height());

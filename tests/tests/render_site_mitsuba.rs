@@ -5,6 +5,7 @@
 //! the site glue and the lighting-unit conventions end to end against the 1024-spp truth.
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
+use photomontage_tests::street::downscale;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -25,24 +26,6 @@ const SHADOW_MEAN_REL_TOL: f64 = 0.03;
 
 fn vec3(v: &Value) -> [f64; 3] {
     [0, 1, 2].map(|k| v[k].as_f64().unwrap())
-}
-
-fn downscale(img: &image::Rgb32FImage) -> image::Rgb32FImage {
-    let (w, h) = (img.width() / SCALE, img.height() / SCALE);
-    image::Rgb32FImage::from_fn(w, h, |x, y| {
-        let mut s = [0.0_f64; 3];
-        for dy in 0..SCALE {
-            for dx in 0..SCALE {
-                let p = img.get_pixel(x * SCALE + dx, y * SCALE + dy).0;
-                for k in 0..3 {
-                    s[k] += f64::from(p[k]);
-                }
-            }
-        }
-        let n = f64::from(SCALE * SCALE);
-        #[allow(clippy::cast_possible_truncation)]
-        image::Rgb(s.map(|v| (v / n) as f32))
-    })
 }
 
 fn arr(v: [f64; 3]) -> String {
@@ -179,8 +162,14 @@ fn site_file_montage_matches_mitsuba_1024spp() {
         return;
     };
     let spec: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
-    let photo = downscale(&photomontage::photo::load(&photo_path).unwrap().pixels);
-    let truth = downscale(&photomontage::photo::load(&truth_path).unwrap().pixels);
+    let photo = downscale(
+        &photomontage::photo::load(&photo_path).unwrap().pixels,
+        SCALE,
+    );
+    let truth = downscale(
+        &photomontage::photo::load(&truth_path).unwrap().pixels,
+        SCALE,
+    );
     let dir = tempfile::tempdir().unwrap();
     let site = write_site(dir.path(), &spec, &photo);
 
