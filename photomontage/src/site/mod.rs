@@ -15,6 +15,7 @@
 
 mod locate;
 pub mod luminaires;
+pub mod new;
 pub mod render;
 mod schema;
 pub mod solve;
