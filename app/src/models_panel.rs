@@ -16,6 +16,12 @@
 //! folder, units metres, up axis Y for glTF (its convention) and Z otherwise, placed at the
 //! centroid of the control points so that it lands in the surveyed area.
 //!
+//! Each model's length unit and up axis (the importer's `LengthUnit` and `UpAxis`, written as
+//! `units` and `up_axis`) are chosen when adding it (the "added in" combo boxes) and edited
+//! afterwards with combo boxes (one undoable [`crate::commands::Command::PutModel`] each); the
+//! wireframe follows, and the importer's scale warning (`site::render::SiteWarning::ModelScale`,
+//! a model under 1 mm or over 10 km across after the conversion) is shown under the model.
+//!
 //! # Known limitations
 //! Edges are drawn as straight screen segments between projected vertices (lens distortion
 //! bends the true image of a long edge slightly); edges with an end behind the camera are
@@ -23,7 +29,8 @@
 //! frame (fine for thousands of edges).
 
 use eframe::egui::{self, Color32};
-use photomontage::site::render::{site_camera, site_scene};
+use photomontage::scene::{LengthUnit, UpAxis};
+use photomontage::site::render::{SiteWarning, site_camera, site_scene};
 use photomontage::site::{CadModel, Placement, SiteDocument};
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -33,8 +40,59 @@ use crate::commands::Command;
 /// A model's edges in its own frame after unit and up-axis conversion (identity placement).
 #[derive(Debug, Clone)]
 struct LocalEdges {
-    key: (String, String, String),
     edges_m: Vec<[[f64; 3]; 2]>,
+    /// The importer's warnings for the model (an absurd extent after the unit conversion,
+    /// `SiteWarning::ModelScale`, among them).
+    warnings: Vec<SiteWarning>,
+}
+
+/// The length units the importer reads (`photomontage::scene::LengthUnit`), with the site file
+/// spelling of `[[models]] units`.
+pub const UNITS: [(&str, LengthUnit); 5] = [
+    ("m", LengthUnit::Metre),
+    ("cm", LengthUnit::Centimetre),
+    ("mm", LengthUnit::Millimetre),
+    ("in", LengthUnit::Inch),
+    ("ft", LengthUnit::Foot),
+];
+
+/// The up axes the importer knows (`photomontage::scene::UpAxis`), with the site file spelling of
+/// `[[models]] up_axis`.
+pub const UP_AXES: [(&str, UpAxis); 2] = [("z", UpAxis::Z), ("y", UpAxis::Y)];
+
+fn unit_label(unit: &str) -> String {
+    UNITS.iter().find(|(u, _)| *u == unit).map_or_else(
+        || format!("{unit} (unknown)"),
+        |(u, l)| format!("{u} ({} m)", l.metres_per_unit()),
+    )
+}
+
+fn axis_label(axis: &str) -> String {
+    match UP_AXES.iter().find(|(a, _)| a.eq_ignore_ascii_case(axis)) {
+        Some((a, UpAxis::Z)) => format!("{} up (CAD, DXF)", a.to_uppercase()),
+        Some((a, UpAxis::Y)) => format!("{} up (glTF)", a.to_uppercase()),
+        None => format!("{axis} (unknown)"),
+    }
+}
+
+/// A combo box choosing one of `options` (site file spellings) for `value`; true when changed.
+fn choice_ui(
+    ui: &mut egui::Ui,
+    name: &str,
+    value: &mut String,
+    options: &[&str],
+    label: fn(&str) -> String,
+) -> bool {
+    let before = value.clone();
+    let r = egui::ComboBox::from_id_salt(name)
+        .selected_text(label(value))
+        .show_ui(ui, |ui| {
+            for o in options {
+                ui.selectable_value(value, (*o).to_owned(), label(o));
+            }
+        });
+    crate::points::name_widget(ui, &r.response, name);
+    *value != before
 }
 
 /// Cache of imported model edges and the overlay switch.
@@ -44,7 +102,14 @@ pub struct ModelsPanel {
     pub show_wireframe: bool,
     /// Model file path typed by the user (the fallback of File → Import model…).
     pub model_path: String,
-    cache: HashMap<String, Result<LocalEdges, String>>,
+    /// Units of the next model added (site spelling, [`UNITS`]); `None`: metres.
+    pub new_units: Option<String>,
+    /// Up axis of the next model added ([`UP_AXES`]); `None`: the format's convention (Y for
+    /// glTF, Z otherwise).
+    pub new_up_axis: Option<String>,
+    /// Per model id: the (file, units, up axis) it was imported with and the result (errors are
+    /// cached too, so a broken file is not re-read every frame).
+    cache: HashMap<String, ((String, String, String), Result<LocalEdges, String>)>,
 }
 
 fn cache_key(m: &CadModel) -> (String, String, String) {
@@ -59,6 +124,25 @@ pub fn place(p_m: [f64; 3], placement: &Placement) -> [f64; 3] {
     let [x, y, z] = p_m.map(|c| c * placement.scale);
     let [tx, ty, tz] = placement.translation;
     [cos * x - sin * y + tx, sin * x + cos * y + ty, z + tz]
+}
+
+/// The `[[models]]` entry that importing the file `path` into `doc` adds (see the module doc),
+/// with units and up axis as chosen (`None`: metres, the format's convention).
+#[must_use]
+pub fn model_entry_as(
+    doc: &SiteDocument,
+    path: &Path,
+    units: Option<&str>,
+    up_axis: Option<&str>,
+) -> CadModel {
+    let mut m = model_entry(doc, path);
+    if let Some(u) = units {
+        m.units = u.to_owned();
+    }
+    if let Some(a) = up_axis {
+        m.up_axis = a.to_owned();
+    }
+    m
 }
 
 /// The `[[models]]` entry that importing the file `path` into `doc` adds (see the module doc).
@@ -146,12 +230,49 @@ fn load_edges(doc: &SiteDocument, model: &CadModel) -> Result<LocalEdges, String
         }
     }
     Ok(LocalEdges {
-        key: cache_key(model),
         edges_m,
+        warnings: scene.warnings,
     })
 }
 
 impl ModelsPanel {
+    /// The model's edges, imported again when its file, units or up axis changed.
+    fn edges(&mut self, doc: &SiteDocument, model: &CadModel) -> &Result<LocalEdges, String> {
+        let key = cache_key(model);
+        let stale = self.cache.get(&model.id).is_none_or(|(k, _)| *k != key);
+        if stale {
+            let loaded = load_edges(doc, model);
+            self.cache.insert(model.id.clone(), (key.clone(), loaded));
+        }
+        &self
+            .cache
+            .entry(model.id.clone())
+            .or_insert_with(|| (key, Err("not loaded".into())))
+            .1
+    }
+
+    /// The importer's warnings for model `model_id` as the site has it now (e.g. "model `x` is
+    /// 12000 m across: check its units"), importing it if needed.
+    ///
+    /// # Errors
+    /// A readable message when the model is unknown or cannot be imported.
+    pub fn model_warnings(
+        &mut self,
+        doc: &SiteDocument,
+        model_id: &str,
+    ) -> Result<Vec<SiteWarning>, String> {
+        let model = doc
+            .site
+            .models
+            .iter()
+            .find(|m| m.id == model_id)
+            .ok_or_else(|| format!("no model {model_id}"))?;
+        self.edges(doc, model)
+            .as_ref()
+            .map(|e| e.warnings.clone())
+            .map_err(Clone::clone)
+    }
+
     /// The projected wireframe (pixel segments) of model `model_id` in photo `photo_id`.
     ///
     /// # Errors
@@ -170,16 +291,7 @@ impl ModelsPanel {
             .find(|m| m.id == model_id)
             .ok_or_else(|| format!("no model {model_id}"))?;
         let camera = site_camera(doc, photo_id).map_err(|e| e.to_string())?;
-        let stale = !matches!(self.cache.get(model_id), Some(Ok(e)) if e.key == cache_key(model));
-        if stale {
-            self.cache
-                .insert(model_id.to_owned(), load_edges(doc, model));
-        }
-        let edges = match self.cache.get(model_id) {
-            Some(Ok(e)) => e,
-            Some(Err(e)) => return Err(e.clone()),
-            None => return Err(format!("model {model_id} not loaded")),
-        };
+        let edges = self.edges(doc, model).as_ref().map_err(Clone::clone)?;
         Ok(edges
             .edges_m
             .iter()
@@ -217,19 +329,34 @@ impl crate::Studio {
         let Some(doc) = self.doc.as_ref() else {
             return;
         };
-        let model = model_entry(doc, path);
+        let model = model_entry_as(
+            doc,
+            path,
+            self.models.new_units.as_deref(),
+            self.models.new_up_axis.as_deref(),
+        );
         match load_edges(doc, &model) {
             Ok(edges) => {
                 let text = format!(
-                    "added model {} from {} (placed at the control points' centroid; move it \
-                     in the Models tab)",
+                    "added model {} from {} in {}, {} (placed at the control points' \
+                     centroid; move it in the Models tab)",
                     model.id,
-                    path.display()
+                    path.display(),
+                    unit_label(&model.units),
+                    axis_label(&model.up_axis)
                 );
-                self.models.cache.insert(model.id.clone(), Ok(edges));
+                let warnings = edges.warnings.clone();
+                self.models
+                    .cache
+                    .insert(model.id.clone(), (cache_key(&model), Ok(edges)));
                 self.models.show_wireframe = true;
                 self.apply(Command::PutModel { model, at: None }, None);
                 self.say(text, false);
+                for w in warnings {
+                    // The scale warning is red: the model is almost certainly in the wrong unit.
+                    let absurd = matches!(w, SiteWarning::ModelScale { .. });
+                    self.say(format!("warning: {w}"), absurd);
+                }
             }
             Err(e) => self.say(format!("cannot import {}: {e}", path.display()), true),
         }
@@ -270,6 +397,30 @@ impl crate::Studio {
             crate::points::name_widget(ui, &r, "model path");
             add = ui.button("Add model").clicked();
         });
+        ui.horizontal(|ui| {
+            ui.label("added in");
+            let mut units = self.models.new_units.clone().unwrap_or_else(|| "m".into());
+            let names: Vec<&str> = UNITS.iter().map(|(u, _)| *u).collect();
+            if choice_ui(ui, "new model units", &mut units, &names, unit_label) {
+                self.models.new_units = Some(units);
+            }
+            let mut axis = self
+                .models
+                .new_up_axis
+                .clone()
+                .unwrap_or_else(|| "auto".into());
+            let axes = ["auto", "z", "y"];
+            let label = |a: &str| {
+                if a == "auto" {
+                    "up axis of the format".to_string()
+                } else {
+                    axis_label(a)
+                }
+            };
+            if choice_ui(ui, "new model up axis", &mut axis, &axes, label) {
+                self.models.new_up_axis = (axis != "auto").then_some(axis);
+            }
+        });
         if add && !self.models.model_path.trim().is_empty() {
             let path = std::path::PathBuf::from(self.models.model_path.trim());
             self.import_model(&path);
@@ -283,13 +434,52 @@ impl crate::Studio {
         }
         let photo = self.current_photo.clone().unwrap_or_default();
         let mut commands = Vec::new();
+        let warn = Color32::from_rgb(230, 160, 40);
         for m in &doc.site.models {
             ui.separator();
-            ui.strong(format!("{} ({}, {})", m.id, m.file, m.units));
+            ui.strong(format!("{} ({})", m.id, m.file));
+            ui.horizontal(|ui| {
+                let mut changed = m.clone();
+                let names: Vec<&str> = UNITS.iter().map(|(u, _)| *u).collect();
+                let a = choice_ui(
+                    ui,
+                    &format!("{} units", m.id),
+                    &mut changed.units,
+                    &names,
+                    unit_label,
+                );
+                let axes: Vec<&str> = UP_AXES.iter().map(|(a, _)| *a).collect();
+                let b = choice_ui(
+                    ui,
+                    &format!("{} up axis", m.id),
+                    &mut changed.up_axis,
+                    &axes,
+                    axis_label,
+                );
+                if a || b {
+                    commands.push((
+                        Command::PutModel {
+                            model: changed,
+                            at: None,
+                        },
+                        None,
+                    ));
+                }
+            });
+            match self.models.model_warnings(doc, &m.id) {
+                Ok(warnings) => {
+                    for w in warnings {
+                        ui.colored_label(warn, format!("importer: {w}"));
+                    }
+                }
+                Err(e) => {
+                    ui.colored_label(warn, e);
+                }
+            }
             if let Err(e) = self.models.wireframe_px(doc, &photo, &m.id)
                 && self.models.show_wireframe
             {
-                ui.colored_label(Color32::from_rgb(230, 160, 40), e);
+                ui.colored_label(warn, e);
             }
             let mut p = m.placement.clone();
             let mut changed = false;
