@@ -12,7 +12,8 @@
 //! the restored edits are kept but can no longer be undone one by one.
 
 use photomontage::site::{
-    CadModel, ControlPoint, Exterior, Interior, Observation, Placement, Polygon, Site, TiePoint,
+    CadModel, ControlPoint, Exterior, Interior, Observation, Placement, Polygon,
+    SelfCalibrationFlags, Site, TiePoint,
 };
 
 /// What can go wrong applying a command.
@@ -70,6 +71,11 @@ pub enum Command {
     PutModel { model: CadModel, at: Option<usize> },
     /// Removes a CAD model.
     RemoveModel { id: String },
+    /// Sets which interior parameters the solve of a photo may estimate.
+    SetSelfCalibration {
+        photo: String,
+        flags: SelfCalibrationFlags,
+    },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
 }
@@ -91,6 +97,7 @@ impl Command {
             Self::PutPolygon { polygon, .. } => format!("polygon {}", polygon.id),
             Self::PutModel { model, .. } => format!("model {}", model.id),
             Self::RemoveModel { id } => format!("remove model {id}"),
+            Self::SetSelfCalibration { photo, .. } => format!("self-calibration of {photo}"),
             Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
         }
@@ -258,6 +265,15 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
                 model,
                 placement: old,
             }
+        }
+        Command::SetSelfCalibration { photo, flags } => {
+            let p = site
+                .photos
+                .iter_mut()
+                .find(|p| p.id == photo)
+                .ok_or(CommandError::NoSuchPhoto { id: photo.clone() })?;
+            let old = std::mem::replace(&mut p.self_calibration, flags);
+            Command::SetSelfCalibration { photo, flags: old }
         }
         Command::Batch(commands) => {
             let mut inverses = Vec::with_capacity(commands.len());
@@ -543,6 +559,49 @@ mod tests {
         assert!(matches!(
             apply(&mut s, Command::RemoveModel { id: "nope".into() }),
             Err(CommandError::NoSuchModel { .. })
+        ));
+    }
+
+    #[test]
+    fn self_calibration_flags_undo_to_the_exact_site() {
+        let mut original = site();
+        original.photos.push(photomontage::site::Photo {
+            id: "P1".into(),
+            file: "p1.png".into(),
+            taken_at: None,
+            interior: None,
+            self_calibration: SelfCalibrationFlags::default(),
+            exterior: None,
+        });
+        let mut s = original.clone();
+        let mut h = History::default();
+        let flags = SelfCalibrationFlags {
+            focal: true,
+            k1: true,
+            ..SelfCalibrationFlags::default()
+        };
+        h.apply(
+            &mut s,
+            Command::SetSelfCalibration {
+                photo: "P1".into(),
+                flags,
+            },
+        )
+        .expect("photo exists");
+        assert_eq!(s.photos[0].self_calibration, flags);
+        h.undo(&mut s).expect("undo");
+        assert_eq!(s, original);
+        h.redo(&mut s).expect("redo");
+        assert_eq!(s.photos[0].self_calibration, flags);
+        assert!(matches!(
+            apply(
+                &mut s,
+                Command::SetSelfCalibration {
+                    photo: "nope".into(),
+                    flags
+                }
+            ),
+            Err(CommandError::NoSuchPhoto { .. })
         ));
     }
 

@@ -10,8 +10,7 @@
 //! # Known limitations
 //! One dialog at a time (a second request while one is open is refused with a message). On
 //! macOS, rfd's synchronous dialogs want the main thread; the studio's worker-thread dialogs are
-//! only exercised on Linux. There is no "New site" item: the library has no workflow that
-//! creates a site from photos yet.
+//! only exercised on Linux. File → New site… opens the [`crate::new_site`] window.
 
 use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
@@ -31,6 +30,10 @@ pub enum DialogPurpose {
     ImportModel,
     /// Export the rendered montage (.exr, .png, .jpg, .tif).
     ExportRender,
+    /// Choose the photos of a new site (several at once).
+    NewSitePhotos,
+    /// Choose where a new site file goes.
+    NewSiteFile,
 }
 
 impl DialogPurpose {
@@ -43,20 +46,38 @@ impl DialogPurpose {
             Self::ImportPoints => "Import control points",
             Self::ImportModel => "Import model",
             Self::ExportRender => "Export render",
+            Self::NewSitePhotos => "Photos of the new site",
+            Self::NewSiteFile => "New site file",
         }
     }
 
     /// Whether the dialog chooses a file to write.
     #[must_use]
     pub fn is_save(self) -> bool {
-        matches!(self, Self::SaveSiteAs | Self::ExportRender)
+        matches!(
+            self,
+            Self::SaveSiteAs | Self::ExportRender | Self::NewSiteFile
+        )
+    }
+
+    /// Whether the dialog lets the user choose several files.
+    #[must_use]
+    pub fn is_multi(self) -> bool {
+        matches!(self, Self::NewSitePhotos)
     }
 
     /// File filters offered: (name, extensions without the dot).
     #[must_use]
     pub fn filters(self) -> &'static [(&'static str, &'static [&'static str])] {
         match self {
-            Self::OpenSite | Self::SaveSiteAs => &[("Site file", &["toml"])],
+            Self::OpenSite | Self::SaveSiteAs | Self::NewSiteFile => &[("Site file", &["toml"])],
+            Self::NewSitePhotos => &[
+                (
+                    "Photos (JPEG, PNG, TIFF, EXR)",
+                    &["jpg", "jpeg", "JPG", "JPEG", "png", "tif", "tiff", "exr"],
+                ),
+                ("All files", &["*"]),
+            ],
             Self::ImportPoints => &[
                 ("Control points (CSV, gcp_list.txt)", &["csv", "txt"]),
                 ("All files", &["*"]),
@@ -91,6 +112,12 @@ pub struct DialogRequest {
 pub trait FilePicker: Send + Sync {
     /// Asks the user for a file.
     fn pick(&self, request: &DialogRequest) -> Option<PathBuf>;
+
+    /// Asks the user for several files ([`DialogPurpose::is_multi`]); `None`: cancelled. By
+    /// default the single-file dialog.
+    fn pick_many(&self, request: &DialogRequest) -> Option<Vec<PathBuf>> {
+        self.pick(request).map(|p| vec![p])
+    }
 }
 
 /// The native dialog of the `rfd` crate.
@@ -115,12 +142,24 @@ impl FilePicker for NativePicker {
             dialog.pick_file()
         }
     }
+
+    fn pick_many(&self, request: &DialogRequest) -> Option<Vec<PathBuf>> {
+        let mut dialog = rfd::FileDialog::new().set_title(request.purpose.title());
+        for (name, extensions) in request.purpose.filters() {
+            dialog = dialog.add_filter(*name, extensions);
+        }
+        if let Some(dir) = &request.start_dir {
+            dialog = dialog.set_directory(dir);
+        }
+        dialog.pick_files()
+    }
 }
 
 /// Runs one dialog at a time on a worker thread and hands its answer back.
 pub struct DialogWorker {
     picker: Arc<dyn FilePicker>,
-    running: Option<(DialogPurpose, Receiver<Option<PathBuf>>)>,
+    /// The open dialog: its purpose and where its answer (empty: cancelled) arrives.
+    running: Option<(DialogPurpose, Receiver<Vec<PathBuf>>)>,
 }
 
 impl Default for DialogWorker {
@@ -157,7 +196,11 @@ impl DialogWorker {
         let spawned = std::thread::Builder::new()
             .name("file-dialog".into())
             .spawn(move || {
-                let answer = picker.pick(&request);
+                let answer = if request.purpose.is_multi() {
+                    picker.pick_many(&request).unwrap_or_default()
+                } else {
+                    picker.pick(&request).into_iter().collect()
+                };
                 // A closed channel means the studio is gone; nothing to report to.
                 let _ = tx.send(answer);
                 ctx.request_repaint();
@@ -169,15 +212,16 @@ impl DialogWorker {
         true
     }
 
-    /// The answer of the open dialog once it is closed: (purpose, chosen path or `None`).
-    pub fn poll(&mut self) -> Option<(DialogPurpose, Option<PathBuf>)> {
+    /// The answer of the open dialog once it is closed: (purpose, chosen paths; empty when
+    /// cancelled).
+    pub fn poll(&mut self) -> Option<(DialogPurpose, Vec<PathBuf>)> {
         let (purpose, rx) = self.running.as_ref()?;
         let purpose = *purpose;
         let answer = match rx.try_recv() {
             Ok(a) => a,
             Err(std::sync::mpsc::TryRecvError::Empty) => return None,
             // The worker died without answering: treat as cancelled.
-            Err(std::sync::mpsc::TryRecvError::Disconnected) => None,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => Vec::new(),
         };
         self.running = None;
         Some((purpose, answer))
@@ -227,6 +271,7 @@ impl crate::Studio {
                 .and_then(|d| d.path.file_name())
                 .map(|n| n.to_string_lossy().into_owned()),
             DialogPurpose::ExportRender => self.current_photo.as_ref().map(|p| format!("{p}.png")),
+            DialogPurpose::NewSiteFile => Some("site.toml".into()),
             _ => None,
         };
         let request = DialogRequest {
@@ -247,7 +292,11 @@ impl crate::Studio {
         let Some((purpose, answer)) = self.dialogs.poll() else {
             return;
         };
-        let Some(path) = answer else {
+        if purpose == DialogPurpose::NewSitePhotos {
+            self.new_site.add_photos(answer);
+            return;
+        }
+        let Some(path) = answer.into_iter().next() else {
             return;
         };
         match purpose {
@@ -262,6 +311,8 @@ impl crate::Studio {
                 self.render.export_path = path.to_string_lossy().into_owned();
                 self.export_render();
             }
+            DialogPurpose::NewSiteFile => self.new_site.set_site_path(&path),
+            DialogPurpose::NewSitePhotos => {}
         }
     }
 
@@ -298,6 +349,10 @@ impl crate::Studio {
             let ctx = ui.ctx().clone();
             let busy = self.dialogs.busy();
             let has_doc = self.doc.is_some();
+            if ui.button("New site…").clicked() {
+                self.new_site.open = true;
+                ui.close();
+            }
             if ui
                 .add_enabled(!busy, egui::Button::new("Open site…"))
                 .clicked()
@@ -406,10 +461,38 @@ mod tests {
         };
         assert_eq!(
             answer,
-            (DialogPurpose::OpenSite, Some(PathBuf::from("/x/site.toml")))
+            (DialogPurpose::OpenSite, vec![PathBuf::from("/x/site.toml")])
         );
         assert!(!w.busy());
         assert!(w.poll().is_none());
+    }
+
+    #[test]
+    fn a_multi_select_dialog_falls_back_to_the_single_pick() {
+        let ctx = egui::Context::default();
+        let mut w = DialogWorker::new(Arc::new(Fixed(PathBuf::from("/x/p1.jpg"))));
+        let req = DialogRequest {
+            purpose: DialogPurpose::NewSitePhotos,
+            start_dir: None,
+            file_name: None,
+        };
+        assert!(req.purpose.is_multi() && !req.purpose.is_save());
+        assert!(w.start(req, &ctx));
+        let start = std::time::Instant::now();
+        let answer = loop {
+            if let Some(a) = w.poll() {
+                break a;
+            }
+            assert!(start.elapsed().as_secs() < 10, "worker never answered");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        };
+        assert_eq!(
+            answer,
+            (
+                DialogPurpose::NewSitePhotos,
+                vec![PathBuf::from("/x/p1.jpg")]
+            )
+        );
     }
 
     #[test]

@@ -18,6 +18,8 @@ pub mod autosave;
 pub mod commands;
 pub mod files;
 pub mod models_panel;
+pub mod new_site;
+pub mod photo_settings;
 mod photo_view;
 pub mod points;
 pub mod render_panel;
@@ -106,6 +108,8 @@ pub struct Studio {
     dialogs: files::DialogWorker,
     /// Enter was pressed on the photo in the Scene tab: close the polygon after the frame.
     close_polygon: bool,
+    new_site: new_site::NewSiteDialog,
+    photo_settings: photo_settings::PhotoSettings,
 }
 
 impl Studio {
@@ -144,6 +148,8 @@ impl Studio {
             scene: scene_panel::ScenePanel::default(),
             dialogs: files::DialogWorker::default(),
             close_polygon: false,
+            new_site: new_site::NewSiteDialog::default(),
+            photo_settings: photo_settings::PhotoSettings::default(),
         };
         s.open(&options.site_path);
         s
@@ -503,6 +509,8 @@ impl Studio {
         egui::CentralPanel::default()
             .frame(frame)
             .show(ui, |ui| self.photo_view_ui(ui));
+        self.new_site_ui(&ctx);
+        self.photo_settings_ui(&ctx);
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
         }
@@ -606,6 +614,11 @@ impl Studio {
         }
         if let Some(id) = chosen {
             self.select_photo(&id);
+        }
+        if let Some(id) = self.current_photo.clone()
+            && ui.button("Camera settings").clicked()
+        {
+            self.open_photo_settings(&id);
         }
     }
 
