@@ -109,10 +109,13 @@ pub struct ModelsPanel {
     pub new_up_axis: Option<String>,
     /// Per model id: the (file, units, up axis) it was imported with and the result (errors are
     /// cached too, so a broken file is not re-read every frame).
-    cache: HashMap<String, ((String, String, String), Result<LocalEdges, String>)>,
+    cache: HashMap<String, (CacheKey, Result<LocalEdges, String>)>,
 }
 
-fn cache_key(m: &CadModel) -> (String, String, String) {
+/// What a model's import depends on: its file, units and up axis.
+type CacheKey = (String, String, String);
+
+fn cache_key(m: &CadModel) -> CacheKey {
     (m.file.clone(), m.units.clone(), m.up_axis.clone())
 }
 
