@@ -5,7 +5,8 @@
 //! montage preview progressively ([`render_panel`]), places CAD models with a wireframe overlay
 //! ([`models_panel`]) and builds scene geometry ([`scene_panel`], vertices picked on the photo
 //! with [`scene_pick`]); the File menu opens native dialogs on a worker and lists recent sites
-//! ([`files`]).
+//! ([`files`]) and creates a site from photos ([`new_site`]); each photo's interior orientation
+//! is edited in its camera settings ([`photo_settings`]).
 //!
 //! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
@@ -187,6 +188,7 @@ impl Studio {
                 self.photos.clear();
                 self.solution = None;
                 self.selected_point = None;
+                self.photo_settings = photo_settings::PhotoSettings::default();
                 self.viewport = Viewport::default();
                 self.doc = Some(doc);
                 self.ui_state.remember(path);

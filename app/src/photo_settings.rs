@@ -83,7 +83,9 @@ fn settings_ui(
         }
         Some(interior) => {
             let mut i = interior.clone();
+            // Drags of one value merge into one undo step; the centre toggle is a step of its own.
             let mut changed = false;
+            let mut toggled = false;
             if let Some([w, h]) = size {
                 ui.label(format!("image {w} × {h} px"));
             }
@@ -105,13 +107,27 @@ fn settings_ui(
                         let [w, h] = size.unwrap_or([0, 0]);
                         Some([f64::from(w) / 2.0, f64::from(h) / 2.0])
                     };
-                    changed = true;
+                    toggled = true;
                 }
                 ui.end_row();
                 if let Some(pp) = i.principal_point_px.as_mut() {
-                    changed |= drag(ui, "principal x px", "principal x px", &mut pp[0], 0.1, 3);
+                    changed |= drag(
+                        ui,
+                        "principal x px",
+                        "principal point x",
+                        &mut pp[0],
+                        0.1,
+                        3,
+                    );
                     ui.end_row();
-                    changed |= drag(ui, "principal y px", "principal y px", &mut pp[1], 0.1, 3);
+                    changed |= drag(
+                        ui,
+                        "principal y px",
+                        "principal point y",
+                        &mut pp[1],
+                        0.1,
+                        3,
+                    );
                     ui.end_row();
                 }
                 let d = &mut i.distortion;
@@ -122,18 +138,18 @@ fn settings_ui(
                     ("p1", &mut d.p1),
                     ("p2", &mut d.p2),
                 ] {
-                    changed |= drag(ui, name, name, v, 1e-4, 8);
+                    changed |= drag(ui, name, &format!("distortion {name}"), v, 1e-4, 8);
                     ui.end_row();
                 }
             });
-            if changed {
+            if changed || toggled {
                 commands.push((
                     Command::SetOrientation {
                         photo: id.clone(),
                         interior: Some(i),
                         exterior: photo.exterior.clone(),
                     },
-                    Some(format!("interior {id}")),
+                    (!toggled).then(|| format!("interior {id}")),
                 ));
             }
         }
@@ -195,6 +211,8 @@ impl crate::Studio {
             .id(egui::Id::unique("photo settings"))
             .open(&mut open)
             .collapsible(false)
+            // Right of the photo strip, below the toolbar (Undo stays reachable).
+            .default_pos(egui::pos2(170.0, 60.0))
             .show(ctx, |ui| {
                 settings_ui(ui, &photo, size_px, &mut commands);
                 ui.separator();

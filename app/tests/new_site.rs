@@ -343,3 +343,43 @@ fn typed_paths_and_readable_errors_change_nothing() {
     assert_eq!(doc.site.photos.len(), 1);
     assert_eq!(doc.site.photos[0].file, "photos/P1.png");
 }
+
+#[test]
+fn a_photo_without_interior_gets_one_entered_by_hand_undoably() {
+    let (_dir, sample_site) = copy_sample();
+    let mut doc = SiteDocument::load(&sample_site).unwrap();
+    doc.site.photos[0].interior = None;
+    doc.save().unwrap();
+    let mut h = harness(&sample_site, WINDOW);
+    h.get_by_label("Camera settings").click();
+    h.run();
+    h.get_by_label("Enter by hand").click();
+    h.run();
+    let p1 = |h: &Harness<'static, Studio>| h.state().document().unwrap().site.photos[0].clone();
+    let i = p1(&h).interior.expect("entered");
+    // The fallback start: the diagonal of 1600 × 1200, exactly 2000 px; size from the file.
+    assert_eq!(i.image_size_px, Some([1600, 1200]));
+    assert!((i.focal_px - 2000.0).abs() < 1e-9);
+    // Principal point off the centre, then a distortion coefficient: each one undo step.
+    h.get_by_label("principal point at centre").click();
+    h.run();
+    assert_eq!(
+        p1(&h).interior.unwrap().principal_point_px,
+        Some([800.0, 600.0])
+    );
+    h.get_by_label("distortion k2").set_value_accesskit(-0.01);
+    h.run();
+    assert_eq!(
+        p1(&h).interior.unwrap().distortion.k2.to_bits(),
+        (-0.01f64).to_bits()
+    );
+    h.get_by_label("Close camera settings").click();
+    h.run();
+    assert!(h.query_by_label("Close camera settings").is_none());
+    for _ in 0..3 {
+        h.get_by_label("Undo").click();
+        h.run();
+    }
+    assert_eq!(p1(&h).interior, None);
+    assert_eq!(h.state().document().unwrap().site, doc.site);
+}
