@@ -26,6 +26,7 @@ pub mod scene_pick;
 pub mod solve;
 pub mod state;
 pub mod viewport;
+pub mod window;
 
 use eframe::egui::{self, Color32, Key, Pos2};
 use photomontage::site::{Observation, SiteDocument, SiteSolution};

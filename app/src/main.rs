@@ -10,7 +10,7 @@
 
 use anyhow::{Context as _, bail};
 use eframe::egui;
-use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state};
+use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state, window};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
@@ -178,12 +178,7 @@ fn main() -> anyhow::Result<()> {
     if args.headless {
         return run_headless(studio);
     }
-    let native = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_inner_size([1400.0, 860.0])
-            .with_title("photomontage studio"),
-        ..Default::default()
-    };
+    let native = window::native_options([1400.0, 860.0], "photomontage studio");
     let shell = Shell {
         studio,
         frames: args.frames.max(1),
