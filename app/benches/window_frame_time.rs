@@ -137,10 +137,11 @@ fn main() {
     };
     let site_path = dir.path().join("site.toml");
     site.save(&site_path).expect("site");
-    let studio = Studio::new(StudioOptions {
+    let mut studio = Studio::new(StudioOptions {
         site_path,
         state_path: None,
     });
+    studio.set_host_clears_to_panel_fill(true);
     let baseline = std::env::args().any(|a| a == "baseline");
     let bench = Bench {
         studio,
@@ -191,6 +192,10 @@ struct Recorder {
 impl eframe::App for Recorder {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         self.bench.ui(ui, frame);
+    }
+
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        window::clear_colour(visuals)
     }
 
     fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {

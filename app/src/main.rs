@@ -137,6 +137,10 @@ impl eframe::App for Shell {
         ctx.request_repaint();
     }
 
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        window::clear_colour(visuals)
+    }
+
     fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
         self.studio.on_exit();
     }
@@ -172,6 +176,7 @@ fn main() -> anyhow::Result<()> {
         },
     };
     let mut studio = Studio::new(options);
+    studio.set_host_clears_to_panel_fill(!args.headless);
     if let Some(script) = &args.script {
         apply_script(&mut studio, script)?;
     }

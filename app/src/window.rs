@@ -6,6 +6,10 @@
 //! own pixel values where users place observations at sub-pixel precision. It is also the most
 //! expensive per-pixel step on a CPU rasteriser (docs/benchmarks.md, window frame time).
 //!
+//! The window clears every frame to the panel colour ([`clear_colour`]) and tells the studio
+//! so ([`crate::Studio::set_host_clears_to_panel_fill`]): the panels then leave their
+//! backgrounds unpainted, which halves the pixels filled per frame.
+//!
 //! # Known limitations
 //! Gradients that egui computes (shadows of popups) can show banding on 8-bit displays.
 
@@ -21,4 +25,11 @@ pub fn native_options(inner_size: [f32; 2], title: &str) -> eframe::NativeOption
         dithering: false,
         ..Default::default()
     }
+}
+
+/// The colour the studio window clears to every frame: the panel fill, so that panels need
+/// not paint their backgrounds (for `eframe::App::clear_color`).
+#[must_use]
+pub fn clear_colour(visuals: &egui::Visuals) -> [f32; 4] {
+    visuals.panel_fill.to_normalized_gamma_f32()
 }
