@@ -29,6 +29,7 @@ pub mod scene_pick;
 pub mod solve;
 pub mod state;
 pub mod viewport;
+pub mod window;
 
 use eframe::egui::{self, Color32, Key, Pos2};
 use photomontage::site::{Observation, SiteDocument, SiteSolution};
@@ -111,6 +112,8 @@ pub struct Studio {
     close_polygon: bool,
     new_site: new_site::NewSiteDialog,
     photo_settings: photo_settings::PhotoSettings,
+    /// The window clears to the panel colour, so panels need not fill their backgrounds.
+    host_clears_to_panel_fill: bool,
 }
 
 impl Studio {
@@ -151,6 +154,7 @@ impl Studio {
             close_polygon: false,
             new_site: new_site::NewSiteDialog::default(),
             photo_settings: photo_settings::PhotoSettings::default(),
+            host_clears_to_panel_fill: false,
         };
         s.open(&options.site_path);
         s
@@ -252,6 +256,15 @@ impl Studio {
     /// Zoom and pan of the photo view (mutable: benches drive it).
     pub fn viewport_mut(&mut self) -> &mut Viewport {
         &mut self.viewport
+    }
+
+    /// Tells the studio that its host clears every frame to `visuals.panel_fill` (the real
+    /// window does: see [`window::clear_colour`]), so the panels skip painting their own
+    /// backgrounds. The picture is the same; on a CPU rasteriser it saves filling about half
+    /// the window every frame (docs/benchmarks.md, window frame time). Off by default: test
+    /// harnesses clear to transparent.
+    pub fn set_host_clears_to_panel_fill(&mut self, clears: bool) {
+        self.host_clears_to_panel_fill = clears;
     }
 
     /// Whether no worker is running and the current photo is fully decoded and uploaded.
@@ -494,15 +507,24 @@ impl Studio {
         let ctx = ui.ctx().clone();
         self.poll_workers(&ctx);
         self.shortcuts(&ctx);
-        egui::Panel::top("toolbar").show(ui, |ui| self.toolbar_ui(ui));
+        let mut side_frame = egui::Frame::side_top_panel(ui.style());
+        if self.host_clears_to_panel_fill {
+            side_frame = side_frame.fill(Color32::TRANSPARENT);
+        }
+        egui::Panel::top("toolbar")
+            .frame(side_frame)
+            .show(ui, |ui| self.toolbar_ui(ui));
         egui::Panel::bottom("messages")
+            .frame(side_frame)
             .resizable(true)
             .default_size(70.0)
             .show(ui, |ui| self.messages_ui(ui));
         egui::Panel::left("photos")
+            .frame(side_frame)
             .default_size(150.0)
             .show(ui, |ui| self.photo_strip_ui(ui));
         egui::Panel::right("side")
+            .frame(side_frame)
             .default_size(560.0)
             .show(ui, |ui| self.side_ui(ui));
         // No panel fill: the photo view paints its own background around the photo only (each

@@ -10,7 +10,7 @@
 
 use anyhow::{Context as _, bail};
 use eframe::egui;
-use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state};
+use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state, window};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
@@ -137,6 +137,10 @@ impl eframe::App for Shell {
         ctx.request_repaint();
     }
 
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        window::clear_colour(visuals)
+    }
+
     fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
         self.studio.on_exit();
     }
@@ -172,18 +176,14 @@ fn main() -> anyhow::Result<()> {
         },
     };
     let mut studio = Studio::new(options);
+    studio.set_host_clears_to_panel_fill(!args.headless);
     if let Some(script) = &args.script {
         apply_script(&mut studio, script)?;
     }
     if args.headless {
         return run_headless(studio);
     }
-    let native = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_inner_size([1400.0, 860.0])
-            .with_title("photomontage studio"),
-        ..Default::default()
-    };
+    let native = window::native_options([1400.0, 860.0], "photomontage studio");
     let shell = Shell {
         studio,
         frames: args.frames.max(1),

@@ -27,12 +27,15 @@ impl Studio {
             return;
         };
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
-        // The central panel has no fill (see `Studio::ui`): paint its margin ring here.
-        let panel = rect.expand(CENTRAL_MARGIN);
-        for band in viewport::outside(panel, rect) {
-            ui.painter()
-                .with_clip_rect(panel)
-                .rect_filled(band, 0.0, ui.visuals().panel_fill);
+        // The central panel has no fill (see `Studio::ui`): paint its margin ring here, unless
+        // the window's clear colour already is the panel colour.
+        if !self.host_clears_to_panel_fill {
+            let panel = rect.expand(CENTRAL_MARGIN);
+            for band in viewport::outside(panel, rect) {
+                ui.painter()
+                    .with_clip_rect(panel)
+                    .rect_filled(band, 0.0, ui.visuals().panel_fill);
+            }
         }
         if !matches!(self.photos.get(&id), Some(PhotoView::Ready(_))) {
             ui.painter().rect_filled(rect, 0.0, BACKGROUND);

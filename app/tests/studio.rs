@@ -331,3 +331,53 @@ fn mask_messages(h: &mut egui_kittest::Harness<'static, photomontage_studio::Stu
         h.mask(r);
     }
 }
+
+/// The same shapes drawn over the same background: only blending order could differ, which it
+/// does not for opaque fills; one 8-bit level allows for rounding in the rasteriser.
+const CLEAR_PICTURE_TOL: u8 = 1;
+
+/// Shapes that fill a rectangle with exactly the panel colour.
+fn panel_fills(h: &egui_kittest::Harness<'static, photomontage_studio::Studio>) -> usize {
+    let fill = h.ctx.global_style().visuals.panel_fill;
+    h.output()
+        .shapes
+        .iter()
+        .filter(|s| matches!(&s.shape, eframe::egui::Shape::Rect(r) if r.fill == fill))
+        .count()
+}
+
+/// The real window clears to the panel colour and the panels then skip their own fill
+/// (`Studio::set_host_clears_to_panel_fill`): the picture must be the one the panels paint
+/// themselves. kittest draws every UI inside a frame filled with the panel colour, which plays
+/// the window's clear here, so the two frames must be the same picture while the one with the
+/// flag paints fewer panel-coloured rectangles.
+#[test]
+fn clearing_to_the_panel_colour_gives_the_same_picture() {
+    let (_dir, site_path) = copy_sample();
+    let mut h = harness(&site_path, [1100.0, 660.0]);
+    h.remove_cursor();
+    h.run();
+    let painted = h.render().expect("render");
+    let fills_painted = panel_fills(&h);
+    h.state_mut().set_host_clears_to_panel_fill(true);
+    // A state change requests no repaint by itself: step explicitly.
+    h.step();
+    h.run();
+    let cleared = h.render().expect("render");
+    let fills_cleared = panel_fills(&h);
+    assert!(
+        fills_cleared + 4 <= fills_painted,
+        "the four side panels must stop filling: {fills_painted} → {fills_cleared} panel fills"
+    );
+    assert_eq!(painted.dimensions(), cleared.dimensions());
+    let worst = painted
+        .pixels()
+        .zip(cleared.pixels())
+        .flat_map(|(a, b)| (0..4).map(move |k| a[k].abs_diff(b[k])))
+        .max()
+        .unwrap_or(0);
+    assert!(
+        worst <= CLEAR_PICTURE_TOL,
+        "the frames differ by {worst} levels"
+    );
+}

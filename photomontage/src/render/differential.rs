@@ -17,7 +17,8 @@
 //!   carried to the camera through eq. 2.
 //!
 //! A natural light counts as blocked by artificial objects when an any-hit against the artificial
-//! geometry succeeds and one against the natural geometry fails (separate BVHs). Shadow rays to
+//! geometry succeeds and one against the natural geometry fails (separate BVHs); glass panes take
+//! only the fraction they do not transmit ([`super::glass`]). Shadow rays to
 //! the artificial BVH are first culled by its bounding box, so the cost of proving that a pixel is
 //! unchanged is one closest hit plus a slab test per light.
 //!
@@ -41,8 +42,8 @@
 //! # Known limitations
 //! Secondary rays that hit natural objects take their apparent colour from the current photo only
 //! (not from the polygon's image attribute photo), when the point is visible in it; otherwise the
-//! library material is shaded by eq. 6. Glass is a thin pane (no refraction through solids) and
-//! opaque to shadow rays; the glossy lobe is sampled with few rays (see [`super::specular`]).
+//! library material is shaded by eq. 6. Glass is a thin pane (no refraction through solids;
+//! shadow rays pass it attenuated but straight); the glossy lobe is sampled with few rays (see [`super::specular`]).
 //! The gather is one bounce on a fixed facet set (deterministic, so it has
 //! quantisation error rather than noise); the artificial radiance a natural point gathers takes sky
 //! facets as visible and gets its own photo bounce only from the coarser nested dome; natural surfaces blocked from the photo's view
@@ -58,8 +59,8 @@ use nalgebra::{Point2, Point3, Vector3};
 
 use super::glass::PhotoBehind;
 use super::illumination::{
-    Daylight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour, mul,
-    natural_irradiance_rgb, scale,
+    Daylight, DistantLight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour,
+    mul, natural_irradiance_rgb, natural_irradiance_weighted_rgb, scale,
 };
 use super::irradiance_cache::{GatherKind, IrradianceCacheSettings, MeanDistance, cached_gather};
 use super::luminaire_light::ArtificialLight;
@@ -142,6 +143,9 @@ pub struct DifferentialTracer<'a> {
     all: SceneTracer,
     natural: Option<SceneTracer>,
     artificial: SceneTracer,
+    /// The glass panes among the artificial triangles and the rest, when there are panes:
+    /// shadow rays pass panes attenuated ([`super::glass`]) and stop at the rest.
+    pub(super) artificial_split: Option<GlassSplit>,
     artificial_bounds_in_world_m: [Point3<f64>; 2],
     lighting: &'a Lighting,
     camera: &'a Camera,
@@ -172,9 +176,24 @@ fn water_noise_of(materials: &[Material]) -> Vec<Option<GradientNoise>> {
         .collect()
 }
 
-/// The triangles of `scene` whose object is of `kind`, as one object; material ids are kept
-/// (the materials are copied in order, so a hit's material id means the same in both scenes).
-fn sub_scene(scene: &Scene, kind: ObjectKind) -> Scene {
+/// The artificial triangles split into glass panes and opaque ones (BVHs over each; `opaque`
+/// is `None` when every artificial triangle is glass).
+#[derive(Debug, Clone)]
+pub(super) struct GlassSplit {
+    pub(super) glass: SceneTracer,
+    pub(super) opaque: Option<SceneTracer>,
+}
+
+/// The triangles of `scene` whose object is of `kind` (and, with `glass`, whose material is or
+/// is not glass), as one object; material ids are kept (the materials are copied in order, so
+/// a hit's material id means the same in both scenes).
+fn sub_scene(scene: &Scene, kind: ObjectKind, glass: Option<bool>) -> Scene {
+    let is_glass = |material: u32| {
+        scene
+            .materials()
+            .get(material as usize)
+            .is_some_and(|m| m.glass.is_some())
+    };
     let (triangles, triangle_materials): (Vec<[Point3<f64>; 3]>, Vec<u32>) = scene
         .triangles()
         .iter()
@@ -183,6 +202,7 @@ fn sub_scene(scene: &Scene, kind: ObjectKind) -> Scene {
                 .objects()
                 .get(t.object.0 as usize)
                 .is_some_and(|o| o.kind == kind)
+                && glass.is_none_or(|g| is_glass(t.material.0) == g)
         })
         .map(|t| (t.vertices_in_world_m, t.material.0))
         .unzip();
@@ -211,11 +231,25 @@ impl<'a> DifferentialTracer<'a> {
         photo_linear: &'a Rgb32FImage,
         max_depth: u32,
     ) -> Result<Self, DifferentialError> {
-        let artificial_scene = sub_scene(scene, ObjectKind::Artificial);
+        let artificial_scene = sub_scene(scene, ObjectKind::Artificial, None);
         let Some(artificial_bounds_in_world_m) = artificial_scene.bounding_box_in_world_m() else {
             return Err(DifferentialError::NoArtificialObject);
         };
-        let natural_scene = sub_scene(scene, ObjectKind::Natural);
+        let glass_scene = sub_scene(scene, ObjectKind::Artificial, Some(true));
+        let artificial_split = if glass_scene.triangles().is_empty() {
+            None
+        } else {
+            let opaque_scene = sub_scene(scene, ObjectKind::Artificial, Some(false));
+            Some(GlassSplit {
+                glass: SceneTracer::new(&glass_scene, BuildQuality::Medium)?,
+                opaque: if opaque_scene.triangles().is_empty() {
+                    None
+                } else {
+                    Some(SceneTracer::new(&opaque_scene, BuildQuality::Medium)?)
+                },
+            })
+        };
+        let natural_scene = sub_scene(scene, ObjectKind::Natural, None);
         let natural = if natural_scene.triangles().is_empty() {
             None
         } else {
@@ -226,6 +260,7 @@ impl<'a> DifferentialTracer<'a> {
             all: SceneTracer::new(scene, BuildQuality::Medium)?,
             natural,
             artificial: SceneTracer::new(&artificial_scene, BuildQuality::Medium)?,
+            artificial_split,
             artificial_bounds_in_world_m,
             lighting,
             camera,
@@ -255,6 +290,7 @@ impl<'a> DifferentialTracer<'a> {
             all: self.all.clone(),
             natural: self.natural.clone(),
             artificial: self.artificial.clone(),
+            artificial_split: self.artificial_split.clone(),
             artificial_bounds_in_world_m: self.artificial_bounds_in_world_m,
             lighting,
             camera: self.camera,
@@ -415,7 +451,12 @@ impl<'a> DifferentialTracer<'a> {
     }
 
     /// Whether the ray `origin + t·dir` can meet the artificial bounding box for t in [0, t_max].
-    fn may_hit_artificial(&self, origin: &Point3<f64>, dir: &Vector3<f64>, t_max: f64) -> bool {
+    pub(super) fn may_hit_artificial(
+        &self,
+        origin: &Point3<f64>,
+        dir: &Vector3<f64>,
+        t_max: f64,
+    ) -> bool {
         let [lo, hi] = self.artificial_bounds_in_world_m;
         let (mut t0, mut t1) = (0.0_f64, t_max);
         for k in 0..3 {
@@ -438,15 +479,38 @@ impl<'a> DifferentialTracer<'a> {
         true
     }
 
-    fn artificial_blocks(&self, origin: &Point3<f64>, dir: &Vector3<f64>, t_max: f64) -> bool {
-        self.may_hit_artificial(origin, dir, t_max)
-            && Self::blocked_by(&self.artificial, origin, dir, t_max)
+    /// The BVH over all geometry.
+    pub(super) fn all_tracer(&self) -> &SceneTracer {
+        &self.all
     }
 
-    fn natural_blocks(&self, origin: &Point3<f64>, dir: &Vector3<f64>, t_max: f64) -> bool {
+    /// The BVH over the artificial geometry (panes included).
+    pub(super) fn artificial_tracer(&self) -> &SceneTracer {
+        &self.artificial
+    }
+
+    pub(super) fn natural_blocks(
+        &self,
+        origin: &Point3<f64>,
+        dir: &Vector3<f64>,
+        t_max: f64,
+    ) -> bool {
         self.natural
             .as_ref()
             .is_some_and(|n| Self::blocked_by(n, origin, dir, t_max))
+    }
+
+    /// Fraction of the sun reaching the offset point `origin` of a surface with geometric
+    /// `normal` (zero from behind or without a sun); see [`Self::light_transmittance`].
+    fn sun_transmittance(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
+        self.lighting
+            .daylight
+            .sun
+            .as_ref()
+            .filter(|s| s.dir_in_world.dot(normal) > 0.0)
+            .map_or([0.0; 3], |s| {
+                self.light_transmittance(origin, &s.dir_in_world, f64::INFINITY)
+            })
     }
 
     /// The artificial lights that reach the surface point `point` (in front of the geometric
@@ -467,10 +531,14 @@ impl<'a> DifferentialTracer<'a> {
                 continue;
             }
             let dir = to_light / dist;
-            if !Self::blocked_by(&self.all, origin, &dir, dist - SURFACE_OFFSET_M) {
+            let passed = self.light_transmittance(origin, &dir, dist - SURFACE_OFFSET_M);
+            if passed.iter().any(|&x| x > 0.0) {
                 let to_light_from_point = light.position_in_world_m() - point;
                 let dir_from_point = to_light_from_point.try_normalize(0.0).unwrap_or(dir);
-                out.push((dir_from_point, light.normal_irradiance_rgb(point)));
+                out.push((
+                    dir_from_point,
+                    mul(light.normal_irradiance_rgb(point), passed),
+                ));
             }
         }
         out
@@ -553,18 +621,11 @@ impl<'a> DifferentialTracer<'a> {
         let shading_normal = shading_normal(material, noise, point, &normal, dir_in_world);
         let rho = material.map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
         let daylight = &self.lighting.daylight;
-        let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
-            s.dir_in_world.dot(&normal) > 0.0
-                && !Self::blocked_by(&self.all, &origin, &s.dir_in_world, f64::INFINITY)
-        });
-        let e_natural = natural_irradiance_rgb(daylight, &shading_normal, sun_visible, |i| {
-            !Self::blocked_by(
-                &self.all,
-                &origin,
-                &daylight.sky[i].dir_in_world,
-                f64::INFINITY,
-            )
-        });
+        let sun_passed = self.sun_transmittance(&origin, &normal);
+        let e_natural =
+            natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |i| {
+                self.light_transmittance(&origin, &daylight.sky[i].dir_in_world, f64::INFINITY)
+            });
         let lights = self.visible_artificial_lights(point, &origin, &normal);
         let mut e = add(
             e_natural,
@@ -592,10 +653,24 @@ impl<'a> DifferentialTracer<'a> {
                     normal: &normal,
                     shading_normal: &shading_normal,
                 };
-                let sun = daylight.sun.as_ref().filter(|_| sun_visible);
+                // The sun as it reaches the point (through panes: attenuated).
+                let sun = daylight
+                    .sun
+                    .filter(|_| sun_passed.iter().any(|&x| x > 0.0))
+                    .map(|s| DistantLight {
+                        normal_irradiance_rgb: mul(s.normal_irradiance_rgb, sun_passed),
+                        ..s
+                    });
                 l0 = add(
                     l0,
-                    self.specular_radiance(spec, &frame, dir_in_world, sun, &lights, depth),
+                    self.specular_radiance(
+                        spec,
+                        &frame,
+                        dir_in_world,
+                        sun.as_ref(),
+                        &lights,
+                        depth,
+                    ),
                 );
             }
             if let (Some(glass), true) = (&m.glass, depth < self.max_depth) {
@@ -638,26 +713,29 @@ impl<'a> DifferentialTracer<'a> {
         let daylight = &self.lighting.daylight;
         let inf = f64::INFINITY;
 
-        // D3 candidates: natural lights that an artificial object blocks (and no natural one).
-        let sun_d3 = daylight.sun.as_ref().is_some_and(|s| {
-            s.dir_in_world.dot(&normal) > 0.0
-                && self.artificial_blocks(&origin, &s.dir_in_world, inf)
-                && !self.natural_blocks(&origin, &s.dir_in_world, inf)
-        });
-        let sky_d3: Vec<usize> = (0..daylight.sky.len())
-            .filter(|&i| {
-                let d = &daylight.sky[i].dir_in_world;
-                d.dot(&normal) > 0.0
-                    && self.artificial_blocks(&origin, d, inf)
-                    && !self.natural_blocks(&origin, d, inf)
-            })
+        // D3 candidates: natural lights that an artificial object blocks (and no natural one),
+        // with the fraction per channel it takes (1 when opaque, 1 − Π T_pane through panes).
+        let blocked_fraction = |d: &Vector3<f64>| -> Option<Rgb> {
+            if d.dot(&normal) <= 0.0 {
+                return None;
+            }
+            let passed = self.artificial_transmittance(&origin, d, inf);
+            (passed.iter().any(|&x| x < 1.0) && !self.natural_blocks(&origin, d, inf))
+                .then(|| passed.map(|x| 1.0 - x))
+        };
+        let sun_d3 = daylight
+            .sun
+            .as_ref()
+            .and_then(|s| blocked_fraction(&s.dir_in_world));
+        let sky_d3: Vec<(usize, Rgb)> = (0..daylight.sky.len())
+            .filter_map(|i| blocked_fraction(&daylight.sky[i].dir_in_world).map(|b| (i, b)))
             .collect();
         // D1: artificial lights add.
         let (e_d1, lit_d1) = Self::artificial_light_irradiance(
             &self.visible_artificial_lights(point, &origin, &normal),
             &normal,
         );
-        let unchanged = !sun_d3 && sky_d3.is_empty() && !lit_d1;
+        let unchanged = sun_d3.is_none() && sky_d3.is_empty() && !lit_d1;
         if unchanged {
             // D2 only: the natural light is already in the photo.
             if photo_distance_m.to_bits() == distance_m.to_bits() {
@@ -691,11 +769,11 @@ impl<'a> DifferentialTracer<'a> {
         };
         // D3: the blocked natural irradiance, negated.
         let mut e_d3 = [0.0; 3];
-        if sun_d3 && let Some(s) = &daylight.sun {
-            e_d3 = add(e_d3, s.irradiance_rgb(&normal));
+        if let (Some(blocked), Some(s)) = (sun_d3, &daylight.sun) {
+            e_d3 = add(e_d3, mul(s.irradiance_rgb(&normal), blocked));
         }
-        for &i in &sky_d3 {
-            e_d3 = add(e_d3, daylight.sky[i].irradiance_rgb(&normal));
+        for &(i, blocked) in &sky_d3 {
+            e_d3 = add(e_d3, mul(daylight.sky[i].irradiance_rgb(&normal), blocked));
         }
         // D1 for the light the artificial objects reflect onto the point: `e_reflected`.
         let e_inter_change = add(e_inter_after, scale(e_inter_before, -1.0));
@@ -934,12 +1012,9 @@ impl<'a> DifferentialTracer<'a> {
         let rho = self
             .material_of(hit)
             .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
-        let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
-            s.dir_in_world.dot(&normal) > 0.0
-                && !Self::blocked_by(&self.all, &origin, &s.dir_in_world, f64::INFINITY)
-        });
+        let sun_passed = self.sun_transmittance(&origin, &normal);
         let e = add(
-            natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true),
+            natural_irradiance_weighted_rgb(daylight, &normal, sun_passed, |_| [1.0; 3]),
             self.cached_photo_bounce(GatherKind::ArtificialNested, &origin, &normal),
         );
         self.apparent(diffuse_radiance_rgb(rho, e), distance_m)
@@ -1011,35 +1086,40 @@ impl<'a> DifferentialTracer<'a> {
         let l0 = match self.photo_colour_of(point) {
             Some((photo_rgb, photo_distance_m)) => {
                 let l0 = self.true_colour(photo_rgb, photo_distance_m);
-                let sun_d3 = with_artificial
-                    && sun_natural
-                    && daylight.sun.as_ref().is_some_and(|s| {
-                        self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
-                    });
-                match (sun_d3, &daylight.sun) {
-                    (true, Some(s)) => {
-                        diffuse_reflectance_from_true_colour(l0, e_natural).map_or(l0, |rho| {
-                            add(
-                                l0,
-                                scale(diffuse_radiance_rgb(rho, s.irradiance_rgb(&normal)), -1.0),
-                            )
-                        })
-                    }
-                    _ => l0,
+                // The fraction of the sun the artificial objects take (D3 at the bounce).
+                let sun_d3 = daylight
+                    .sun
+                    .as_ref()
+                    .filter(|_| with_artificial && sun_natural)
+                    .map(|s| {
+                        let passed =
+                            self.artificial_transmittance(&origin, &s.dir_in_world, f64::INFINITY);
+                        (s, passed.map(|x| 1.0 - x))
+                    })
+                    .filter(|(_, blocked)| blocked.iter().any(|&x| x > 0.0));
+                match sun_d3 {
+                    Some((s, blocked)) => diffuse_reflectance_from_true_colour(l0, e_natural)
+                        .map_or(l0, |rho| {
+                            let e_blocked = mul(s.irradiance_rgb(&normal), blocked);
+                            add(l0, scale(diffuse_radiance_rgb(rho, e_blocked), -1.0))
+                        }),
+                    None => l0,
                 }
             }
             None => {
                 let rho = self
                     .material_of(hit)
                     .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
-                let sun_visible = sun_natural
-                    && daylight.sun.as_ref().is_some_and(|s| {
-                        !with_artificial
-                            || !self.artificial_blocks(&origin, &s.dir_in_world, f64::INFINITY)
-                    });
+                let sun_passed = match (&daylight.sun, sun_natural, with_artificial) {
+                    (Some(s), true, true) => {
+                        self.artificial_transmittance(&origin, &s.dir_in_world, f64::INFINITY)
+                    }
+                    (Some(_), true, false) => [1.0; 3],
+                    _ => [0.0; 3],
+                };
                 diffuse_radiance_rgb(
                     rho,
-                    natural_irradiance_rgb(daylight, &normal, sun_visible, |_| true),
+                    natural_irradiance_weighted_rgb(daylight, &normal, sun_passed, |_| [1.0; 3]),
                 )
             }
         };

@@ -175,13 +175,37 @@ pub fn natural_irradiance_rgb(
     sun_visible: bool,
     mut sky_visible: impl FnMut(usize) -> bool,
 ) -> Rgb {
+    let weight = |visible: bool| if visible { [1.0; 3] } else { [0.0; 3] };
+    natural_irradiance_weighted_rgb(daylight, normal_in_world, weight(sun_visible), |i| {
+        weight(sky_visible(i))
+    })
+}
+
+/// [`natural_irradiance_rgb`] with a fraction per channel of each light reaching the point
+/// (0 blocked, 1 unobstructed, between when it passes glass panes): the sun's `sun_rgb`, sky
+/// facet `i`'s `sky_rgb(i)` (asked only for facets above the surface). Lights with a zero
+/// fraction are skipped and a fraction of 1 multiplies exactly, so with 0/1 fractions the sum
+/// is bit for bit the unweighted one.
+#[must_use]
+pub fn natural_irradiance_weighted_rgb(
+    daylight: &Daylight,
+    normal_in_world: &Vector3<f64>,
+    sun_rgb: Rgb,
+    mut sky_rgb: impl FnMut(usize) -> Rgb,
+) -> Rgb {
+    let reaches = |w: &Rgb| w.iter().any(|&x| x > 0.0);
     let mut e = daylight.ambient_irradiance_rgb();
-    if let (Some(sun), true) = (&daylight.sun, sun_visible) {
-        e = add(e, sun.irradiance_rgb(normal_in_world));
+    if let Some(sun) = &daylight.sun
+        && reaches(&sun_rgb)
+    {
+        e = add(e, mul(sun.irradiance_rgb(normal_in_world), sun_rgb));
     }
     for (i, facet) in daylight.sky.iter().enumerate() {
-        if facet.dir_in_world.dot(normal_in_world) > 0.0 && sky_visible(i) {
-            e = add(e, facet.irradiance_rgb(normal_in_world));
+        if facet.dir_in_world.dot(normal_in_world) > 0.0 {
+            let w = sky_rgb(i);
+            if reaches(&w) {
+                e = add(e, mul(facet.irradiance_rgb(normal_in_world), w));
+            }
         }
     }
     e

@@ -522,3 +522,98 @@ fn glossy_glass_and_spectral_renders_are_identical_for_one_and_two_threads() {
     assert_eq!(run(1, false), run(2, false));
     assert_eq!(run(1, true), run(2, true));
 }
+
+/// Unpolarised Fresnel reflectance of one air–glass interface (index `n`) at incidence
+/// cosine `cos_i`, written out from the Fresnel equations (independent of
+/// `Glass::fresnel_reflectance`).
+fn fresnel_unpolarised(n: f64, cos_i: f64) -> f64 {
+    let sin_t = (1.0 - cos_i * cos_i).sqrt() / n;
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = ((cos_i - n * cos_t) / (cos_i + n * cos_t)).powi(2);
+    let rp = ((n * cos_i - cos_t) / (n * cos_i + cos_t)).powi(2);
+    0.5 * (rs + rp)
+}
+
+/// Photographed ground (value `photo`) under sun from 45° and ambient light; a 20 × 20 m roof
+/// of `roof` material 50 m up casts its shadow 50 m to −x, where a camera 10 m up looks
+/// straight down (the roof is behind it). Returns the shadow pixel values.
+fn shadow_of_roof(roof: Material, photo: [f64; 3], k_s: [f64; 3], k_u: [f64; 3]) -> RenderedImage {
+    let mut scene = Scene::new();
+    add_quad(
+        &mut scene,
+        1000.0,
+        0.0,
+        Material::diffuse("ground", [0.3; 3]),
+        ObjectKind::Natural,
+    );
+    add_quad(&mut scene, 10.0, 50.0, roof, ObjectKind::Artificial);
+    let lighting = Lighting {
+        daylight: Daylight {
+            sun: Some(DistantLight {
+                dir_in_world: Vector3::new(1.0, 0.0, 1.0).normalize(),
+                normal_irradiance_rgb: k_s,
+            }),
+            ambient_radiance_rgb: k_u,
+            sky: Vec::new(),
+        },
+        ..Lighting::default()
+    };
+    let cam = looking_down(Point3::new(-50.0, 0.0, 0.0), 10.0, 20_000.0);
+    let photo = uniform_photo(photo);
+    let tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 2).unwrap();
+    render(&tracer, &RenderSettings::default())
+}
+
+#[test]
+fn a_glass_roof_takes_only_the_light_it_does_not_transmit_case_d3() {
+    let photo = [0.2, 0.25, 0.3];
+    let k_s = [3.0, 2.8, 2.5];
+    let k_u = [0.1, 0.12, 0.16];
+    let cos_sun = std::f64::consts::FRAC_1_SQRT_2;
+    // Natural irradiance on the ground: π k_u + k_s cos θ; eq. 10 gives ρ/π = photo / E.
+    let e_total = [0, 1, 2].map(|k| PI * k_u[k] + k_s[k] * cos_sun);
+    let e_sun = k_s.map(|k| k * cos_sun);
+
+    // Opaque roof: D3 removes all of the sun.
+    let opaque = shadow_of_roof(Material::diffuse("roof", [0.5; 3]), photo, k_s, k_u);
+    // Glass roof (n = 1.5, tinted): the sun crosses the pane at 45°.
+    let tau = [0.9, 0.8, 0.6];
+    let n = 1.5;
+    let glass = Material {
+        glass: Some(Glass {
+            ior: n,
+            transmittance_rgb: tau,
+        }),
+        ..Material::diffuse("glass roof", [0.0; 3])
+    };
+    let tinted = shadow_of_roof(glass, photo, k_s, k_u);
+    // Thin slab at 45°: R from the Fresnel equations, τ_θ = τ^(1/cos θ_t),
+    // T = τ_θ(1−R)²/(1−τ_θ²R²).
+    let r = fresnel_unpolarised(n, cos_sun);
+    let cos_t = (1.0 - 0.5 / (n * n)).sqrt();
+    let t_pane = tau.map(|t| {
+        let t_theta = t.powf(1.0 / cos_t);
+        t_theta * (1.0 - r).powi(2) / (1.0 - t_theta * t_theta * r * r)
+    });
+    for (o, g) in opaque.rgba.iter().zip(&tinted.rgba) {
+        for k in 0..3 {
+            let lit_fraction_opaque = 1.0 - e_sun[k] / e_total[k];
+            assert_rel(
+                o[k],
+                photo[k] * lit_fraction_opaque,
+                NARROW_VIEW_REL_TOL,
+                "opaque",
+            );
+            let lit_fraction_glass = 1.0 - (1.0 - t_pane[k]) * e_sun[k] / e_total[k];
+            assert_rel(
+                g[k],
+                photo[k] * lit_fraction_glass,
+                NARROW_VIEW_REL_TOL,
+                "glass",
+            );
+        }
+    }
+    // A tinted shadow: the red channel (τ = 0.9) keeps relatively more light than blue.
+    let px = tinted.rgba[0];
+    assert!(f64::from(px[0]) / photo[0] > f64::from(px[2]) / photo[2]);
+}
