@@ -100,6 +100,8 @@ impl crate::Studio {
             .open(&mut open)
             .collapsible(false)
             .default_width(520.0)
+            // Right of the photo strip, below the toolbar.
+            .default_pos(egui::pos2(170.0, 60.0))
             .show(ctx, |ui| {
                 let busy = self.dialogs.busy();
                 let d = &mut self.new_site;
