@@ -32,6 +32,8 @@ pub enum CommandError {
     NothingToUndo,
     #[error("nothing to redo")]
     NothingToRedo,
+    #[error("no sample `{id}`")]
+    NoSuchSample { id: String },
 }
 
 /// One edit of a site.
@@ -72,6 +74,8 @@ pub enum Command {
     RemoveModel { id: String },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
+    /// An edit of the lighting fit's data ([`crate::fit_commands`]).
+    Fit(crate::fit_commands::FitCommand),
 }
 
 impl Command {
@@ -93,6 +97,7 @@ impl Command {
             Self::RemoveModel { id } => format!("remove model {id}"),
             Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
+            Self::Fit(c) => c.describe(),
         }
     }
 }
@@ -276,6 +281,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
             inverses.reverse();
             Command::Batch(inverses)
         }
+        Command::Fit(c) => crate::fit_commands::apply(site, c)?,
     })
 }
 

@@ -4,7 +4,8 @@
 //! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
 //! montage preview progressively ([`render_panel`]), places CAD models with a wireframe overlay
 //! ([`models_panel`]) and builds scene geometry ([`scene_panel`], vertices picked on the photo
-//! with [`scene_pick`]); the File menu opens native dialogs on a worker and lists recent sites
+//! with [`scene_pick`]), picks lighting-fit samples on the photo and runs, shows and applies the
+//! fit ([`fit_panel`], [`fit_pick`]); the File menu opens native dialogs on a worker and lists recent sites
 //! ([`files`]).
 //!
 //! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
@@ -17,6 +18,9 @@
 pub mod autosave;
 pub mod commands;
 pub mod files;
+pub mod fit_commands;
+pub mod fit_panel;
+pub mod fit_pick;
 pub mod models_panel;
 mod photo_view;
 pub mod points;
@@ -74,6 +78,7 @@ enum SideTab {
     Render,
     Models,
     Scene,
+    Fit,
 }
 
 /// The studio app.
@@ -106,6 +111,7 @@ pub struct Studio {
     dialogs: files::DialogWorker,
     /// Enter was pressed on the photo in the Scene tab: close the polygon after the frame.
     close_polygon: bool,
+    fit: fit_panel::FitPanel,
 }
 
 impl Studio {
@@ -144,6 +150,7 @@ impl Studio {
             scene: scene_panel::ScenePanel::default(),
             dialogs: files::DialogWorker::default(),
             close_polygon: false,
+            fit: fit_panel::FitPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -182,6 +189,7 @@ impl Studio {
                 self.solution = None;
                 self.selected_point = None;
                 self.viewport = Viewport::default();
+                self.fit = fit_panel::FitPanel::default();
                 self.doc = Some(doc);
                 self.ui_state.remember(path);
                 self.persist_ui_state();
@@ -259,6 +267,7 @@ impl Studio {
             && !self.loader.busy()
             && !self.render.busy()
             && !self.dialogs.busy()
+            && !self.fit.worker.busy()
     }
 
     /// Whether edits are not yet in the autosave sidecar.
@@ -412,6 +421,7 @@ impl Studio {
         }
         self.poll_render(ctx);
         self.poll_dialogs(ctx);
+        self.poll_fit(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)
@@ -616,6 +626,8 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Render, "Render");
             ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
             ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Fit, "Fit");
+            points::name_widget(ui, &r, "Fit tab");
         });
         ui.separator();
         match self.tab {
@@ -624,6 +636,7 @@ impl Studio {
             SideTab::Render => self.render_tab_ui(ui),
             SideTab::Models => self.models_tab_ui(ui),
             SideTab::Scene => self.scene_tab_ui(ui),
+            SideTab::Fit => self.fit_tab_ui(ui),
         }
     }
 
