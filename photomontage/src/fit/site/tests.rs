@@ -8,6 +8,7 @@ use crate::site::{
     ControlPoint, Exterior, HorizonSample, Interior, Location, Photo, Polygon, Sample,
     SunShadowPair,
 };
+use crate::scene::{ObjectKind, SceneObject};
 use image::{Rgb, Rgb32FImage};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
