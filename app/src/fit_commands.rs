@@ -158,8 +158,10 @@ mod tests {
 
     #[test]
     fn sample_edits_undo_to_the_exact_site() {
-        let mut s = Site::default();
-        s.samples = vec![sample("S1"), sample("S2"), sample("S3")];
+        let mut s = Site {
+            samples: vec![sample("S1"), sample("S2"), sample("S3")],
+            ..Site::default()
+        };
         let original = s.clone();
         let mut h = History::default();
         h.apply(

@@ -4,11 +4,11 @@
 //! chosen), a material library with the material's ρ_d.
 
 use super::*;
+use crate::scene::{ObjectKind, SceneObject};
 use crate::site::{
     ControlPoint, Exterior, HorizonSample, Interior, Location, Photo, Polygon, Sample,
     SunShadowPair,
 };
-use crate::scene::{ObjectKind, SceneObject};
 use image::{Rgb, Rgb32FImage};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
