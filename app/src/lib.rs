@@ -189,6 +189,7 @@ impl Studio {
                 self.solution = None;
                 self.selected_point = None;
                 self.viewport = Viewport::default();
+                self.fit.worker.cancel();
                 self.fit = fit_panel::FitPanel::default();
                 self.doc = Some(doc);
                 self.ui_state.remember(path);
