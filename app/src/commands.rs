@@ -33,6 +33,8 @@ pub enum CommandError {
     NothingToUndo,
     #[error("nothing to redo")]
     NothingToRedo,
+    #[error("no sample `{id}`")]
+    NoSuchSample { id: String },
 }
 
 /// One edit of a site.
@@ -78,6 +80,8 @@ pub enum Command {
     },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
+    /// An edit of the lighting fit's data ([`crate::fit_commands`]).
+    Fit(crate::fit_commands::FitCommand),
 }
 
 impl Command {
@@ -100,6 +104,7 @@ impl Command {
             Self::SetSelfCalibration { photo, .. } => format!("self-calibration of {photo}"),
             Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
+            Self::Fit(c) => c.describe(),
         }
     }
 }
@@ -292,6 +297,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
             inverses.reverse();
             Command::Batch(inverses)
         }
+        Command::Fit(c) => crate::fit_commands::apply(site, c)?,
     })
 }
 

@@ -4,9 +4,10 @@
 //! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
 //! montage preview progressively ([`render_panel`]), places CAD models with a wireframe overlay
 //! ([`models_panel`]) and builds scene geometry ([`scene_panel`], vertices picked on the photo
-//! with [`scene_pick`]); the File menu opens native dialogs on a worker and lists recent sites
-//! ([`files`]) and creates a site from photos ([`new_site`]); each photo's interior orientation
-//! is edited in its camera settings ([`photo_settings`]).
+//! with [`scene_pick`]), picks lighting-fit samples on the photo and runs, shows and applies the
+//! fit ([`fit_panel`], [`fit_pick`]); the File menu opens native dialogs on a worker and lists
+//! recent sites ([`files`]) and creates a site from photos ([`new_site`]); each photo's interior
+//! orientation is edited in its camera settings ([`photo_settings`]).
 //!
 //! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
 //! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
@@ -18,6 +19,9 @@
 pub mod autosave;
 pub mod commands;
 pub mod files;
+pub mod fit_commands;
+pub mod fit_panel;
+pub mod fit_pick;
 pub mod models_panel;
 pub mod new_site;
 pub mod photo_settings;
@@ -78,6 +82,7 @@ enum SideTab {
     Render,
     Models,
     Scene,
+    Fit,
 }
 
 /// The studio app.
@@ -114,6 +119,7 @@ pub struct Studio {
     photo_settings: photo_settings::PhotoSettings,
     /// The window clears to the panel colour, so panels need not fill their backgrounds.
     host_clears_to_panel_fill: bool,
+    fit: fit_panel::FitPanel,
 }
 
 impl Studio {
@@ -155,6 +161,7 @@ impl Studio {
             new_site: new_site::NewSiteDialog::default(),
             photo_settings: photo_settings::PhotoSettings::default(),
             host_clears_to_panel_fill: false,
+            fit: fit_panel::FitPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -194,6 +201,8 @@ impl Studio {
                 self.selected_point = None;
                 self.photo_settings = photo_settings::PhotoSettings::default();
                 self.viewport = Viewport::default();
+                self.fit.worker.cancel();
+                self.fit = fit_panel::FitPanel::default();
                 self.doc = Some(doc);
                 self.ui_state.remember(path);
                 self.persist_ui_state();
@@ -280,6 +289,7 @@ impl Studio {
             && !self.loader.busy()
             && !self.render.busy()
             && !self.dialogs.busy()
+            && !self.fit.worker.busy()
     }
 
     /// Whether edits are not yet in the autosave sidecar.
@@ -433,6 +443,7 @@ impl Studio {
         }
         self.poll_render(ctx);
         self.poll_dialogs(ctx);
+        self.poll_fit(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)
@@ -653,6 +664,8 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Render, "Render");
             ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
             ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Fit, "Fit");
+            points::name_widget(ui, &r, "Fit tab");
         });
         ui.separator();
         match self.tab {
@@ -661,6 +674,7 @@ impl Studio {
             SideTab::Render => self.render_tab_ui(ui),
             SideTab::Models => self.models_tab_ui(ui),
             SideTab::Scene => self.scene_tab_ui(ui),
+            SideTab::Fit => self.fit_tab_ui(ui),
         }
     }
 

@@ -83,12 +83,13 @@ impl Studio {
         }
         let t = self.viewport.transform(rect);
         self.last_transform = Some(t);
-        if self.tab == crate::SideTab::Scene {
-            if !space {
-                self.vertex_pick_interaction(&response, &t, &id);
+        match self.tab {
+            crate::SideTab::Scene if !space => self.vertex_pick_interaction(&response, &t, &id),
+            crate::SideTab::Fit if !space => {
+                self.fit_pick_interaction(&response, &t, &id, size_px);
             }
-        } else {
-            self.observation_interaction(&response, &t, &id, space);
+            crate::SideTab::Scene | crate::SideTab::Fit => {}
+            _ => self.observation_interaction(&response, &t, &id, space),
         }
 
         let painter = ui.painter_at(rect);
@@ -112,11 +113,19 @@ impl Studio {
                 .paint(&ctx, &painter, &t, &id, size_px, &tone_map);
         }
         self.paint_wireframes(&painter, &t, &id);
-        self.paint_marks(&painter, &t, &id);
+        // The Fit tab shows its samples only (the observation marks would hide them).
+        let fit_tab = self.tab == crate::SideTab::Fit;
+        if !fit_tab {
+            self.paint_marks(&painter, &t, &id);
+        }
         if self.tab == crate::SideTab::Scene {
             self.paint_scene_overlay(&painter, &t, &id, response.hover_pos());
         }
+        if self.tab == crate::SideTab::Fit {
+            self.paint_fit_overlay(&painter, &t, &id);
+        }
         if self.ui_state.show_residuals
+            && !fit_tab
             && let (Some(sol), Some(doc)) = (&self.solution, &self.doc)
             && let Some(ps) = sol.photos.iter().find(|p| p.id == id)
         {

@@ -12,6 +12,8 @@
 //!   sample (E_r), gathered from its photo as the renderer does, subtracted in eq. 9.
 //! - [`colour`]: a sample's colour read robustly from the photo (median over a window, saturated
 //!   and underexposed pixels rejected), linearised.
+//! - [`pick`]: the scene polygon (and its material) a pixel of a photo shows, for picking
+//!   samples on the photo.
 //! - [`sun_check`]: the sun direction measured from an object/shadow pair against the SPA sun for
 //!   the photo's time, with the camera-clock offset that would explain a disagreement.
 //! - [`site`]: the glue that runs all of it on a site file; [`report`] its report and the
@@ -29,6 +31,7 @@ pub mod atmosphere;
 pub mod colour;
 pub mod daylight;
 pub mod interreflection;
+pub mod pick;
 pub mod report;
 pub mod site;
 pub mod sun_check;
@@ -63,6 +66,13 @@ pub struct FitIteration {
 pub trait FitObserver: Send + Sync {
     /// Called once per solver iteration.
     fn on_iteration(&self, event: &FitIteration);
+
+    /// Polled by [`site::fit_site`] between its steps (before each sample is located and read,
+    /// before each daylight fit pass): `true` stops the fit with
+    /// [`site::SiteFitError::Cancelled`]. The default never cancels.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// An observer that ignores everything.

@@ -45,7 +45,7 @@ pub use super::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport
 use super::sun_check::{DEFAULT_TOLERANCE_DEG, check_sun};
 use crate::atmosphere::{AtmosphereError, schachter::true_radiance};
 use crate::photo::PhotoImage;
-use crate::scene::{Material, MaterialLibrary, ObjectKind, Scene, SceneObject, SceneTracer};
+use crate::scene::{Material, MaterialLibrary, Scene, SceneTracer};
 use crate::site::render::{parse_sky_model, site_material_library, site_sun_dir};
 use crate::site::{SamplePurpose, Site, SiteDocument, stored_camera};
 use crate::sky_dome::durisch_facets::durisch_dome;
@@ -148,6 +148,17 @@ pub enum SiteFitError {
     /// The interreflection gather failed.
     #[error("interreflection: {0}")]
     Interreflection(String),
+    /// The observer asked to stop ([`FitObserver::cancelled`]).
+    #[error("the fit was cancelled")]
+    Cancelled,
+}
+
+/// [`SiteFitError::Cancelled`] when the observer asks to stop.
+fn check_cancel(observer: Option<&Arc<dyn FitObserver>>) -> Result<(), SiteFitError> {
+    if observer.is_some_and(|o| o.cancelled()) {
+        return Err(SiteFitError::Cancelled);
+    }
+    Ok(())
 }
 
 /// The natural scene of a site: its polygons with their materials (library definitions where
@@ -159,44 +170,7 @@ pub fn natural_scene(
     site: &Site,
     library: Option<&MaterialLibrary>,
 ) -> Result<(Scene, Vec<String>), String> {
-    let mut coords: HashMap<&str, [f64; 3]> = HashMap::new();
-    for t in &site.tie_points {
-        coords.insert(t.id.as_str(), t.xyz);
-    }
-    for c in &site.control_points {
-        coords.insert(c.id.as_str(), c.xyz);
-    }
-    let mut scene = Scene::new();
-    let mut warnings = Vec::new();
-    let object = scene
-        .add_object(SceneObject {
-            name: "natural polygons".into(),
-            kind: ObjectKind::Natural,
-            image_attribute: None,
-        })
-        .map_err(|e| e.to_string())?;
-    for poly in &site.polygons {
-        let Some(vertices) = poly
-            .vertices
-            .iter()
-            .map(|v| coords.get(v.as_str()).map(|p| Point3::from(*p)))
-            .collect::<Option<Vec<_>>>()
-        else {
-            warnings.push(format!(
-                "polygon `{}` skipped: a vertex has no coordinates yet (run `solve`)",
-                poly.id
-            ));
-            continue;
-        };
-        let material = library
-            .and_then(|l| l.get(&poly.material).cloned())
-            .unwrap_or_else(|| Material::diffuse(&poly.material, [0.5; 3]));
-        let id = scene.add_material(material).map_err(|e| e.to_string())?;
-        scene
-            .add_polygon(&vertices, id, object)
-            .map_err(|e| format!("polygon `{}`: {e}", poly.id))?;
-    }
-    Ok((scene, warnings))
+    super::pick::natural_scene_indexed(site, library).map(|(scene, _, warnings)| (scene, warnings))
 }
 
 /// The capture time of a photo: `taken_at`, else its EXIF time with offset.
@@ -397,6 +371,7 @@ pub fn fit_site(
         let tracer = SceneTracer::new(&scene, crate::bvh::BuildQuality::default())
             .map_err(|e| SiteFitError::Scene(e.to_string()))?;
         for s in &enabled {
+            check_cancel(observer.as_ref())?;
             match locate_sample(doc, s, &scene, &tracer, &mut photos, options, &mut warnings) {
                 Ok(l) => located.push(l),
                 Err(e) => warnings.push(format!("sample `{}` not used: {e}", s.id)),
@@ -714,6 +689,7 @@ fn run_fits(
         let mut previous: Option<DaylightFit> = None;
         let mut passes = 0_usize;
         let fit = loop {
+            check_cancel(observer.as_ref())?;
             passes += 1;
             if let Some(probe_scene) = &probe_scene {
                 let points: Vec<GatherPoint<'_>> = day_samples

@@ -4,6 +4,7 @@
 //! chosen), a material library with the material's ρ_d.
 
 use super::*;
+use crate::scene::{ObjectKind, SceneObject};
 use crate::site::{
     ControlPoint, Exterior, HorizonSample, Interior, Location, Photo, Polygon, Sample,
     SunShadowPair,
@@ -666,4 +667,20 @@ fn weights_rendered_by_the_renderer_are_recovered() {
         report.warnings
     );
     assert_recovered(&report, SYNTHETIC_SITE_REL);
+}
+
+#[test]
+fn an_observer_that_cancels_stops_the_fit() {
+    struct Stop;
+    impl FitObserver for Stop {
+        fn on_iteration(&self, _event: &crate::fit::FitIteration) {}
+        fn cancelled(&self) -> bool {
+            true
+        }
+    }
+    let syn = synthetic_site(24, None);
+    let r = fit_site(&syn.doc, &SiteFitOptions::default(), Some(Arc::new(Stop)));
+    assert!(matches!(r, Err(SiteFitError::Cancelled)), "{r:?}");
+    // Without the observer the same site fits (the cancel is what stopped it).
+    assert!(fit_site(&syn.doc, &SiteFitOptions::default(), None).is_ok());
 }

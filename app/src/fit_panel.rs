@@ -1,0 +1,767 @@
+//! The studio's Fit tab: the lighting fits of Durisch 1992 §4.2–4.3 (atmosphere eq. 7,
+//! daylight eq. 9) on the site's samples, as `photomontage fit` runs them.
+//!
+//! - The site's `[[samples]]` and `[[horizon_samples]]` in tables (egui_extras): purpose, median
+//!   window, on/off, delete, and the `[fit_settings]` toggles; every change is a
+//!   [`crate::fit_commands::FitCommand`] through the one command path (undo/redo, autosave).
+//!   Samples are picked on the photo ([`crate::fit_pick`]).
+//! - **Run fit** calls `photomontage::fit::site::fit_site` (the CLI's call, default options) on a
+//!   snapshot of the site on a named worker thread; the solver iterations come back through a
+//!   `FitObserver` and are shown as progress, and the same observer carries **Cancel fit**. The results panel shows the report's numbers
+//!   formatted as the CLI prints them (5 decimals): τₐ over 1 km, L∞, k_s, k_u, k_h with σ,
+//!   absolute/relative weights, the sun cross-checks, the warnings and the residual table (flagged
+//!   rows in red). Errors (`SiteFitError`) are shown as their messages.
+//! - **Apply fit** writes the report into the site with `photomontage::fit::site::apply_fit`
+//!   (the CLI's write-back: `[lighting]` and the `[fit]` record) as one undoable edit, so a
+//!   later render uses the fitted lighting.
+//!
+//! # Known limitations
+//! **Cancel fit** stops the fit at its next step (before the next sample is read or the next
+//! daylight pass), not inside one (a pass of the interreflection gather may take seconds). The
+//! report belongs to the site as it was when the fit started; editing samples afterwards does
+//! not re-run it.
+
+use eframe::egui::{self, Color32};
+use egui_extras::{Column, TableBuilder};
+use photomontage::fit::site::{SiteFitOptions, SiteFitReport, apply_fit, fit_site};
+use photomontage::fit::{FitIteration, FitObserver, FitStage};
+use photomontage::site::{FitSettings, SamplePurpose, Site, SiteDocument};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use crate::commands::Command;
+use crate::fit_commands::FitCommand;
+use crate::points::name_widget;
+
+/// Colour of flagged rows and errors.
+pub const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
+/// Colour of warnings.
+pub const WARNING: Color32 = Color32::from_rgb(230, 160, 40);
+
+/// An RGB triple as `photomontage fit` prints it.
+#[must_use]
+pub fn rgb_text(v: [f64; 3]) -> String {
+    format!("{:.5} {:.5} {:.5}", v[0], v[1], v[2])
+}
+
+/// A σ triple as `photomontage fit` prints it (`—` where it cannot be estimated), after `±`.
+#[must_use]
+pub fn sigma_text(s: [Option<f64>; 3]) -> String {
+    let parts: Vec<String> = s
+        .iter()
+        .map(|x| x.map_or_else(|| "—".into(), |x| format!("{x:.5}")))
+        .collect();
+    format!("± {}", parts.join(" "))
+}
+
+/// The largest normalised residual |r|/σ̂ over the channels (daylight samples only).
+#[must_use]
+pub fn max_normalised(n: Option<[f64; 3]>) -> Option<f64> {
+    n.map(|n| n.into_iter().fold(0.0_f64, f64::max))
+}
+
+/// An RFC 3339 UTC timestamp of now (seconds), as the CLI stamps `[fit].fitted_at`.
+#[must_use]
+pub fn fitted_at_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    rfc3339_utc(secs)
+}
+
+/// Seconds since the Unix epoch as `YYYY-MM-DDThh:mm:ssZ` (proleptic Gregorian; days to civil
+/// date by H. Hinnant's `civil_from_days`).
+#[must_use]
+pub fn rfc3339_utc(secs: u64) -> String {
+    let days = i64::try_from(secs / 86_400).unwrap_or(0);
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        (rem % 3600) / 60,
+        rem % 60
+    )
+}
+
+/// The latest solver iteration and the cancel request, shared with the worker.
+struct Progress {
+    latest: Mutex<Option<FitIteration>>,
+    cancel: AtomicBool,
+    ctx: egui::Context,
+}
+
+impl FitObserver for Progress {
+    fn on_iteration(&self, event: &FitIteration) {
+        if let Ok(mut l) = self.latest.lock() {
+            *l = Some(*event);
+        }
+        self.ctx.request_repaint();
+    }
+
+    fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+/// A fit running on the worker thread.
+#[derive(Default)]
+pub struct FitWorker {
+    rx: Option<mpsc::Receiver<Result<SiteFitReport, String>>>,
+    progress: Option<Arc<Progress>>,
+    started: Option<Instant>,
+}
+
+impl FitWorker {
+    /// Starts `fit_site` on a snapshot of the site. False when a fit is already running.
+    pub fn start(&mut self, doc: SiteDocument, ctx: egui::Context) -> bool {
+        if self.rx.is_some() {
+            return false;
+        }
+        let (tx, rx) = mpsc::channel();
+        let progress = Arc::new(Progress {
+            latest: Mutex::new(None),
+            cancel: AtomicBool::new(false),
+            ctx: ctx.clone(),
+        });
+        let observer: Arc<dyn FitObserver> = progress.clone();
+        let spawned = std::thread::Builder::new()
+            .name("lighting fit".into())
+            .spawn(move || {
+                // The observer only stores the latest iteration (a Mutex): a panic leaves
+                // nothing half-updated that the UI could misread.
+                let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
+                    fit_site(&doc, &SiteFitOptions::default(), Some(observer))
+                        .map_err(|e| e.to_string())
+                }))
+                .unwrap_or_else(|_| Err("the fit crashed; the site is unchanged".into()));
+                let _ = tx.send(result);
+                ctx.request_repaint();
+            });
+        if spawned.is_err() {
+            return false;
+        }
+        self.rx = Some(rx);
+        self.progress = Some(progress);
+        self.started = Some(Instant::now());
+        true
+    }
+
+    /// Whether a fit is running.
+    #[must_use]
+    pub fn busy(&self) -> bool {
+        self.rx.is_some()
+    }
+
+    /// Asks the running fit to stop at its next step (the library polls
+    /// `FitObserver::cancelled` before each sample and each daylight pass); it then reports
+    /// `the fit was cancelled`.
+    pub fn cancel(&self) {
+        if let Some(p) = &self.progress {
+            p.cancel.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Whether a cancel was requested for the running fit.
+    #[must_use]
+    pub fn cancelling(&self) -> bool {
+        self.progress
+            .as_ref()
+            .is_some_and(|p| p.cancel.load(Ordering::Relaxed))
+    }
+
+    /// The outcome once the worker has finished.
+    pub fn poll(&mut self) -> Option<Result<SiteFitReport, String>> {
+        let rx = self.rx.as_ref()?;
+        let out = match rx.try_recv() {
+            Ok(r) => r,
+            Err(mpsc::TryRecvError::Empty) => return None,
+            Err(mpsc::TryRecvError::Disconnected) => {
+                Err("the fit worker stopped without an answer".into())
+            }
+        };
+        self.rx = None;
+        self.progress = None;
+        self.started = None;
+        Some(out)
+    }
+
+    /// A line describing the progress: elapsed time and the latest solver iteration.
+    #[must_use]
+    pub fn progress_text(&self) -> Option<String> {
+        let started = self.started?;
+        let secs = started.elapsed().as_secs_f64();
+        let latest = self
+            .progress
+            .as_ref()
+            .and_then(|p| p.latest.lock().ok().and_then(|l| *l));
+        if self.cancelling() {
+            return Some(format!(
+                "cancelling… {secs:.1} s (stops at the fit's next step)"
+            ));
+        }
+        Some(match latest {
+            None => format!("fitting… {secs:.1} s (locating and reading samples)"),
+            Some(e) => {
+                let stage = match e.stage {
+                    FitStage::Atmosphere => "atmosphere (eq. 7)",
+                    FitStage::Daylight => "daylight (eq. 9)",
+                };
+                let channel = ["red", "green", "blue"].get(e.channel).unwrap_or(&"?");
+                format!(
+                    "fitting… {secs:.1} s: {stage} {channel} iteration {} |r| = {:.3e}",
+                    e.iteration, e.cost
+                )
+            }
+        })
+    }
+}
+
+/// State of the Fit tab.
+pub struct FitPanel {
+    /// Purpose of samples picked on the photo.
+    pub purpose: SamplePurpose,
+    /// Median window (odd, pixels) of samples picked on the photo.
+    pub window_px: u32,
+    /// The running fit.
+    pub worker: FitWorker,
+    /// The last fit's report.
+    pub report: Option<SiteFitReport>,
+    /// The last fit's error.
+    pub error: Option<String>,
+    /// A horizon rectangle being drawn: (start, current) photo pixel positions.
+    pub(crate) rect_drag: Option<([f64; 2], [f64; 2])>,
+}
+
+impl Default for FitPanel {
+    fn default() -> Self {
+        Self {
+            purpose: SamplePurpose::Daylight,
+            window_px: 5,
+            worker: FitWorker::default(),
+            report: None,
+            error: None,
+            rect_drag: None,
+        }
+    }
+}
+
+fn purpose_name(p: SamplePurpose) -> &'static str {
+    match p {
+        SamplePurpose::Daylight => "daylight",
+        SamplePurpose::Atmosphere => "atmosphere",
+    }
+}
+
+impl crate::Studio {
+    /// The Fit tab's state.
+    pub fn fit_panel_mut(&mut self) -> &mut FitPanel {
+        &mut self.fit
+    }
+
+    /// The last fit's report.
+    #[must_use]
+    pub fn fit_report(&self) -> Option<&SiteFitReport> {
+        self.fit.report.as_ref()
+    }
+
+    /// Starts the lighting fit on the site as it is now (worker thread).
+    pub fn start_fit(&mut self, ctx: &egui::Context) {
+        let Some(doc) = self.doc.clone() else {
+            return;
+        };
+        if self.fit.worker.start(doc, ctx.clone()) {
+            self.fit.error = None;
+            self.say("fitting the lighting…", false);
+        } else {
+            self.say("a fit is already running", true);
+        }
+    }
+
+    /// Applies the last fit's report to the site as `photomontage fit` does (`apply_fit`), as
+    /// one undoable edit.
+    pub fn apply_fit_report(&mut self) {
+        let (Some(report), Some(doc)) = (self.fit.report.as_ref(), self.doc.as_ref()) else {
+            self.say("nothing to apply: run the fit first", true);
+            return;
+        };
+        let mut fitted = doc.site.clone();
+        apply_fit(&mut fitted, report, &fitted_at_now());
+        let command = Command::Fit(FitCommand::SetLighting {
+            lighting: Box::new(fitted.lighting),
+            record: fitted.fit.map(Box::new),
+        });
+        self.apply(command, None);
+        self.say(
+            "fitted lighting written into the site ([lighting], [fit]); Undo restores the previous one",
+            false,
+        );
+    }
+
+    pub(crate) fn poll_fit(&mut self, ctx: &egui::Context) {
+        match self.fit.worker.poll() {
+            Some(Ok(report)) => {
+                let flagged = report.residuals.iter().filter(|r| r.flagged).count();
+                self.say(
+                    format!(
+                        "fit done: {} sample(s) read, {flagged} flagged, {} warning(s)",
+                        report.samples.len(),
+                        report.warnings.len()
+                    ),
+                    false,
+                );
+                self.fit.report = Some(report);
+                self.fit.error = None;
+            }
+            Some(Err(e)) => {
+                self.say(format!("fit failed: {e}"), true);
+                self.fit.error = Some(e);
+            }
+            None => {}
+        }
+        if self.fit.worker.busy() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+    }
+
+    pub(crate) fn fit_tab_ui(&mut self, ui: &mut egui::Ui) {
+        let Some(doc) = self.doc.as_ref() else {
+            return;
+        };
+        let site = doc.site.clone();
+        let mut commands: Vec<(Command, Option<String>)> = Vec::new();
+        let (mut run, mut cancel, mut apply) = (false, false, false);
+        ui.horizontal(|ui| {
+            let busy = self.fit.worker.busy();
+            run = ui
+                .add_enabled(!busy, egui::Button::new("Run fit"))
+                .clicked();
+            cancel = ui
+                .add_enabled(
+                    busy && !self.fit.worker.cancelling(),
+                    egui::Button::new("Cancel fit"),
+                )
+                .clicked();
+            apply = ui
+                .add_enabled(
+                    !busy && self.fit.report.is_some(),
+                    egui::Button::new("Apply fit"),
+                )
+                .on_hover_text("write the fitted lighting into the site (undoable)")
+                .clicked();
+            if busy {
+                ui.spinner();
+            }
+        });
+        if let Some(p) = self.fit.worker.progress_text() {
+            ui.label(p);
+        }
+        settings_ui(ui, site.fit_settings, &mut commands);
+        ui.horizontal(|ui| {
+            ui.label("new samples:");
+            for p in [SamplePurpose::Daylight, SamplePurpose::Atmosphere] {
+                let r = ui.radio_value(&mut self.fit.purpose, p, purpose_name(p));
+                name_widget(ui, &r, &format!("pick purpose {}", purpose_name(p)));
+            }
+            let r = ui.add(
+                egui::DragValue::new(&mut self.fit.window_px)
+                    .range(1..=101)
+                    .suffix(" px"),
+            );
+            name_widget(ui, &r, "pick window");
+            self.fit.window_px |= 1;
+        });
+        ui.label(
+            "click the photo to add a sample on the polygon under the cursor; Shift-drag draws a \
+             horizon (sky) rectangle",
+        );
+        egui::ScrollArea::vertical()
+            .auto_shrink([false, false])
+            .show(ui, |ui| {
+                ui.strong(format!("Samples ({})", site.samples.len()));
+                samples_table_ui(ui, &site, &mut commands);
+                ui.strong(format!("Horizon samples ({})", site.horizon_samples.len()));
+                horizons_table_ui(ui, &site, &mut commands);
+                ui.separator();
+                if let Some(e) = &self.fit.error {
+                    ui.colored_label(FLAGGED, format!("fit failed: {e}"));
+                }
+                if let Some(r) = &self.fit.report {
+                    report_ui(ui, r, site.solve.outlier_threshold_sigma);
+                } else if self.fit.error.is_none() {
+                    ui.label("not fitted yet: press Run fit");
+                }
+            });
+        self.pending.extend(commands);
+        if run {
+            let ctx = ui.ctx().clone();
+            self.start_fit(&ctx);
+        }
+        if cancel {
+            self.fit.worker.cancel();
+        }
+        if apply {
+            self.apply_fit_report();
+        }
+    }
+}
+
+fn settings_ui(
+    ui: &mut egui::Ui,
+    settings: FitSettings,
+    commands: &mut Vec<(Command, Option<String>)>,
+) {
+    ui.horizontal(|ui| {
+        let mut s = settings;
+        let r = ui
+            .checkbox(&mut s.interreflection, "interreflection E_r")
+            .on_hover_text("subtract the light the photographed surroundings reflect onto each daylight sample");
+        name_widget(ui, &r, "interreflection");
+        let r2 = ui
+            .checkbox(&mut s.ambient, "fit ambient k_u")
+            .on_hover_text("off: k_u = 0 (the sky model carries all diffuse light)");
+        name_widget(ui, &r2, "fit ambient");
+        if s != settings {
+            commands.push((Command::Fit(FitCommand::SetFitSettings(s)), None));
+        }
+    });
+}
+
+fn samples_table_ui(ui: &mut egui::Ui, site: &Site, commands: &mut Vec<(Command, Option<String>)>) {
+    if site.samples.is_empty() {
+        ui.label("none: click the photo to add one");
+        return;
+    }
+    TableBuilder::new(ui)
+        .id_salt("fit samples")
+        .striped(true)
+        .column(Column::auto().at_least(40.0))
+        .column(Column::auto().at_least(36.0))
+        .column(Column::auto().at_least(90.0))
+        .column(Column::auto().at_least(110.0))
+        .column(Column::auto().at_least(74.0))
+        .column(Column::auto().at_least(56.0))
+        .column(Column::auto().at_least(24.0))
+        .column(Column::remainder().at_least(30.0))
+        .max_scroll_height(220.0)
+        .header(20.0, |mut h| {
+            for t in [
+                "id", "photo", "material", "at", "purpose", "window", "on", "",
+            ] {
+                h.col(|ui| {
+                    ui.strong(t);
+                });
+            }
+        })
+        .body(|mut body| {
+            for s in &site.samples {
+                body.row(22.0, |mut row| {
+                    row.col(|ui| {
+                        ui.label(&s.id);
+                    });
+                    row.col(|ui| {
+                        ui.label(&s.photo);
+                    });
+                    row.col(|ui| {
+                        ui.label(&s.material);
+                    });
+                    row.col(|ui| {
+                        let at = match (s.point, s.x_px, s.y_px) {
+                            (_, Some(x), Some(y)) => format!("{x:.1}, {y:.1} px"),
+                            (Some(_), _, _) => "world point".into(),
+                            _ => "—".into(),
+                        };
+                        ui.label(at);
+                    });
+                    row.col(|ui| {
+                        let r = ui.button(purpose_name(s.purpose));
+                        name_widget(ui, &r, &format!("purpose {}", s.id));
+                        if r.on_hover_text("click to switch").clicked() {
+                            let mut c = s.clone();
+                            c.purpose = match s.purpose {
+                                SamplePurpose::Daylight => SamplePurpose::Atmosphere,
+                                SamplePurpose::Atmosphere => SamplePurpose::Daylight,
+                            };
+                            commands.push((put(c), None));
+                        }
+                    });
+                    row.col(|ui| {
+                        let mut w = s.window_px;
+                        let r = ui.add(egui::DragValue::new(&mut w).range(1..=101).speed(0.2));
+                        name_widget(ui, &r, &format!("window {}", s.id));
+                        let w = w | 1;
+                        if r.changed() && w != s.window_px {
+                            let mut c = s.clone();
+                            c.window_px = w;
+                            commands.push((put(c), Some(format!("sample window {}", s.id))));
+                        }
+                    });
+                    row.col(|ui| {
+                        let mut on = s.enabled;
+                        let r = ui.checkbox(&mut on, "");
+                        name_widget(ui, &r, &format!("use sample {}", s.id));
+                        if r.changed() {
+                            let mut c = s.clone();
+                            c.enabled = on;
+                            commands.push((put(c), None));
+                        }
+                    });
+                    row.col(|ui| {
+                        let r = ui.small_button("del");
+                        name_widget(ui, &r, &format!("delete sample {}", s.id));
+                        if r.clicked() {
+                            commands.push((
+                                Command::Fit(FitCommand::RemoveSample { id: s.id.clone() }),
+                                None,
+                            ));
+                        }
+                    });
+                });
+            }
+        });
+}
+
+fn put(sample: photomontage::site::Sample) -> Command {
+    Command::Fit(FitCommand::PutSample { sample, at: None })
+}
+
+fn horizons_table_ui(
+    ui: &mut egui::Ui,
+    site: &Site,
+    commands: &mut Vec<(Command, Option<String>)>,
+) {
+    if site.horizon_samples.is_empty() {
+        ui.label("none: Shift-drag a rectangle of sky at the horizon on the photo");
+        return;
+    }
+    TableBuilder::new(ui)
+        .id_salt("fit horizon samples")
+        .striped(true)
+        .column(Column::auto().at_least(40.0))
+        .column(Column::auto().at_least(36.0))
+        .column(Column::auto().at_least(90.0))
+        .column(Column::auto().at_least(80.0))
+        .column(Column::auto().at_least(24.0))
+        .column(Column::remainder().at_least(30.0))
+        .max_scroll_height(140.0)
+        .header(20.0, |mut h| {
+            for t in ["id", "photo", "origin px", "size px", "on", ""] {
+                h.col(|ui| {
+                    ui.strong(t);
+                });
+            }
+        })
+        .body(|mut body| {
+            for s in &site.horizon_samples {
+                body.row(22.0, |mut row| {
+                    row.col(|ui| {
+                        ui.label(&s.id);
+                    });
+                    row.col(|ui| {
+                        ui.label(&s.photo);
+                    });
+                    row.col(|ui| {
+                        ui.label(format!("{}, {}", s.origin_px[0], s.origin_px[1]));
+                    });
+                    row.col(|ui| {
+                        ui.label(format!("{} × {}", s.size_px[0], s.size_px[1]));
+                    });
+                    row.col(|ui| {
+                        let mut on = s.enabled;
+                        let r = ui.checkbox(&mut on, "");
+                        name_widget(ui, &r, &format!("use horizon {}", s.id));
+                        if r.changed() {
+                            let mut c = s.clone();
+                            c.enabled = on;
+                            commands.push((
+                                Command::Fit(FitCommand::PutHorizonSample {
+                                    sample: c,
+                                    at: None,
+                                }),
+                                None,
+                            ));
+                        }
+                    });
+                    row.col(|ui| {
+                        let r = ui.small_button("del");
+                        name_widget(ui, &r, &format!("delete horizon {}", s.id));
+                        if r.clicked() {
+                            commands.push((
+                                Command::Fit(FitCommand::RemoveHorizonSample { id: s.id.clone() }),
+                                None,
+                            ));
+                        }
+                    });
+                });
+            }
+        });
+}
+
+/// The report: fitted values with σ, flags, sun checks, warnings and the residual table.
+pub fn report_ui(ui: &mut egui::Ui, r: &SiteFitReport, outlier_threshold: f64) {
+    ui.strong("Fit results");
+    egui::Grid::new("fit values")
+        .num_columns(3)
+        .striped(true)
+        .show(ui, |ui| {
+            ui.label(format!(
+                "transmittance τ_a over {:.0} m",
+                r.reference_distance_m
+            ));
+            match r.transmittance {
+                Some(t) => {
+                    ui.monospace(rgb_text(t));
+                    ui.monospace(r.transmittance_sigma.map(sigma_text).unwrap_or_default());
+                }
+                None => {
+                    ui.label("not fitted (kept from the site)");
+                    ui.label("");
+                }
+            }
+            ui.end_row();
+            ui.label("horizon colour L∞");
+            ui.monospace(rgb_text(r.horizon_colour));
+            ui.monospace(
+                r.horizon_colour_sigma
+                    .map(|s| sigma_text(s.map(Some)))
+                    .unwrap_or_default(),
+            );
+            ui.end_row();
+            for (name, w, s) in [
+                ("sun weight k_s", r.sun_weight, r.sun_weight_sigma),
+                (
+                    "ambient weight k_u",
+                    r.ambient_weight,
+                    r.ambient_weight_sigma,
+                ),
+                ("sky weight k_h", r.sky_weight, r.sky_weight_sigma),
+            ] {
+                ui.label(name);
+                match w {
+                    Some(w) => {
+                        ui.monospace(rgb_text(w));
+                        ui.monospace(s.map(sigma_text).unwrap_or_default());
+                    }
+                    None => {
+                        ui.label("not fitted (kept from the site)");
+                        ui.label("");
+                    }
+                }
+                ui.end_row();
+            }
+        });
+    if r.sun_weight.is_some() {
+        ui.label(if r.weights_relative {
+            "weights relative: the material's reflectance is not in the library (ρ_d = 1 assumed)"
+        } else {
+            "weights absolute (materials' ρ_d from the library)"
+        });
+    }
+    for c in &r.sun_checks {
+        let text = format!(
+            "sun check {}: {:.2}° between shadow and SPA sun (elevation {:.2}°, azimuth {:.2}°)",
+            c.pair, c.check.angle_deg, c.check.spa_elevation_deg, c.check.spa_azimuth_deg
+        );
+        if c.check.agrees() {
+            ui.label(text);
+        } else {
+            ui.colored_label(WARNING, text);
+        }
+    }
+    for w in &r.warnings {
+        ui.colored_label(WARNING, format!("warning: {w}"));
+    }
+    if r.residuals.is_empty() {
+        return;
+    }
+    ui.strong("Residuals (model − photo, linear)");
+    TableBuilder::new(ui)
+        .id_salt("fit residuals")
+        .striped(true)
+        .column(Column::auto().at_least(70.0))
+        .column(Column::auto().at_least(70.0))
+        .column(Column::auto().at_least(190.0))
+        .column(Column::auto().at_least(50.0))
+        .column(Column::remainder().at_least(60.0))
+        .max_scroll_height(300.0)
+        .header(18.0, |mut h| {
+            for t in ["sample", "fit", "residual R G B", "|r|/σ", "flag"] {
+                h.col(|ui| {
+                    ui.strong(t);
+                });
+            }
+        })
+        .body(|mut body| {
+            for res in &r.residuals {
+                let colour = if res.flagged {
+                    FLAGGED
+                } else {
+                    Color32::from_gray(220)
+                };
+                body.row(18.0, |mut row| {
+                    row.col(|ui| {
+                        ui.colored_label(colour, &res.sample);
+                    });
+                    row.col(|ui| {
+                        ui.colored_label(colour, res.fit);
+                    });
+                    row.col(|ui| {
+                        ui.colored_label(colour, rgb_text(res.residual_rgb));
+                    });
+                    row.col(|ui| {
+                        let n = max_normalised(res.normalised)
+                            .map_or_else(|| "—".into(), |n| format!("{n:.2}"));
+                        let c = if max_normalised(res.normalised)
+                            .is_some_and(|n| n > outlier_threshold)
+                        {
+                            FLAGGED
+                        } else {
+                            colour
+                        };
+                        ui.colored_label(c, n);
+                    });
+                    row.col(|ui| {
+                        if res.flagged {
+                            ui.colored_label(colour, "OUTLIER");
+                        }
+                    });
+                });
+            }
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timestamps_match_known_dates() {
+        // 1_700_000_000 s is 2023-11-14 22:13:20 UTC; 951_782_400 s is 2000-02-29 00:00 UTC
+        // (a leap day of a century leap year).
+        assert_eq!(rfc3339_utc(0), "1970-01-01T00:00:00Z");
+        assert_eq!(rfc3339_utc(1_700_000_000), "2023-11-14T22:13:20Z");
+        assert_eq!(rfc3339_utc(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(rfc3339_utc(951_868_799), "2000-02-29T23:59:59Z");
+    }
+
+    #[test]
+    fn numbers_are_formatted_as_the_cli_prints_them() {
+        assert_eq!(rgb_text([1.0, 0.123_456, 2.5]), "1.00000 0.12346 2.50000");
+        assert_eq!(
+            sigma_text([Some(0.001), None, Some(2.0)]),
+            "± 0.00100 — 2.00000"
+        );
+        assert_eq!(max_normalised(Some([0.5, 3.0, 1.0])), Some(3.0));
+        assert_eq!(max_normalised(None), None);
+    }
+}
