@@ -140,10 +140,17 @@ fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, __m128) {
             _mm_mul_ps(a[2], b[2]),
         )
     };
-    let ng = [0, 1, 2].map(|a| load4(&b.ng[a]));
+    let e1 = [0, 1, 2].map(|a| load4(&b.e1[a]));
+    let e2 = [0, 1, 2].map(|a| load4(&b.e2[a]));
+    // ng = e1 × e2, as `RtTriangle::new`.
+    let ng = [
+        _mm_sub_ps(_mm_mul_ps(e1[1], e2[2]), _mm_mul_ps(e1[2], e2[1])),
+        _mm_sub_ps(_mm_mul_ps(e1[2], e2[0]), _mm_mul_ps(e1[0], e2[2])),
+        _mm_sub_ps(_mm_mul_ps(e1[0], e2[1]), _mm_mul_ps(e1[1], e2[0])),
+    ];
     let inv_det = _mm_div_ps(_mm_set1_ps(1.0), dot(&ng, d));
-    let u = _mm_mul_ps(dot(&r, [0, 1, 2].map(|a| load4(&b.e2[a]))), inv_det);
-    let v = _mm_mul_ps(dot(&r, [0, 1, 2].map(|a| load4(&b.e1[a]))), inv_det);
+    let u = _mm_mul_ps(dot(&r, e2), inv_det);
+    let v = _mm_mul_ps(dot(&r, e1), inv_det);
     let w = _mm_sub_ps(_mm_sub_ps(_mm_set1_ps(1.0), u), v);
     let t = _mm_mul_ps(dot(&ng, c), inv_det);
     // Sign bits of u, v, w (−0 counts as outside, as in obvhs).
@@ -158,6 +165,48 @@ fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, __m128) {
 /// The closest hit, or `None`. `stack` must hold [`WideBvh::stack_max`] entries.
 #[target_feature(enable = "avx2,fma")]
 fn closest_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Option<LeafHit> {
+    traverse(bvh, ray, stack)
+}
+
+/// Whether any triangle is hit within `[t_min, t_max]`. `stack` as for [`closest_impl`].
+/// Children are visited in slot order: stopping the ordered traversal at its first hit measured
+/// no faster on the Embree benchmark's rays.
+#[target_feature(enable = "avx2,fma")]
+fn any_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> bool {
+    let lanes = ray_lanes(ray);
+    let t_max = _mm256_set1_ps(ray.t_max);
+    stack[0].code = bvh.root;
+    let mut sp = 1;
+    'pop: while sp > 0 {
+        sp -= 1;
+        let mut code = stack[sp].code;
+        while code & LEAF_FLAG == 0 {
+            let node = &bvh.nodes[code as usize];
+            let (_, mut mask) = node_test(node, &lanes, t_max);
+            if mask == 0 {
+                continue 'pop;
+            }
+            code = node.children[mask.trailing_zeros() as usize];
+            mask &= mask - 1;
+            while mask != 0 {
+                stack[sp].code = node.children[mask.trailing_zeros() as usize];
+                sp += 1;
+                mask &= mask - 1;
+            }
+        }
+        for block in leaf_blocks(code) {
+            if tri4_test(&bvh.blocks[block], ray, ray.t_max).0 != 0 {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Ordered traversal: nearest child first, pushed children skipped once beyond the closest hit.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Option<LeafHit> {
     let lanes = ray_lanes(ray);
     let mut best: Option<LeafHit> = None;
     let mut t_max = ray.t_max;
@@ -203,6 +252,7 @@ fn closest_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> O
                 };
                 sp += 1;
                 code = node.children[near];
+
                 continue;
             }
             // Three or more: push all, keeping the pushed run sorted far to near; pop the nearest.
@@ -254,37 +304,4 @@ fn closest_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> O
         }
     }
     best
-}
-
-/// Whether any triangle is hit within `[t_min, t_max]`. `stack` as for [`closest_impl`].
-#[target_feature(enable = "avx2,fma")]
-fn any_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> bool {
-    let lanes = ray_lanes(ray);
-    let t_max = _mm256_set1_ps(ray.t_max);
-    stack[0].code = bvh.root;
-    let mut sp = 1;
-    'pop: while sp > 0 {
-        sp -= 1;
-        let mut code = stack[sp].code;
-        while code & LEAF_FLAG == 0 {
-            let node = &bvh.nodes[code as usize];
-            let (_, mut mask) = node_test(node, &lanes, t_max);
-            if mask == 0 {
-                continue 'pop;
-            }
-            code = node.children[mask.trailing_zeros() as usize];
-            mask &= mask - 1;
-            while mask != 0 {
-                stack[sp].code = node.children[mask.trailing_zeros() as usize];
-                sp += 1;
-                mask &= mask - 1;
-            }
-        }
-        for block in leaf_blocks(code) {
-            if tri4_test(&bvh.blocks[block], ray, ray.t_max).0 != 0 {
-                return true;
-            }
-        }
-    }
-    false
 }

@@ -23,15 +23,13 @@ mod avx2;
 mod portable;
 mod wide;
 
-use std::time::Duration;
-
 use glam::Vec3A;
 use obvhs::{BvhBuildParams, rt_triangle::RtTriangle, triangle::Triangle};
 use rayon::prelude::*;
 
 pub use obvhs::ray::Ray;
 
-use wide::{LEAF_TRIANGLES_MAX, LeafHit, PreparedRay, StackEntry, WideBvh};
+use wide::{LeafHit, PreparedRay, StackEntry, WideBvh};
 
 /// Rays per rayon task in the batch queries (large enough to amortise scheduling, small enough
 /// to balance two to dozens of threads on a million rays).
@@ -80,14 +78,11 @@ pub enum BuildQuality {
 
 impl BuildQuality {
     fn params(self) -> BvhBuildParams {
-        let mut params = match self {
+        match self {
             Self::Fast => BvhBuildParams::fast_build(),
             Self::Medium => BvhBuildParams::medium_build(),
             Self::High => BvhBuildParams::slow_build(),
-        };
-        // Leaves are one Triangle4 block.
-        params.max_prims_per_leaf = LEAF_TRIANGLES_MAX;
-        params
+        }
     }
 }
 
@@ -177,6 +172,8 @@ impl std::fmt::Debug for Bvh {
         f.debug_struct("Bvh")
             .field("leaf_blocks", &self.wide.blocks.len())
             .field("nodes", &self.wide.nodes.len())
+            .field("references", &self.wide.references)
+            .field("stack_max", &self.wide.stack_max)
             .field("kernel", &self.kernel())
             .finish()
     }
@@ -210,11 +207,7 @@ impl Bvh {
                 v2: t[2],
             })
             .collect();
-        let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
-            &tris,
-            quality.params(),
-            &mut Duration::default(),
-        );
+        let bvh2 = wide::binary_tree(&tris, &quality.params());
         let rt: Vec<RtTriangle> = tris.iter().map(RtTriangle::from).collect();
         drop(tris);
         let wide = wide::collapse(&bvh2, &rt)?;
@@ -561,8 +554,15 @@ mod tests {
                 if h.triangle_id == id {
                     let uv = rt.compute_barycentric(ray);
                     let n = rt.compute_normal();
-                    assert_eq!(h.barycentric, [uv.x, uv.y]);
-                    assert_eq!(h.normal_geometric, [n.x, n.y, n.z]);
+                    // Same stored values, same obvhs code: the same bits.
+                    assert_eq!(
+                        h.barycentric.map(f32::to_bits),
+                        [uv.x, uv.y].map(f32::to_bits)
+                    );
+                    assert_eq!(
+                        h.normal_geometric.map(f32::to_bits),
+                        [n.x, n.y, n.z].map(f32::to_bits)
+                    );
                 }
             }
         }

@@ -52,14 +52,21 @@ pub(super) fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, [f32; 
         let rx = dy * cz - dz * cy;
         let ry = dz * cx - dx * cz;
         let rz = dx * cy - dy * cx;
-        let inv_det = 1.0 / ((b.ng[0][l] * dx + b.ng[1][l] * dy) + b.ng[2][l] * dz);
+        let (e1, e2) = (&b.e1, &b.e2);
+        // ng = e1 × e2, as `RtTriangle::new`.
+        let ng = [
+            e1[1][l] * e2[2][l] - e1[2][l] * e2[1][l],
+            e1[2][l] * e2[0][l] - e1[0][l] * e2[2][l],
+            e1[0][l] * e2[1][l] - e1[1][l] * e2[0][l],
+        ];
+        let inv_det = 1.0 / ((ng[0] * dx + ng[1] * dy) + ng[2] * dz);
         let u = ((rx * b.e2[0][l] + ry * b.e2[1][l]) + rz * b.e2[2][l]) * inv_det;
         let v = ((rx * b.e1[0][l] + ry * b.e1[1][l]) + rz * b.e1[2][l]) * inv_det;
         let w = 1.0 - u - v;
         // Sign bits, as obvhs: −0 counts as outside.
         let outside = (u.to_bits() | v.to_bits() | w.to_bits()) & 0x8000_0000 != 0;
         if inv_det != 0.0 && !outside {
-            let t = ((b.ng[0][l] * cx + b.ng[1][l] * cy) + b.ng[2][l] * cz) * inv_det;
+            let t = ((ng[0] * cx + ng[1] * cy) + ng[2] * cz) * inv_det;
             if t >= ray.t_min && t <= t_max {
                 *t_lane = t;
                 mask |= 1 << l;
