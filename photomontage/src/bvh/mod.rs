@@ -1,13 +1,14 @@
 //! Bounding volume hierarchy over triangles for the CPU. obvhs 0.4 builds a binary tree by PLOC
-//! (Meister & Bittner 2018) with reinsertion optimisation and SAH leaf collapse; [`wide`]
-//! collapses it into an 8-wide tree with structure-of-arrays child boxes and "Triangle4" leaves
-//! (Wald, Benthin & Boulos 2008, "Getting rid of packets"; Embree's `BVH8` + `Triangle4`, Wald
-//! et al. 2014). Traversal is ordered (nearest child first) for closest hits and early-exit for
-//! any-hit, with Möller–Trumbore intersection (1997) in `f32` computed exactly as obvhs's
-//! `RtTriangle::intersect`. The kernel is chosen once when the BVH is built: explicit AVX2 + FMA
-//! ([`avx2`]) where the CPU has them, otherwise portable code ([`portable`]; SSE2 by the
-//! compiler on x86-64). Closest-hit returns the triangle id, distance, barycentrics and geometric
-//! normal; any-hit answers shadow queries; batch queries spread over rayon.
+//! (Meister & Bittner 2018) with reinsertion optimisation; `wide` collapses it by the
+//! surface-area-heuristic-optimal programme of Ylitie, Karras & Laine 2017 into an 8-wide tree with
+//! structure-of-arrays child boxes and "Triangle4" leaves (Wald, Benthin & Boulos 2008, "Getting
+//! rid of packets"; Embree's `BVH8` + `Triangle4`, Wald et al. 2014). Traversal is ordered (nearest
+//! child first) for closest hits and early-exit for any-hit, with Möller–Trumbore intersection
+//! (1997) in `f32` computed exactly as obvhs's `RtTriangle::intersect`. The kernel is chosen once
+//! when the BVH is built: explicit AVX2 + FMA (`avx2`) where the CPU has them, otherwise portable
+//! code (`portable`; SSE2 by the compiler on x86-64). Closest-hit returns the triangle id,
+//! distance, barycentrics and geometric normal; any-hit answers shadow queries; batch queries
+//! spread over rayon.
 //!
 //! Triangle ids in results are the caller's order. Batch queries split the rays into fixed
 //! chunks of [`RAY_CHUNK`], so results are independent of the thread count.

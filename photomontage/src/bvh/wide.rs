@@ -1,24 +1,25 @@
 //! The CPU layout of the BVH: an 8-wide tree whose nodes keep their children's boxes in
-//! structure-of-arrays form, and leaves of up to four triangles in "Triangle4" form (Wald,
-//! Benthin & Boulos 2008, "Getting rid of packets", and Embree's `BVH8` + `Triangle4`, Wald et
-//! al. 2014, §4–5), so that one SIMD instruction tests a ray against eight boxes or four
-//! triangles.
+//! structure-of-arrays form, and leaves of one or two blocks of four triangles in "Triangle4"
+//! form (Wald, Benthin & Boulos 2008, "Getting rid of packets", and Embree's `BVH8` +
+//! `Triangle4`, Wald et al. 2014, §4–5), so that one SIMD instruction tests a ray against eight
+//! boxes or four triangles.
 //!
 //! The tree is collapsed from obvhs's binary PLOC tree (Meister & Bittner 2018) with
 //! reinsertion, by the surface-area-heuristic-optimal dynamic programme of Ylitie, Karras &
-//! Laine 2017 (§3.1; obvhs's CWBVH converter computes the decisions): every binary node is
-//! either a leaf of at most [`LEAF_TRIANGLES_MAX`] triangles, an 8-wide node, or hands its
-//! children up to its parent.
+//! Laine 2017 (§3.1, as in obvhs's CWBVH converter but with this module's costs: a leaf costs
+//! per block of four, not per triangle): every binary node is either a leaf of at most
+//! [`LEAF_TRIANGLES_MAX`] triangles, an 8-wide node, or hands its children up to its parent.
 //!
 //! Triangles are stored with the precomputed edges of obvhs's `RtTriangle` (`e1 = v0 − v1`,
-//! `e2 = v2 − v0`; the kernels recompute its `ng = e1 × e2` exactly), so that the traversal kernels can evaluate
-//! Möller–Trumbore (1997) with the same floating-point operations in the same order as
-//! `RtTriangle::intersect` and return bit-identical distances.
+//! `e2 = v2 − v0`; the kernels recompute its `ng = e1 × e2` exactly), so that the traversal
+//! kernels evaluate Möller–Trumbore (1997) with the same floating-point operations in the same
+//! order as `RtTriangle::intersect` and return bit-identical distances.
 //!
 //! # Known limitations
-//! The collapse uses obvhs's GPU cost constants (a triangle costs 0.3 of a node), not ones
-//! measured for these kernels; boxes are uncompressed `f32` (224 bytes a node), so the tree takes more memory than a
-//! quantised CWBVH. The build after PLOC is sequential.
+//! The two cost constants were chosen among a few values by benchmark, not fitted. Boxes are
+//! uncompressed `f32` (224 bytes a node, 160 a block), so the tree takes more memory than a
+//! quantised CWBVH. The collapse after PLOC is sequential and its table takes 64 bytes per
+//! binary node while it runs.
 
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
@@ -334,9 +335,9 @@ pub(super) fn binary_tree(triangles: &[Triangle], params: &BvhBuildParams) -> Bv
 }
 
 /// Collapses obvhs's binary tree (leaves of one triangle) over `triangles` (ids are indices
-/// into `triangles`) with the SAH-optimal wide-node decisions of obvhs's CWBVH converter
-/// (Ylitie et al. 2017, §3.1: each binary node becomes a leaf of at most
-/// [`LEAF_TRIANGLES_MAX`] triangles, a wide node, or distributes its children upwards).
+/// into `triangles`) by the decisions of [`Plan`] (Ylitie et al. 2017, §3.1: each binary node
+/// becomes a leaf of at most [`LEAF_TRIANGLES_MAX`] triangles, a wide node, or distributes its
+/// children upwards).
 pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh, BvhError> {
     let mut w = WideBvh {
         nodes: Vec::with_capacity(bvh2.nodes.len() / 8 + 1),
