@@ -218,6 +218,7 @@ fn main() -> Result<()> {
             );
         }
         let tracer = SceneTracer::new(&scene, quality)?;
+        println!("{scene_name}: {:?}", tracer.bvh());
         let o = tracer.local_origin_in_world_m();
         #[allow(clippy::cast_possible_truncation)]
         let offset = Vec3A::new(o.x as f32, o.y as f32, o.z as f32);
