@@ -590,7 +590,11 @@ impl Studio {
             if solving {
                 ui.spinner();
             }
-            if ui.button("Fit").clicked() {
+            if ui
+                .button("Fit view")
+                .on_hover_text("fit the whole photo into the view")
+                .clicked()
+            {
                 self.viewport.fitted = true;
             }
             ui.separator();
