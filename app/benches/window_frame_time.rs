@@ -15,43 +15,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use eframe::egui;
-use photomontage::site::{Interior, Photo, Site};
 use photomontage_studio::{Studio, StudioOptions, window};
 use std::time::{Duration, Instant};
 
-const WIDTH_PX: u32 = 6000;
-const HEIGHT_PX: u32 = 4000;
-const FRAMES: usize = 240;
-const WINDOW: [f32; 2] = [1600.0, 1000.0];
+mod common;
+use common::{FRAMES, WINDOW, photo_site, stats};
+
 /// Frames run after decoding and before timing (shader compilation, first uploads).
 const WARM_UP_FRAMES: usize = 10;
-
-fn generate(path: &std::path::Path) {
-    // The same picture as frame_time.rs: gradients, a fine checker and a 100 px grid.
-    let img = image::RgbImage::from_fn(WIDTH_PX, HEIGHT_PX, |x, y| {
-        let grid = x % 100 == 0 || y % 100 == 0;
-        let checker = ((x / 4) + (y / 4)) % 2 == 0;
-        if grid {
-            image::Rgb([255, 255, 255])
-        } else {
-            image::Rgb([
-                (x * 255 / WIDTH_PX) as u8,
-                (y * 255 / HEIGHT_PX) as u8,
-                if checker { 160 } else { 90 },
-            ])
-        }
-    });
-    img.save(path).expect("write photo");
-}
-
-fn stats(name: &str, mut v: Vec<Duration>) {
-    v.sort();
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let median = ms(v[v.len() / 2]);
-    let p95 = ms(v[(v.len() * 95) / 100]);
-    let worst = ms(v[v.len() - 1]);
-    println!("{name:<26} median {median:7.2} ms   p95 {p95:7.2} ms   worst {worst:7.2} ms");
-}
 
 struct Bench {
     studio: Studio,
@@ -116,27 +87,7 @@ impl eframe::App for Bench {
 
 fn main() {
     let dir = tempfile::tempdir().expect("tempdir");
-    std::fs::create_dir(dir.path().join("photos")).expect("mkdir");
-    generate(&dir.path().join("photos/big.png"));
-    let site = Site {
-        name: "window frame-time bench".into(),
-        photos: vec![Photo {
-            id: "BIG".into(),
-            file: "photos/big.png".into(),
-            taken_at: None,
-            interior: Some(Interior {
-                focal_px: 5000.0,
-                principal_point_px: None,
-                distortion: Default::default(),
-                image_size_px: Some([WIDTH_PX, HEIGHT_PX]),
-            }),
-            self_calibration: Default::default(),
-            exterior: None,
-        }],
-        ..Site::default()
-    };
-    let site_path = dir.path().join("site.toml");
-    site.save(&site_path).expect("site");
+    let site_path = photo_site(dir.path(), "window frame-time bench");
     let mut studio = Studio::new(StudioOptions {
         site_path,
         state_path: None,
