@@ -21,6 +21,7 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod huge;
 mod portable;
 mod wide;
 
@@ -211,7 +212,9 @@ impl Bvh {
         let bvh2 = wide::binary_tree(&tris, &quality.params());
         let rt: Vec<RtTriangle> = tris.iter().map(RtTriangle::from).collect();
         drop(tris);
-        let wide = wide::collapse(&bvh2, &rt)?;
+        let mut wide = wide::collapse(&bvh2, &rt)?;
+        wide.nodes = huge::on_huge_pages(std::mem::take(&mut wide.nodes));
+        wide.blocks = huge::on_huge_pages(std::mem::take(&mut wide.blocks));
         Ok(Self {
             wide,
             dispatch: Dispatch::new(Kernel::best_available()).unwrap_or(Dispatch::Portable),
