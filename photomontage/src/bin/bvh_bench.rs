@@ -38,6 +38,9 @@ struct Args {
     /// Scenes, comma-separated.
     #[arg(long, default_value = "city_10k,terrain_1m", value_delimiter = ',')]
     scenes: Vec<String>,
+    /// Ray sets, comma-separated.
+    #[arg(long, default_value = "incoherent_2m,primary_1m", value_delimiter = ',')]
+    sets: Vec<String>,
     /// BVH build quality: fast, medium or high.
     #[arg(long, default_value = "medium")]
     quality: String,
@@ -222,7 +225,7 @@ fn main() -> Result<()> {
         let o = tracer.local_origin_in_world_m();
         #[allow(clippy::cast_possible_truncation)]
         let offset = Vec3A::new(o.x as f32, o.y as f32, o.z as f32);
-        for set in ["incoherent_2m", "primary_1m"] {
+        for set in args.sets.iter().map(String::as_str) {
             let rays = read_rays(&file(set)?, offset)?;
             let hits_path =
                 bench.join(format!("data/embree/generated/hits_{scene_name}_{set}.bin"));

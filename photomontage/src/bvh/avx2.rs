@@ -123,10 +123,10 @@ fn node_test(node: &Node8, r: &RayLanes, t_max: __m256) -> (__m256, u32) {
 }
 
 /// Möller–Trumbore on four triangles, operation for operation as `RtTriangle::intersect`:
-/// the mask of lanes hit within `[t_min, t_max]` and the distances.
+/// the mask of lanes hit within `[t_min, t_max]`, the distances and the barycentrics `u`, `v`.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
-fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, __m128) {
+fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, [__m128; 3]) {
     let d = ray.direction.map(|x| _mm_set1_ps(x));
     let c = [0, 1, 2].map(|a| _mm_sub_ps(load4(&b.v0[a]), _mm_set1_ps(ray.origin[a])));
     // r = d × c
@@ -160,8 +160,11 @@ fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, __m128) {
     let in_range = _mm_movemask_ps(_mm_cmpge_ps(t, _mm_set1_ps(ray.t_min)))
         & _mm_movemask_ps(_mm_cmple_ps(t, _mm_set1_ps(t_max)));
     #[allow(clippy::cast_sign_loss)] // a 4-bit mask
-    ((det_ok & in_range & !outside) as u32 & 0xf, t)
+    ((det_ok & in_range & !outside) as u32 & 0xf, [t, u, v])
 }
+
+/// Cache lines asked for per child.
+const PREFETCH_LINES: usize = 4;
 
 /// Asks the cache for the children in `mask` (nodes or leaf blocks) before they are visited,
 /// so that their misses overlap instead of following one another down the tree.
@@ -171,19 +174,16 @@ fn prefetch_children(bvh: &WideBvh, node: &Node8, mut mask: u32) {
     while mask != 0 {
         let code = node.children[mask.trailing_zeros() as usize];
         mask &= mask - 1;
-        let (start, bytes) = if code & LEAF_FLAG == 0 {
-            let p = bvh.nodes.as_ptr().wrapping_add(code as usize);
-            (p.cast::<i8>(), std::mem::size_of::<Node8>())
+        let start = if code & LEAF_FLAG == 0 {
+            bvh.nodes.as_ptr().wrapping_add(code as usize).cast::<i8>()
         } else {
-            let blocks = leaf_blocks(code);
-            let p = bvh.blocks.as_ptr().wrapping_add(blocks.start);
-            (p.cast::<i8>(), std::mem::size_of::<Tri4>() * blocks.len())
+            let first = leaf_blocks(code).start;
+            bvh.blocks.as_ptr().wrapping_add(first).cast::<i8>()
         };
-        let mut offset = 0;
-        while offset < bytes {
-            // Prefetching never faults, whatever the address.
-            _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset));
-            offset += 64;
+        // Prefetching never faults, whatever the address. Four lines cover a node's boxes
+        // and codes or a block and a half; one line more measured slower on coherent rays.
+        for line in 0..PREFETCH_LINES {
+            _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(64 * line));
         }
     }
 }
@@ -307,13 +307,19 @@ fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Optio
             code = stack[sp].code;
         }
         for block in leaf_blocks(code) {
-            let (mut mask, t_v) = tri4_test(&bvh.blocks[block], ray, t_max);
+            let (mut mask, [t_v, u_v, v_v]) = tri4_test(&bvh.blocks[block], ray, t_max);
             if mask == 0 {
                 continue;
             }
             let mut t = [0.0f32; LANES];
-            // SAFETY: `t` is 4 writable `f32`; the unaligned store needs no alignment.
-            unsafe { _mm_storeu_ps(t.as_mut_ptr(), t_v) };
+            let mut u = [0.0f32; LANES];
+            let mut v = [0.0f32; LANES];
+            // SAFETY: each array is 4 writable `f32`; unaligned stores need no alignment.
+            unsafe {
+                _mm_storeu_ps(t.as_mut_ptr(), t_v);
+                _mm_storeu_ps(u.as_mut_ptr(), u_v);
+                _mm_storeu_ps(v.as_mut_ptr(), v_v);
+            }
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -325,6 +331,8 @@ fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Optio
                         block: block as u32,
                         lane: lane as u32,
                         t: t[lane],
+                        u: u[lane],
+                        v: v[lane],
                     };
                     best = Some(hit);
                 }

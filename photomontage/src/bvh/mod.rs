@@ -273,16 +273,16 @@ impl Bvh {
         }
     }
 
-    /// The hit record of a leaf hit, computed with obvhs's `RtTriangle` from the stored values.
-    fn hit_record(&self, ray: &Ray, leaf: LeafHit) -> BvhHit {
-        let block = &self.wide.blocks[leaf.block as usize];
+    /// The hit record of a leaf hit: the kernel's barycentrics, and the normal computed with
+    /// obvhs's `RtTriangle` from the stored values.
+    fn hit_record(leaf: LeafHit, blocks: &[wide::Tri4]) -> BvhHit {
+        let block = &blocks[leaf.block as usize];
         let tri = block.triangle(leaf.lane as usize);
-        let uv = tri.compute_barycentric(ray);
         let n = tri.compute_normal();
         BvhHit {
             triangle_id: block.ids[leaf.lane as usize],
             t: leaf.t,
-            barycentric: [uv.x, uv.y],
+            barycentric: [leaf.u, leaf.v],
             normal_geometric: [n.x, n.y, n.z],
         }
     }
@@ -290,7 +290,7 @@ impl Bvh {
     #[inline]
     fn closest_hit_with(&self, ray: &Ray, stack: &mut [StackEntry]) -> Option<BvhHit> {
         self.closest_leaf_hit(ray, stack)
-            .map(|leaf| self.hit_record(ray, leaf))
+            .map(|leaf| Self::hit_record(leaf, &self.wide.blocks))
     }
 
     /// The closest intersection with `ray.tmin ≤ t ≤ ray.tmax`.
@@ -556,13 +556,14 @@ mod tests {
                 let rt = RtTriangle::new(tri[0], tri[1], tri[2]);
                 assert_eq!(rt.intersect(ray).to_bits(), t.to_bits(), "tie partner at t");
                 if h.triangle_id == id {
-                    let uv = rt.compute_barycentric(ray);
+                    // u, v as `RtTriangle::intersect` forms them (a product with 1/det;
+                    // `compute_barycentric` divides, which can differ in the last bit).
+                    let r = ray.direction.cross(rt.v0 - ray.origin);
+                    let inv_det = 1.0 / rt.ng.dot(ray.direction);
+                    let uv = [r.dot(rt.e2) * inv_det, r.dot(rt.e1) * inv_det];
                     let n = rt.compute_normal();
-                    // Same stored values, same obvhs code: the same bits.
-                    assert_eq!(
-                        h.barycentric.map(f32::to_bits),
-                        [uv.x, uv.y].map(f32::to_bits)
-                    );
+                    // Same stored values, same arithmetic: the same bits.
+                    assert_eq!(h.barycentric.map(f32::to_bits), uv.map(f32::to_bits));
                     assert_eq!(
                         h.normal_geometric.map(f32::to_bits),
                         [n.x, n.y, n.z].map(f32::to_bits)

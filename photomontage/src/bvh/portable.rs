@@ -36,15 +36,27 @@ fn node_test(node: &Node8, ray: &PreparedRay, t_max: f32) -> (u32, [f32; WIDTH])
     (mask, t_near)
 }
 
+/// Lanes of a block test: distances and barycentrics.
+pub(super) struct Tri4Hits {
+    pub t: [f32; LANES],
+    pub u: [f32; LANES],
+    pub v: [f32; LANES],
+}
+
 /// Möller–Trumbore on four triangles, operation for operation as `RtTriangle::intersect`
-/// (so distances are bit-identical): a mask of lanes hit within `[t_min, t_max]` and their `t`.
+/// (so distances are bit-identical): a mask of lanes hit within `[t_min, t_max]`, their `t`
+/// and barycentrics.
 #[inline(always)]
-pub(super) fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, [f32; LANES]) {
+pub(super) fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, Tri4Hits) {
     let [ox, oy, oz] = ray.origin;
     let [dx, dy, dz] = ray.direction;
-    let mut t_out = [f32::INFINITY; LANES];
+    let mut out = Tri4Hits {
+        t: [f32::INFINITY; LANES],
+        u: [0.0; LANES],
+        v: [0.0; LANES],
+    };
     let mut mask = 0;
-    for (l, t_lane) in t_out.iter_mut().enumerate() {
+    for l in 0..LANES {
         let cx = b.v0[0][l] - ox;
         let cy = b.v0[1][l] - oy;
         let cz = b.v0[2][l] - oz;
@@ -68,12 +80,14 @@ pub(super) fn tri4_test(b: &Tri4, ray: &PreparedRay, t_max: f32) -> (u32, [f32; 
         if inv_det != 0.0 && !outside {
             let t = ((ng[0] * cx + ng[1] * cy) + ng[2] * cz) * inv_det;
             if t >= ray.t_min && t <= t_max {
-                *t_lane = t;
+                out.t[l] = t;
+                out.u[l] = u;
+                out.v[l] = v;
                 mask |= 1 << l;
             }
         }
     }
-    (mask, t_out)
+    (mask, out)
 }
 
 /// The closest hit, or `None`. `stack` must hold [`WideBvh::stack_max`] entries.
@@ -131,7 +145,8 @@ pub(super) fn closest(
             code = stack[sp].code;
         }
         for block in leaf_blocks(code) {
-            let (mut mask, t) = tri4_test(&bvh.blocks[block], ray, t_max);
+            let (mut mask, hits) = tri4_test(&bvh.blocks[block], ray, t_max);
+            let t = hits.t;
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -143,6 +158,8 @@ pub(super) fn closest(
                         block: block as u32,
                         lane: lane as u32,
                         t: t[lane],
+                        u: hits.u[lane],
+                        v: hits.v[lane],
                     };
                     best = Some(hit);
                 }

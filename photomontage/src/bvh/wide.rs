@@ -529,6 +529,9 @@ pub(super) struct LeafHit {
     pub block: u32,
     pub lane: u32,
     pub t: f32,
+    /// Barycentrics as `RtTriangle::intersect` computes them: `(r·e2, r·e1) · (1/det)`.
+    pub u: f32,
+    pub v: f32,
 }
 
 /// A traversal stack entry: a child code and its entry distance.
