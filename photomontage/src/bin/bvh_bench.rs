@@ -39,7 +39,11 @@ struct Args {
     #[arg(long, default_value = "city_10k,terrain_1m", value_delimiter = ',')]
     scenes: Vec<String>,
     /// Ray sets, comma-separated.
-    #[arg(long, default_value = "incoherent_2m,primary_1m", value_delimiter = ',')]
+    #[arg(
+        long,
+        default_value = "incoherent_2m,primary_1m",
+        value_delimiter = ','
+    )]
     sets: Vec<String>,
     /// BVH build quality: fast, medium or high.
     #[arg(long, default_value = "medium")]
