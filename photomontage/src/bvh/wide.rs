@@ -354,17 +354,18 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
     let mut work: Vec<(usize, usize)> = Vec::new();
     w.root = w.push_node()?;
     work.push((0, 0));
-    let mut prims: Vec<u32> = Vec::with_capacity(LANES);
     let mut subtree: Vec<usize> = Vec::new();
+    let mut leaves: Vec<(usize, Vec<u32>)> = Vec::with_capacity(WIDTH);
     while let Some((wide, id)) = work.pop() {
         let mut children = [0usize; WIDTH];
         let mut count = 0;
         plan.children(bvh2, id, 0, &mut children, &mut count);
+        leaves.clear();
         for (slot, &c) in children.iter().enumerate().take(count) {
             let node = &bvh2.nodes[c];
             let code = if node.is_leaf() || plan.decisions[c * WIDTH].kind == Kind::Leaf {
                 // All triangles of the binary subtree.
-                prims.clear();
+                let mut prims = Vec::with_capacity(LANES);
                 subtree.clear();
                 subtree.push(c);
                 while let Some(n) = subtree.pop() {
@@ -379,8 +380,13 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
                         subtree.extend([f + 1, f]);
                     }
                 }
-                let aabb = node.aabb();
-                w.leaf_code(&prims, triangles, [aabb.min, aabb.max])?
+                if prims.len() > LEAF_BLOCKS_MAX * LANES {
+                    let aabb = node.aabb();
+                    w.leaf_code(&prims, triangles, [aabb.min, aabb.max])?
+                } else {
+                    leaves.push((slot, prims));
+                    EMPTY_CHILD // set by `pack_leaves` below
+                }
             } else {
                 let index = w.push_node()?;
                 work.push((index as usize, c));
@@ -393,6 +399,9 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
                 node.bounds[2 * axis][slot] = aabb.min[axis];
                 node.bounds[2 * axis + 1][slot] = aabb.max[axis];
             }
+        }
+        for (slot, code) in w.pack_leaves(&leaves, triangles)? {
+            w.nodes[wide].children[slot] = code;
         }
     }
     w.stack_max = w.stack_need();
@@ -409,6 +418,67 @@ impl WideBvh {
             })?;
         self.nodes.push(Node8::empty());
         Ok(index)
+    }
+
+    /// Codes for the leaf children `(slot, triangles)` of one node, whose triangles share
+    /// blocks where they fit: a leaf of up to four triangles goes into the fullest of this
+    /// node's blocks with room (best fit, larger leaves first), a larger leaf takes blocks of
+    /// its own whose last one others may fill. Testing a block tests all its lanes, so a
+    /// visit to one leaf may also test a sibling's triangles: every hit found is a true hit
+    /// of the ray, so results are unchanged, while terrain-like trees of leaves of one to
+    /// three triangles need about a third fewer blocks (less memory traffic per ray).
+    fn pack_leaves(
+        &mut self,
+        leaves: &[(usize, Vec<u32>)],
+        triangles: &[RtTriangle],
+    ) -> Result<Vec<(usize, u32)>, BvhError> {
+        let mut order: Vec<usize> = (0..leaves.len()).collect();
+        order.sort_by_key(|&i| std::cmp::Reverse(leaves[i].1.len()));
+        let mut lanes_of: Vec<Vec<u32>> = Vec::new();
+        let mut placed = Vec::with_capacity(leaves.len());
+        for i in order {
+            let (slot, prims) = &leaves[i];
+            if prims.len() > LANES {
+                let first = lanes_of.len();
+                lanes_of.extend(prims.chunks(LANES).map(<[u32]>::to_vec));
+                placed.push((*slot, first, lanes_of.len() - first));
+            } else {
+                let fit = lanes_of
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.len() + prims.len() <= LANES)
+                    .max_by_key(|(_, b)| b.len())
+                    .map(|(j, _)| j);
+                let j = fit.unwrap_or_else(|| {
+                    lanes_of.push(Vec::with_capacity(LANES));
+                    lanes_of.len() - 1
+                });
+                lanes_of[j].extend_from_slice(prims);
+                placed.push((*slot, j, 1));
+            }
+        }
+        let base = self.blocks.len();
+        if base + lanes_of.len() > BLOCK_INDEX_LIMIT {
+            return Err(BvhError::TooManyTriangles {
+                count: triangles.len(),
+            });
+        }
+        for block in &lanes_of {
+            let lanes: Vec<(u32, RtTriangle)> =
+                block.iter().map(|&p| (p, triangles[p as usize])).collect();
+            self.blocks.push(Tri4::new(&lanes));
+        }
+        // Indices below BLOCK_INDEX_LIMIT and counts up to LEAF_BLOCKS_MAX fit their fields.
+        #[allow(clippy::cast_possible_truncation)]
+        Ok(placed
+            .into_iter()
+            .map(|(slot, first, count)| {
+                (
+                    slot,
+                    LEAF_FLAG | (((count - 1) as u32) << LEAF_COUNT_SHIFT) | (base + first) as u32,
+                )
+            })
+            .collect())
     }
 
     /// A leaf over `prims`; a leaf larger than one code can name becomes a node of leaves with
@@ -539,4 +609,55 @@ pub(super) struct LeafHit {
 pub(super) struct StackEntry {
     pub code: u32,
     pub t_near: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle(i: u32) -> RtTriangle {
+        #[allow(clippy::cast_precision_loss)]
+        let x = i as f32;
+        RtTriangle::new(
+            Vec3A::new(x, 0.0, 0.0),
+            Vec3A::new(x + 1.0, 0.0, 0.0),
+            Vec3A::new(x, 1.0, 0.0),
+        )
+    }
+
+    /// Leaves of 3, 1, 2, 2 and 5 triangles: the 5 takes two blocks (4 + 1), the 3 fills the
+    /// second, the 2 + 2 share a third, the 1 goes to the fullest block with room (the third
+    /// would overflow, so a fourth): four blocks instead of six, and every leaf's block range
+    /// holds all of its triangles.
+    #[test]
+    fn sibling_leaves_share_blocks() {
+        let triangles: Vec<RtTriangle> = (0..13).map(triangle).collect();
+        let leaves: Vec<(usize, Vec<u32>)> = vec![
+            (0, vec![0, 1, 2]),
+            (1, vec![3]),
+            (2, vec![4, 5]),
+            (3, vec![6, 7]),
+            (4, vec![8, 9, 10, 11, 12]),
+        ];
+        let mut w = WideBvh {
+            nodes: Vec::new(),
+            blocks: Vec::new(),
+            root: EMPTY_CHILD,
+            stack_max: 1,
+            references: 13,
+        };
+        let codes = w.pack_leaves(&leaves, &triangles).unwrap();
+        assert_eq!(w.blocks.len(), 4, "blocks used");
+        assert_eq!(codes.len(), leaves.len());
+        for (slot, prims) in &leaves {
+            let code = codes.iter().find(|(s, _)| s == slot).unwrap().1;
+            assert_ne!(code & LEAF_FLAG, 0);
+            let ids: Vec<u32> = leaf_blocks(code).flat_map(|b| w.blocks[b].ids).collect();
+            for p in prims {
+                assert!(ids.contains(p), "leaf {slot} lost triangle {p}");
+            }
+            let expected_blocks = prims.len().div_ceil(LANES);
+            assert_eq!(leaf_blocks(code).len(), expected_blocks, "leaf {slot}");
+        }
+    }
 }
