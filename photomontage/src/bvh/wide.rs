@@ -23,11 +23,9 @@
 
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
-use obvhs::aabb::Aabb;
 use obvhs::bvh2::{Bvh2, reinsertion::ReinsertionOptimizer};
 use obvhs::ploc::PlocBuilder;
 use obvhs::rt_triangle::RtTriangle;
-use obvhs::splits::split_aabbs_preset;
 use obvhs::triangle::Triangle;
 
 use super::BvhError;
@@ -296,40 +294,17 @@ impl Plan {
     }
 }
 
-/// obvhs's binary tree with one triangle per leaf: PLOC (with pre-splits if `params` asks)
-/// and reinsertion, as `obvhs::cwbvh::builder::build_cwbvh_from_tris` makes it.
+/// obvhs's binary tree with one triangle per leaf: PLOC and reinsertion with `params`, as
+/// `obvhs::cwbvh::builder::build_cwbvh_from_tris` makes it (without its pre-splits).
 pub(super) fn binary_tree(triangles: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
     let n = u32::try_from(triangles.len()).unwrap_or(u32::MAX);
-    let mut bvh2 = if params.pre_split {
-        let mut aabbs: Vec<Aabb> = triangles.iter().map(Triangle::aabb).collect();
-        let largest_half_area = aabbs.iter().map(Aabb::half_area).fold(0.0, f32::max);
-        #[allow(clippy::cast_precision_loss)]
-        let avg_area = aabbs.iter().map(Aabb::half_area).sum::<f32>() / triangles.len() as f32;
-        let mut indices: Vec<u32> = (0..n).collect();
-        split_aabbs_preset(
-            &mut aabbs,
-            &mut indices,
-            triangles,
-            avg_area,
-            largest_half_area,
-        );
-        PlocBuilder::with_capacity(aabbs.len()).build(
-            params.ploc_search_distance,
-            &aabbs,
-            indices,
-            params.sort_precision,
-            params.search_depth_threshold,
-        )
-    } else {
-        PlocBuilder::with_capacity(triangles.len()).build(
-            params.ploc_search_distance,
-            triangles,
-            (0..n).collect(),
-            params.sort_precision,
-            params.search_depth_threshold,
-        )
-    };
-    bvh2.uses_spatial_splits = params.pre_split;
+    let mut bvh2 = PlocBuilder::with_capacity(triangles.len()).build(
+        params.ploc_search_distance,
+        triangles,
+        (0..n).collect(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
     ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
     bvh2
 }
