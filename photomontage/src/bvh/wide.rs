@@ -4,11 +4,13 @@
 //! `Triangle4`, Wald et al. 2014, §4–5), so that one SIMD instruction tests a ray against eight
 //! boxes or four triangles.
 //!
-//! The tree is collapsed from obvhs's binary PLOC tree (Meister & Bittner 2018) with
-//! reinsertion, by the surface-area-heuristic-optimal dynamic programme of Ylitie, Karras &
-//! Laine 2017 (§3.1, as in obvhs's CWBVH converter but with this module's costs: a leaf costs
-//! per block of four, not per triangle): every binary node is either a leaf of at most
-//! [`LEAF_TRIANGLES_MAX`] triangles, an 8-wide node, or hands its children up to its parent.
+//! The tree is collapsed from a binary tree with one triangle a leaf (binned SAH,
+//! [`super::sah`], or obvhs's PLOC, Meister & Bittner 2018, from [`binary_tree`]) by the
+//! surface-area-heuristic-optimal dynamic programme of Ylitie, Karras & Laine 2017 (§3.1, as
+//! in obvhs's CWBVH converter but with this module's costs: a leaf costs per block of four,
+//! not per triangle): every binary node is either a leaf of at most [`LEAF_TRIANGLES_MAX`]
+//! triangles, an 8-wide node, or hands its children up to its parent. The leaves of one node
+//! then share blocks where they fit ([`WideBvh::pack_leaves`]).
 //!
 //! Triangles are stored with the precomputed edges of obvhs's `RtTriangle` (`e1 = v0 − v1`,
 //! `e2 = v2 − v0`; the kernels recompute its `ng = e1 × e2` exactly), so that the traversal
@@ -18,7 +20,7 @@
 //! # Known limitations
 //! The two cost constants were chosen among a few values by benchmark, not fitted. Boxes are
 //! uncompressed `f32` (224 bytes a node, 160 a block), so the tree takes more memory than a
-//! quantised CWBVH. The collapse after PLOC is sequential and its table takes 64 bytes per
+//! quantised CWBVH. The collapse is sequential and its table takes 64 bytes per
 //! binary node while it runs.
 
 use glam::Vec3A;
