@@ -212,7 +212,9 @@ fn any_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> bool 
             if mask == 0 {
                 continue 'pop;
             }
-            prefetch_children(bvh, node, mask);
+            if bvh.prefetch {
+                prefetch_children(bvh, node, mask);
+            }
             code = node.children[mask.trailing_zeros() as usize];
             mask &= mask - 1;
             while mask != 0 {
@@ -256,7 +258,9 @@ fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Optio
             if mask == 0 {
                 continue 'pop;
             }
-            prefetch_children(bvh, node, mask);
+            if bvh.prefetch {
+                prefetch_children(bvh, node, mask);
+            }
             let first = mask.trailing_zeros() as usize;
             mask &= mask - 1;
             if mask == 0 {

@@ -149,7 +149,13 @@ pub(super) struct WideBvh {
     pub stack_max: usize,
     /// Triangle references in the leaves (pre-split triangles count once per reference).
     pub references: usize,
+    /// Whether the kernels prefetch entered children: only for trees larger than a core's
+    /// L2 cache, where node and block loads miss (small scenes only pay the instructions).
+    pub prefetch: bool,
 }
+
+/// Trees above this many bytes of nodes and blocks are traversed with prefetching.
+const PREFETCH_MIN_BYTES: usize = 512 << 10;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
@@ -322,6 +328,7 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
         root: EMPTY_CHILD,
         stack_max: 1,
         references: bvh2.primitive_indices.len(),
+        prefetch: false,
     };
     if bvh2.nodes.is_empty() {
         return Err(BvhError::Empty);
@@ -382,6 +389,9 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
         }
     }
     w.stack_max = w.stack_need();
+    w.prefetch = std::mem::size_of_val(w.nodes.as_slice())
+        + std::mem::size_of_val(w.blocks.as_slice())
+        > PREFETCH_MIN_BYTES;
     Ok(w)
 }
 
@@ -622,6 +632,7 @@ mod tests {
             root: EMPTY_CHILD,
             stack_max: 1,
             references: 13,
+            prefetch: false,
         };
         let codes = w.pack_leaves(&leaves, &triangles).unwrap();
         assert_eq!(w.blocks.len(), 4, "blocks used");
