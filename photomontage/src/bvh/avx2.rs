@@ -181,7 +181,7 @@ fn prefetch_children(bvh: &WideBvh, node: &Node8, mut mask: u32) {
             bvh.blocks.as_ptr().wrapping_add(first).cast::<i8>()
         };
         // Prefetching never faults, whatever the address. Four lines cover a node's boxes
-        // and codes or a block and a half; one line more measured slower on coherent rays.
+        // and codes, or a leaf's first block and part of its second.
         for line in 0..PREFETCH_LINES {
             _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(64 * line));
         }

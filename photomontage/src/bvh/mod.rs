@@ -244,7 +244,7 @@ impl Bvh {
         Ok(())
     }
 
-    /// Number of triangles in the leaves (pre-splits would count once per reference).
+    /// Number of triangles in the leaves.
     #[must_use]
     pub fn triangle_count(&self) -> usize {
         self.wide.references

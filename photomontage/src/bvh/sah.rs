@@ -104,7 +104,8 @@ fn split(prims: &Prims, indices: &mut [u32], centre_bounds: &Aabb) -> usize {
         if scale[axis] == 0.0 {
             continue;
         }
-        let mut right_cost = [0.0f32; BINS];
+        // (cost, triangles) of bins b.. on the right.
+        let mut right = [(0.0f32, 0usize); BINS];
         let mut acc = Aabb::empty();
         let mut count = 0usize;
         for b in (1..BINS).rev() {
@@ -112,23 +113,26 @@ fn split(prims: &Prims, indices: &mut [u32], centre_bounds: &Aabb) -> usize {
             count += counts[axis][b];
             #[allow(clippy::cast_precision_loss)]
             let cost = acc.half_area() * count as f32;
-            right_cost[b] = if count > 0 { cost } else { f32::NAN };
+            right[b] = (cost, count);
         }
         let mut acc = Aabb::empty();
         let mut count = 0usize;
         for b in 0..BINS - 1 {
             acc = acc.union(&boxes[axis][b]);
             count += counts[axis][b];
+            let (right_cost, right_count) = right[b + 1];
+            if count == 0 || right_count == 0 {
+                continue; // not a split
+            }
             #[allow(clippy::cast_precision_loss)]
-            let cost = acc.half_area() * count as f32 + right_cost[b + 1];
-            // NaN (an empty side) never compares less.
-            if count > 0 && best.is_none_or(|(c, _, _)| cost < c) {
+            let cost = acc.half_area() * count as f32 + right_cost;
+            if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, b));
             }
         }
     }
     let Some((_, axis, last_left)) = best else {
-        return indices.len() / 2; // all centroids coincide
+        return indices.len() / 2; // all centroids coincide (or share one bin on every axis)
     };
     let mut mid = 0;
     for k in 0..indices.len() {
