@@ -5,10 +5,12 @@
 //! traversal with a sorted push of the hit children, early-exit any-hit, and a 4-wide SSE
 //! Möller–Trumbore (1997) on "Triangle4" leaves with the same operations in the same order as
 //! obvhs's `RtTriangle::intersect` (no FMA there), so distances match the portable kernel and
-//! the scalar oracle bit for bit.
+//! the scalar oracle bit for bit. On trees larger than the caches, batch closest-hit queries
+//! walk two rays in turn, one node or leaf each (software interleaving, so that the cache
+//! misses of two independent traversals overlap).
 //!
 //! # Known limitations
-//! One ray at a time (no packets for coherent rays). The slab test with FMA rounds differently
+//! No packets for coherent rays; any-hit queries are not interleaved (measured no faster). The slab test with FMA rounds differently
 //! from the portable kernel's, which can only change which of two triangles at the same
 //! distance (a float tie) is reported.
 #![allow(unsafe_code)] // std::arch loads and the calls of `target_feature` functions.
@@ -45,6 +47,18 @@ impl Token {
     ) -> Option<LeafHit> {
         // SAFETY: a `Token` exists only if the CPU has AVX2 and FMA (`Token::new`).
         unsafe { closest_impl(bvh, ray, stack) }
+    }
+
+    /// The closest hits of two rays (see [`closest_pair_impl`]).
+    #[inline]
+    pub fn closest_pair(
+        self,
+        bvh: &WideBvh,
+        rays: [&PreparedRay; 2],
+        stacks: [&mut [StackEntry]; 2],
+    ) -> [Option<LeafHit>; 2] {
+        // SAFETY: as in `closest`.
+        unsafe { closest_pair_impl(bvh, rays, stacks) }
     }
 
     /// The any-hit answer (see [`any_impl`]).
@@ -212,7 +226,7 @@ fn any_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> bool 
             if mask == 0 {
                 continue 'pop;
             }
-            if bvh.prefetch {
+            if bvh.large {
                 prefetch_children(bvh, node, mask);
             }
             code = node.children[mask.trailing_zeros() as usize];
@@ -232,86 +246,128 @@ fn any_impl(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> bool 
     false
 }
 
-/// Ordered traversal: nearest child first, pushed children skipped once beyond the closest hit.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Option<LeafHit> {
-    let lanes = ray_lanes(ray);
-    let mut best: Option<LeafHit> = None;
-    let mut t_max = ray.t_max;
-    stack[0] = StackEntry {
-        code: bvh.root,
-        t_near: f32::NEG_INFINITY,
-    };
-    let mut sp = 1;
-    let mut t_near = [0.0f32; WIDTH];
-    'pop: while sp > 0 {
-        sp -= 1;
-        let entry = stack[sp];
-        if entry.t_near > t_max {
-            continue;
-        }
-        let mut code = entry.code;
-        while code & LEAF_FLAG == 0 {
-            let node = &bvh.nodes[code as usize];
-            let (t_near_v, mut mask) = node_test(node, &lanes, _mm256_set1_ps(t_max));
-            if mask == 0 {
-                continue 'pop;
-            }
-            if bvh.prefetch {
-                prefetch_children(bvh, node, mask);
-            }
-            let first = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if mask == 0 {
-                code = node.children[first];
-                continue;
-            }
-            // SAFETY: `t_near` is 8 writable `f32`; the unaligned store needs no alignment.
-            unsafe { _mm256_storeu_ps(t_near.as_mut_ptr(), t_near_v) };
-            let second = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if mask == 0 {
-                // Two children: continue with the nearer, push the farther.
-                let (near, far) = if t_near[second] < t_near[first] {
-                    (second, first)
-                } else {
-                    (first, second)
-                };
-                stack[sp] = StackEntry {
-                    code: node.children[far],
-                    t_near: t_near[far],
-                };
-                sp += 1;
-                code = node.children[near];
+/// One ray's ordered closest-hit traversal (nearest child first, pushed children skipped once
+/// beyond the closest hit) as a state that advances one node or one leaf per [`Walk::step`],
+/// so that two rays can be advanced in turn ([`closest_pair_impl`]).
+struct Walk<'s> {
+    lanes: RayLanes,
+    ray: PreparedRay,
+    stack: &'s mut [StackEntry],
+    sp: usize,
+    /// The node or leaf to visit next; meaningless once `done`.
+    code: u32,
+    t_max: f32,
+    best: Option<LeafHit>,
+    done: bool,
+}
 
-                continue;
-            }
-            // Three or more: push all, keeping the pushed run sorted far to near; pop the nearest.
-            let base = sp;
-            let mut push = |slot: usize| {
-                let mut j = sp;
-                stack[j] = StackEntry {
-                    code: node.children[slot],
-                    t_near: t_near[slot],
-                };
-                while j > base && stack[j - 1].t_near < stack[j].t_near {
-                    stack.swap(j - 1, j);
-                    j -= 1;
-                }
-                sp += 1;
-            };
-            push(first);
-            push(second);
-            while mask != 0 {
-                push(mask.trailing_zeros() as usize);
-                mask &= mask - 1;
-            }
-            sp -= 1;
-            code = stack[sp].code;
+impl<'s> Walk<'s> {
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn new(bvh: &WideBvh, ray: &PreparedRay, stack: &'s mut [StackEntry]) -> Self {
+        Self {
+            lanes: ray_lanes(ray),
+            ray: *ray,
+            stack,
+            sp: 0,
+            code: bvh.root,
+            t_max: ray.t_max,
+            best: None,
+            done: false,
         }
+    }
+
+    /// Continues with the nearest pushed child not beyond the closest hit, or ends.
+    #[inline(always)]
+    fn pop(&mut self) {
+        while self.sp > 0 {
+            self.sp -= 1;
+            let entry = self.stack[self.sp];
+            if entry.t_near <= self.t_max {
+                self.code = entry.code;
+                return;
+            }
+        }
+        self.done = true;
+    }
+
+    /// Visits `self.code`: a node's children are tested and the nearest becomes next (the rest
+    /// pushed, sorted far to near); a leaf's blocks are tested, then the walk pops.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn step(&mut self, bvh: &WideBvh) {
+        let code = self.code;
+        if code & LEAF_FLAG != 0 {
+            self.leaf(bvh, code);
+            self.pop();
+            return;
+        }
+        let node = &bvh.nodes[code as usize];
+        let (t_near_v, mut mask) = node_test(node, &self.lanes, _mm256_set1_ps(self.t_max));
+        if mask == 0 {
+            self.pop();
+            return;
+        }
+        if bvh.large {
+            prefetch_children(bvh, node, mask);
+        }
+        let first = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        if mask == 0 {
+            self.code = node.children[first];
+            return;
+        }
+        let mut t_near = [0.0f32; WIDTH];
+        // SAFETY: `t_near` is 8 writable `f32`; the unaligned store needs no alignment.
+        unsafe { _mm256_storeu_ps(t_near.as_mut_ptr(), t_near_v) };
+        let second = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        if mask == 0 {
+            // Two children: continue with the nearer, push the farther.
+            let (near, far) = if t_near[second] < t_near[first] {
+                (second, first)
+            } else {
+                (first, second)
+            };
+            self.stack[self.sp] = StackEntry {
+                code: node.children[far],
+                t_near: t_near[far],
+            };
+            self.sp += 1;
+            self.code = node.children[near];
+            return;
+        }
+        // Three or more: push all, keeping the pushed run sorted far to near; pop the nearest.
+        let (stack, base) = (&mut *self.stack, self.sp);
+        let mut sp = base;
+        let mut push = |slot: usize| {
+            let mut j = sp;
+            stack[j] = StackEntry {
+                code: node.children[slot],
+                t_near: t_near[slot],
+            };
+            while j > base && stack[j - 1].t_near < stack[j].t_near {
+                stack.swap(j - 1, j);
+                j -= 1;
+            }
+            sp += 1;
+        };
+        push(first);
+        push(second);
+        while mask != 0 {
+            push(mask.trailing_zeros() as usize);
+            mask &= mask - 1;
+        }
+        self.sp = sp - 1;
+        self.code = self.stack[self.sp].code;
+    }
+
+    /// Tests the blocks of leaf `code`, keeping the closest hit.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn leaf(&mut self, bvh: &WideBvh, code: u32) {
         for block in leaf_blocks(code) {
-            let (mut mask, [t_v, u_v, v_v]) = tri4_test(&bvh.blocks[block], ray, t_max);
+            let (mut mask, [t_v, u_v, v_v]) = tri4_test(&bvh.blocks[block], &self.ray, self.t_max);
             if mask == 0 {
                 continue;
             }
@@ -327,8 +383,8 @@ fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Optio
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                if best.is_none_or(|b| t[lane] < b.t) {
-                    t_max = t[lane];
+                if self.best.is_none_or(|b| t[lane] < b.t) {
+                    self.t_max = t[lane];
                     // Block and lane indices fit u32 (checked at build).
                     #[allow(clippy::cast_possible_truncation)]
                     let hit = LeafHit {
@@ -338,10 +394,46 @@ fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Optio
                         u: u[lane],
                         v: v[lane],
                     };
-                    best = Some(hit);
+                    self.best = Some(hit);
                 }
             }
         }
     }
-    best
+}
+
+/// Closest hit of one ray.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn traverse(bvh: &WideBvh, ray: &PreparedRay, stack: &mut [StackEntry]) -> Option<LeafHit> {
+    let mut walk = Walk::new(bvh, ray, stack);
+    while !walk.done {
+        walk.step(bvh);
+    }
+    walk.best
+}
+
+/// Closest hits of two rays, advanced in turn: while one waits for a node or block from
+/// memory, the processor works on the other, so two cache misses are in flight instead of
+/// one (memory-level parallelism for incoherent rays in trees larger than the caches). Each
+/// ray visits exactly what it would alone: the results are the same.
+#[target_feature(enable = "avx2,fma")]
+fn closest_pair_impl(
+    bvh: &WideBvh,
+    rays: [&PreparedRay; 2],
+    stacks: [&mut [StackEntry]; 2],
+) -> [Option<LeafHit>; 2] {
+    let [stack_a, stack_b] = stacks;
+    let mut a = Walk::new(bvh, rays[0], stack_a);
+    let mut b = Walk::new(bvh, rays[1], stack_b);
+    while !a.done && !b.done {
+        a.step(bvh);
+        b.step(bvh);
+    }
+    while !a.done {
+        a.step(bvh);
+    }
+    while !b.done {
+        b.step(bvh);
+    }
+    [a.best, b.best]
 }

@@ -9,7 +9,8 @@
 //! when the BVH is built: explicit AVX2 + FMA (`avx2`) where the CPU has them, otherwise portable
 //! code (`portable`; SSE2 by the compiler on x86-64). Closest-hit returns the triangle id,
 //! distance, barycentrics and geometric normal; any-hit answers shadow queries; batch queries
-//! spread over rayon.
+//! spread over rayon (and, for closest hits on trees larger than the caches, walk two rays in
+//! turn per thread with the AVX2 kernel, so that their cache misses overlap).
 //!
 //! Triangle ids in results are the caller's order. Batch queries split the rays into fixed
 //! chunks of [`RAY_CHUNK`], so results are independent of the thread count.
@@ -17,8 +18,8 @@
 //! # Known limitations
 //! Single precision: build the BVH in a local frame near the geometry (see
 //! [`crate::scene::tracer`]). Intersection is not watertight: a ray through a shared edge can miss
-//! both triangles in rare float ties (the Embree comparison counts these). One ray at a time (no
-//! packets), no AVX-512 kernel. No instancing and no motion blur.
+//! both triangles in rare float ties (the Embree comparison counts these). No ray
+//! packets, no AVX-512 kernel. No instancing and no motion blur.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -325,12 +326,41 @@ impl Bvh {
         rays.par_chunks(RAY_CHUNK)
             .zip(out.par_chunks_mut(RAY_CHUNK))
             .for_each(|(rays, out)| {
+                #[cfg(target_arch = "x86_64")]
+                if let Dispatch::Avx2(token) = self.dispatch
+                    && self.wide.large
+                {
+                    self.closest_pairs_into(token, rays, out);
+                    return;
+                }
                 self.with_stack(|stack| {
                     for (ray, o) in rays.iter().zip(out) {
                         *o = self.closest_hit_with(ray, stack);
                     }
                 });
             });
+    }
+
+    /// Closest hits two rays at a time with the AVX2 kernel's interleaved traversal.
+    #[cfg(target_arch = "x86_64")]
+    fn closest_pairs_into(&self, token: avx2::Token, rays: &[Ray], out: &mut [Option<BvhHit>]) {
+        let record = |leaf: Option<LeafHit>| leaf.map(|l| Self::hit_record(l, &self.wide.blocks));
+        self.with_stack(|stack_a| {
+            self.with_stack(|stack_b| {
+                let mut rays_2 = rays.chunks_exact(2);
+                let mut out_2 = out.chunks_exact_mut(2);
+                for (r, o) in (&mut rays_2).zip(&mut out_2) {
+                    let (a, b) = (PreparedRay::new(&r[0]), PreparedRay::new(&r[1]));
+                    let [hit_a, hit_b] =
+                        token.closest_pair(&self.wide, [&a, &b], [&mut *stack_a, &mut *stack_b]);
+                    o[0] = record(hit_a);
+                    o[1] = record(hit_b);
+                }
+                for (r, o) in rays_2.remainder().iter().zip(out_2.into_remainder()) {
+                    *o = self.closest_hit_with(r, stack_a);
+                }
+            });
+        });
     }
 
     /// Any-hit answers of many rays, in parallel on the current rayon pool.
@@ -587,17 +617,32 @@ mod tests {
         let tris = random_soup(1500, 11);
         let mut bvh = Bvh::build(&tris, BuildQuality::Medium).unwrap();
         let rays = random_rays(1500, 12, 12.0);
-        // A tree this small is traversed without prefetching; force it on too (a hint, so
-        // the answers must not change).
-        assert!(!bvh.wide.prefetch);
-        for prefetch in [false, true] {
-            bvh.wide.prefetch = prefetch;
+        // A tree this small is traversed without prefetching and one ray at a time; force the
+        // large-tree traversal too (prefetches and two rays in turn: the answers must not change).
+        assert!(!bvh.wide.large);
+        for large in [false, true] {
+            bvh.wide.large = large;
             for kernel in kernels() {
-                let n_hit = check_against_oracle(&tris, &with_kernel(&bvh, kernel), &rays);
+                let bvh = with_kernel(&bvh, kernel);
+                let n_hit = check_against_oracle(&tris, &bvh, &rays);
                 assert!(
                     n_hit > 150,
                     "{kernel:?}: the test must exercise hits, got {n_hit}"
                 );
+                // Batches (an odd count: pairs and one ray alone) answer as single queries.
+                let odd = &rays[..rays.len() - 1];
+                let mut hits = vec![None; odd.len()];
+                bvh.closest_hits_into(odd, &mut hits);
+                let mut any = vec![false; odd.len()];
+                bvh.any_hits_into(odd, &mut any);
+                for ((ray, hit), any) in odd.iter().zip(&hits).zip(&any) {
+                    assert_eq!(
+                        *hit,
+                        bvh.closest_hit(ray),
+                        "{kernel:?} large {large} {ray:?}"
+                    );
+                    assert_eq!(*any, bvh.any_hit(ray), "{kernel:?} large {large} {ray:?}");
+                }
             }
         }
     }

@@ -149,13 +149,14 @@ pub(super) struct WideBvh {
     pub stack_max: usize,
     /// Triangle references in the leaves (one per triangle).
     pub references: usize,
-    /// Whether the kernels prefetch entered children: only for trees larger than a core's
-    /// L2 cache, where node and block loads miss (small scenes only pay the instructions).
-    pub prefetch: bool,
+    /// Whether the tree is larger than a core's L2 cache, where node and block loads miss:
+    /// then the AVX2 kernel prefetches entered children and batch closest-hit queries walk two
+    /// rays in turn (small trees would only pay the instructions).
+    pub large: bool,
 }
 
-/// Trees above this many bytes of nodes and blocks are traversed with prefetching.
-const PREFETCH_MIN_BYTES: usize = 512 << 10;
+/// Trees above this many bytes of nodes and blocks count as [`WideBvh::large`].
+const LARGE_MIN_BYTES: usize = 512 << 10;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
@@ -328,7 +329,7 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
         root: EMPTY_CHILD,
         stack_max: 1,
         references: bvh2.primitive_indices.len(),
-        prefetch: false,
+        large: false,
     };
     if bvh2.nodes.is_empty() {
         return Err(BvhError::Empty);
@@ -389,9 +390,9 @@ pub(super) fn collapse(bvh2: &Bvh2, triangles: &[RtTriangle]) -> Result<WideBvh,
         }
     }
     w.stack_max = w.stack_need();
-    w.prefetch = std::mem::size_of_val(w.nodes.as_slice())
+    w.large = std::mem::size_of_val(w.nodes.as_slice())
         + std::mem::size_of_val(w.blocks.as_slice())
-        > PREFETCH_MIN_BYTES;
+        > LARGE_MIN_BYTES;
     Ok(w)
 }
 
@@ -619,7 +620,7 @@ mod tests {
             root: EMPTY_CHILD,
             stack_max: 1,
             references: 13,
-            prefetch: false,
+            large: false,
         };
         let codes = w.pack_leaves(&leaves, &triangles).unwrap();
         assert_eq!(w.blocks.len(), 4, "blocks used");
