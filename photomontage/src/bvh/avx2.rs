@@ -25,6 +25,7 @@ use std::arch::x86_64::{
 
 use super::wide::{
     LANES, LEAF_FLAG, LeafHit, Node8, PreparedRay, StackEntry, Tri4, WIDTH, WideBvh, leaf_blocks,
+    push_sorted,
 };
 
 /// Proof that this CPU has AVX2 and FMA: only [`Token::new`] makes one, after checking.
@@ -341,16 +342,11 @@ impl<'s> Walk<'s> {
         let (stack, base) = (&mut *self.stack, self.sp);
         let mut sp = base;
         let mut push = |slot: usize| {
-            let mut j = sp;
-            stack[j] = StackEntry {
+            let entry = StackEntry {
                 code: node.children[slot],
                 t_near: t_near[slot],
             };
-            while j > base && stack[j - 1].t_near < stack[j].t_near {
-                stack.swap(j - 1, j);
-                j -= 1;
-            }
-            sp += 1;
+            push_sorted(stack, base, &mut sp, entry);
         };
         push(first);
         push(second);

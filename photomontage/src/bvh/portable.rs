@@ -10,6 +10,7 @@
 
 use super::wide::{
     LANES, LEAF_FLAG, LeafHit, Node8, PreparedRay, StackEntry, Tri4, WIDTH, WideBvh, leaf_blocks,
+    push_sorted,
 };
 
 /// Slab test of the ray against the eight child boxes: the hit mask and entry distances.
@@ -125,16 +126,11 @@ pub(super) fn closest(
             // Push every hit child, keeping the pushed run sorted far to near; pop the nearest.
             let base = sp;
             let mut push = |slot: usize| {
-                let mut j = sp;
-                stack[j] = StackEntry {
+                let entry = StackEntry {
                     code: node.children[slot],
                     t_near: t_near[slot],
                 };
-                while j > base && stack[j - 1].t_near < stack[j].t_near {
-                    stack.swap(j - 1, j);
-                    j -= 1;
-                }
-                sp += 1;
+                push_sorted(stack, base, &mut sp, entry);
             };
             push(first);
             while mask != 0 {

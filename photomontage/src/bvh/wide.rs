@@ -20,7 +20,8 @@
 //! # Known limitations
 //! The two cost constants were chosen among a few values by benchmark, not fitted. Boxes are
 //! uncompressed `f32` (224 bytes a node, 160 a block), so the tree takes more memory than a
-//! quantised CWBVH. The collapse is sequential and its table takes 64 bytes per
+//! quantised CWBVH (128-byte quantised nodes were tried: incoherent rays no faster, primary
+//! rays 10–15 % slower from the dequantisation). The collapse is sequential and its table takes 64 bytes per
 //! binary node while it runs.
 
 use glam::Vec3A;
@@ -584,6 +585,24 @@ pub(super) struct LeafHit {
 pub(super) struct StackEntry {
     pub code: u32,
     pub t_near: f32,
+}
+
+/// Pushes `entry` at `*sp`, keeping the run of entries from `base` up sorted far to near (the
+/// nearest on top, popped first): the insertion step of ordered closest-hit traversal.
+#[inline(always)]
+pub(super) fn push_sorted(
+    stack: &mut [StackEntry],
+    base: usize,
+    sp: &mut usize,
+    entry: StackEntry,
+) {
+    let mut j = *sp;
+    stack[j] = entry;
+    while j > base && stack[j - 1].t_near < stack[j].t_near {
+        stack.swap(j - 1, j);
+        j -= 1;
+    }
+    *sp += 1;
 }
 
 #[cfg(test)]
