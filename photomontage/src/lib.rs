@@ -9,6 +9,7 @@
 //! coordinates; `_px` pixels, `_m` metres, `_deg` degrees (radians otherwise).
 
 pub mod atmosphere;
+pub mod atomic_file;
 pub mod bvh;
 pub mod camera;
 pub mod colour;

@@ -37,25 +37,29 @@ pub mod illumination;
 pub mod irradiance_cache;
 pub mod luminaire_light;
 pub mod output;
+pub mod partial;
 pub mod spectral;
 pub mod specular;
+pub mod tiling;
 pub mod water;
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
 use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 
 pub use differential::{DifferentialError, DifferentialTracer, Lighting, PrimaryHit, RaySample};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
 pub use irradiance_cache::IrradianceCacheSettings;
 pub use luminaire_light::{ArtificialLight, LuminaireLight};
 pub use output::{LayerSet, OutputError, OutputFormat, OutputLayers};
-pub use spectral::{SpectralError, render_view_spectral};
+pub use spectral::{SpectralError, render_band_spectral, render_view_spectral};
+pub use tiling::{Band, BandError};
+
+use tiling::{TileOut, drive_tiles};
 
 use crate::colour::ToneMap;
 
@@ -81,6 +85,9 @@ pub enum RenderError {
     /// The cancel flag was raised.
     #[error("render cancelled")]
     Cancelled,
+    /// The band cannot be cut from this view.
+    #[error(transparent)]
+    Band(#[from] BandError),
     /// Writing an output file failed.
     #[error("cannot write {path}: {message}")]
     Write {
@@ -197,13 +204,6 @@ impl RenderedImage {
     }
 }
 
-struct TileOut {
-    rgba: Vec<[f32; 4]>,
-    layers: OutputLayers,
-    changed: usize,
-    rays: u64,
-}
-
 /// Renders the current view: `tracer` holds the scene, lights, camera and linear photo.
 /// `on_tile` is called (from worker threads) as each tile finishes; raising `cancel` stops the
 /// render at the next tile.
@@ -232,66 +232,38 @@ pub fn render_view_with_layers(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<(RenderedImage, OutputLayers), RenderError> {
+    render_band_with_layers(tracer, settings, layers, Band::WHOLE, on_tile, cancel)
+}
+
+/// [`render_view_with_layers`] of one horizontal [`Band`] of the view: the returned image and
+/// layers cover the band's pixel rows ([`Band::pixel_rows`]) and hold exactly the values the
+/// whole-image render holds there.
+///
+/// # Errors
+/// As [`render_view`]; [`RenderError::Band`] when the view has fewer tile rows than bands.
+pub fn render_band_with_layers(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+    layers: LayerSet,
+    band: Band,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<(RenderedImage, OutputLayers), RenderError> {
     check_view(tracer, settings)?;
     let photo = tracer.photo();
-    let [w, h] = [photo.width(), photo.height()];
-    let ts = settings.tile_size_px;
-    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
-    let tile_count = (tiles_x * tiles_y) as usize;
-    let tiles: Vec<Option<TileOut>> = (0..tile_count)
-        .into_par_iter()
-        .map(|index| {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            #[allow(clippy::cast_possible_truncation)]
-            let i = index as u32;
-            let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
-            let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
-            let out = render_tile(tracer, settings, layers, index, origin_px, size_px);
-            on_tile(TileProgress {
-                tile_index: index,
-                tile_count,
-                origin_px,
-                size_px,
-                rgb_linear: rgb_of(&out.rgba),
-            });
-            Some(out)
-        })
-        .collect();
-    let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
-    let mut out_layers = OutputLayers::new(layers, (w * h) as usize);
-    let (mut changed_pixels, mut primary_rays) = (0, 0);
-    for (index, tile) in tiles.into_iter().enumerate() {
-        let Some(tile) = tile else {
-            return Err(RenderError::Cancelled);
-        };
-        #[allow(clippy::cast_possible_truncation)]
-        let i = index as u32;
-        let (x0, y0) = ((i % tiles_x) * ts, (i / tiles_x) * ts);
-        let tw = ts.min(w - x0);
-        for (k, p) in tile.rgba.iter().enumerate() {
-            #[allow(clippy::cast_possible_truncation)]
-            let k = k as u32;
-            let to = ((y0 + k / tw) * w + x0 + k % tw) as usize;
-            rgba[to] = *p;
-            out_layers.copy_pixel(&tile.layers, k as usize, to);
-        }
-        changed_pixels += tile.changed;
-        primary_rays += tile.rays;
-    }
-    if cancel.load(Ordering::Relaxed) {
-        return Err(RenderError::Cancelled);
-    }
-    Ok((
-        RenderedImage {
-            size_px: [w, h],
-            rgba,
-            changed_pixels,
-            primary_rays,
+    let size_px = [photo.width(), photo.height()];
+    let rows = band.tile_rows(size_px[1], settings.tile_size_px)?;
+    drive_tiles(
+        size_px,
+        settings,
+        layers,
+        rows,
+        on_tile,
+        cancel,
+        &|index, origin_px, tile_px| {
+            render_tile(tracer, settings, layers, index, origin_px, tile_px)
         },
-        out_layers,
-    ))
+    )
 }
 
 /// Checks that the photo is the camera's size and the settings are valid.

@@ -18,11 +18,14 @@
 //!   not artificial of (ray radiance − photo value), divided by the pixel's ray count; 0 in
 //!   unchanged pixels.
 //!
+//! Every file is written atomically ([`crate::atomic_file`]): encoded in memory, written to a
+//! temporary file beside the target and renamed, so a killed render leaves the old file or the
+//! complete new one.
+//!
 //! # Known limitations
 //! Depth and object id come from one ray per pixel (no antialiasing of those layers). 8-bit
 //! outputs drop alpha and the auxiliary layers; EXR is the only lossless output.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::RenderedImage;
@@ -226,6 +229,29 @@ pub fn write_exr(
 ) -> Result<(), OutputError> {
     use exr::prelude::*;
     let [w, h] = image.size_px;
+    let channels = exr_channels(image, layers);
+    let layer = Layer::new(
+        (w as usize, h as usize),
+        LayerAttributes::default(),
+        // ZIP over scan lines in increasing order: lossless, and the block order (so the file's
+        // bytes) does not depend on which compression thread finishes first.
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| write_error(path, &e))?;
+    write_file(path, &bytes.into_inner())
+}
+
+/// The EXR channels of `image` and `layers` (see the module documentation), unsorted.
+pub(crate) fn exr_channels(
+    image: &RenderedImage,
+    layers: &OutputLayers,
+) -> Vec<exr::prelude::AnyChannel<exr::prelude::FlatSamples>> {
+    use exr::prelude::*;
     let channel = |name: &str, values: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(values));
     let rgba = |k: usize| image.rgba.iter().map(|p| p[k]).collect::<Vec<f32>>();
     let mut channels = vec![
@@ -248,18 +274,13 @@ pub fn write_exr(
             channels.push(channel(name, s.iter().map(|p| p[k]).collect()));
         }
     }
-    let layer = Layer::new(
-        (w as usize, h as usize),
-        LayerAttributes::default(),
-        // ZIP over scan lines in increasing order: lossless, and the block order (so the file's
-        // bytes) does not depend on which compression thread finishes first.
-        Encoding::SMALL_LOSSLESS,
-        AnyChannels::sort(SmallVec::from_vec(channels)),
-    );
-    Image::from_layer(layer)
-        .write()
-        .to_file(path)
-        .map_err(|e| write_error(path, &e))
+    channels
+}
+
+/// Writes finished file contents atomically ([`crate::atomic_file`]): a reader sees the old file
+/// or the whole new one, never a torn one.
+pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    crate::atomic_file::write_atomically(path, bytes).map_err(|e| write_error(path, &e))
 }
 
 /// Writes 8-bit sRGB (alpha dropped) through `tone_map` as PNG, JPEG (quality
@@ -279,22 +300,21 @@ pub fn write_8bit(
         let p = image.rgba[(y * w + x) as usize];
         image::Rgb(encode_srgb8([p[0], p[1], p[2]], tone_map))
     });
+    let mut bytes = std::io::Cursor::new(Vec::new());
     match format {
         OutputFormat::Jpeg => {
-            let file = std::fs::File::create(path).map_err(|e| write_error(path, &e))?;
-            let mut writer = std::io::BufWriter::new(file);
-            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut writer, JPEG_QUALITY)
+            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut bytes, JPEG_QUALITY)
                 .encode_image(&rgb)
                 .map_err(|e| write_error(path, &e))?;
-            writer.flush().map_err(|e| write_error(path, &e))
         }
         OutputFormat::Png => rgb
-            .save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| write_error(path, &e)),
+            .write_to(&mut bytes, image::ImageFormat::Png)
+            .map_err(|e| write_error(path, &e))?,
         OutputFormat::Tiff | OutputFormat::Exr => rgb
-            .save_with_format(path, image::ImageFormat::Tiff)
-            .map_err(|e| write_error(path, &e)),
+            .write_to(&mut bytes, image::ImageFormat::Tiff)
+            .map_err(|e| write_error(path, &e))?,
     }
+    write_file(path, &bytes.into_inner())
 }
 
 /// Writes `image` to `path` in the format its extension names: EXR with `layers`, or 8-bit sRGB
@@ -350,7 +370,7 @@ pub fn write_object_table(exr_path: &Path, names: &[String]) -> Result<PathBuf, 
         .collect();
     let json = serde_json::json!({ "channel": "object_id", "none": -1, "objects": objects });
     let text = serde_json::to_string_pretty(&json).map_err(|e| write_error(&path, &e))?;
-    std::fs::write(&path, text).map_err(|e| write_error(&path, &e))?;
+    write_file(&path, text.as_bytes())?;
     Ok(path)
 }
 

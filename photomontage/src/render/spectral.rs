@@ -29,17 +29,18 @@
 //! each pass holds its own f32 copy of the photo (the secondary rays look natural surfaces up in
 //! it): 3 extra photo-sized images for Durisch's 9.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
 use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 
 use super::differential::{DifferentialTracer, Lighting};
 use super::illumination::Rgb;
 use super::luminaire_light::ArtificialLight;
+use super::output::{LayerSet, OutputLayers};
+use super::tiling::{Band, TileOut, drive_tiles};
 use super::{RenderError, RenderSettings, RenderedImage, TileProgress};
 use crate::atmosphere::schachter::SchachterAtmosphere;
 use crate::colour::spectrum::{DURISCH_RANGE_NM, MEYER4_WAVELENGTHS_NM};
@@ -251,6 +252,22 @@ pub fn render_view_spectral(
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, SpectralError> {
+    render_band_spectral(tracer, settings, sample_set, Band::WHOLE, on_tile, cancel)
+}
+
+/// [`render_view_spectral`] of one horizontal [`Band`] of the view (see
+/// [`super::render_band_with_layers`]).
+///
+/// # Errors
+/// As [`render_view_spectral`].
+pub fn render_band_spectral(
+    tracer: &DifferentialTracer<'_>,
+    settings: &RenderSettings,
+    sample_set: SampleSet,
+    band: Band,
+    on_tile: &(dyn Fn(TileProgress) + Sync),
+    cancel: &AtomicBool,
+) -> Result<RenderedImage, SpectralError> {
     super::check_view(tracer, settings)?;
     let conv = Converter::new(sample_set)?;
     let passes = passes(tracer, &conv)?;
@@ -265,64 +282,20 @@ pub fn render_view_spectral(
         conv: &conv,
         settings,
     };
-    let [w, h] = [tracer.photo().width(), tracer.photo().height()];
-    let ts = settings.tile_size_px;
-    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
-    let tile_count = (tiles_x * tiles_y) as usize;
-    let tiles: Vec<Option<TileOut>> = (0..tile_count)
-        .into_par_iter()
-        .map(|index| {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            #[allow(clippy::cast_possible_truncation)]
-            let i = index as u32;
-            let origin_px = [(i % tiles_x) * ts, (i / tiles_x) * ts];
-            let size_px = [ts.min(w - origin_px[0]), ts.min(h - origin_px[1])];
-            let out = job.tile(index, origin_px, size_px);
-            on_tile(TileProgress {
-                tile_index: index,
-                tile_count,
-                origin_px,
-                size_px,
-                rgb_linear: super::rgb_of(&out.rgba),
-            });
-            Some(out)
-        })
-        .collect();
-    let mut rgba = vec![[0.0_f32; 4]; (w * h) as usize];
-    let (mut changed_pixels, mut primary_rays) = (0, 0);
-    for (index, tile) in tiles.into_iter().enumerate() {
-        let Some(tile) = tile else {
-            return Err(RenderError::Cancelled.into());
-        };
-        #[allow(clippy::cast_possible_truncation)]
-        let i = index as u32;
-        let (x0, y0) = ((i % tiles_x) * ts, (i / tiles_x) * ts);
-        let tw = ts.min(w - x0);
-        for (k, p) in tile.rgba.iter().enumerate() {
-            #[allow(clippy::cast_possible_truncation)]
-            let k = k as u32;
-            rgba[((y0 + k / tw) * w + x0 + k % tw) as usize] = *p;
-        }
-        changed_pixels += tile.changed;
-        primary_rays += tile.rays;
-    }
-    if cancel.load(Ordering::Relaxed) {
-        return Err(RenderError::Cancelled.into());
-    }
-    Ok(RenderedImage {
-        size_px: [w, h],
-        rgba,
-        changed_pixels,
-        primary_rays,
-    })
-}
-
-struct TileOut {
-    rgba: Vec<[f32; 4]>,
-    changed: usize,
-    rays: u64,
+    let size_px = [tracer.photo().width(), tracer.photo().height()];
+    let rows = band
+        .tile_rows(size_px[1], settings.tile_size_px)
+        .map_err(RenderError::from)?;
+    let (image, _) = drive_tiles(
+        size_px,
+        settings,
+        LayerSet::default(),
+        rows,
+        on_tile,
+        cancel,
+        &|index, origin_px, tile_px| job.tile(index, origin_px, tile_px),
+    )?;
+    Ok(image)
 }
 
 struct Job<'j, 't> {
@@ -368,6 +341,7 @@ impl Job<'_, '_> {
         let mut bands = vec![0.0; self.conv.len()];
         let mut out = TileOut {
             rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),
+            layers: OutputLayers::default(),
             changed: 0,
             rays: 0,
         };

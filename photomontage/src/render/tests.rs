@@ -706,3 +706,108 @@ fn irradiance_cache_is_thread_independent_and_close_to_gathering_every_sample() 
     assert!(worst <= CACHE_REL_TOL, "worst {worst}, mean {mean}");
     assert!(mean <= CACHE_MEAN_REL_TOL, "worst {worst}, mean {mean}");
 }
+
+/// Render farms (issue 18): every band of the view, rendered alone, holds exactly the
+/// whole-image render's pixels and layers; parts written from the bands merge into files
+/// byte-identical to the whole render's EXR and PNG.
+#[test]
+fn bands_rendered_alone_merge_into_the_whole_render_byte_for_byte() {
+    use crate::render::partial::{PART_FORMAT, PartInfo, merge_parts, write_part};
+    let scene = site(true);
+    let dome = crate::sky_dome::durisch_facets::durisch_dome(4).unwrap();
+    let mut lighting = sun_and_ambient();
+    lighting.daylight.sky = Daylight::uniform_sky_lights(&dome, [0.02, 0.03, 0.05]);
+    let cam = camera();
+    let photo = uniform_photo(ground_radiance());
+    let tracer = DifferentialTracer::new(&scene, &lighting, &cam, &photo, 2).unwrap();
+    // 4-px tiles: 12 tile rows, so 7 bands are uneven (1 or 2 rows each).
+    let settings = RenderSettings {
+        tile_size_px: 4,
+        seed: 5,
+        ..RenderSettings::default()
+    };
+    let all = LayerSet::parse("depth,object_id,shadow_change").unwrap();
+    let cancel = AtomicBool::new(false);
+    let (whole, whole_layers) =
+        render_view_with_layers(&tracer, &settings, all, &|_| {}, &cancel).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let tm = crate::colour::ToneMap::clamp();
+    let whole_exr = dir.path().join("whole.exr");
+    let whole_png = dir.path().join("whole.png");
+    output::write_output(&whole_exr, &whole, &whole_layers, &tm).unwrap();
+    output::write_output(&whole_png, &whole, &OutputLayers::default(), &tm).unwrap();
+    for count in [1, 4, 7] {
+        let mut paths = Vec::new();
+        for index in 1..=count {
+            let band = Band::new(index, count).unwrap();
+            let (img, layers) =
+                render_band_with_layers(&tracer, &settings, all, band, &|_| {}, &cancel).unwrap();
+            let rows = band.pixel_rows(SIZE_PX[1], 4).unwrap();
+            let info = PartInfo {
+                format: PART_FORMAT.into(),
+                tile: band.to_string(),
+                full_size_px: SIZE_PX,
+                rows_px: [rows.start, rows.end],
+                identity: std::collections::BTreeMap::new(),
+                exposure: 1.0,
+                object_names: None,
+                changed_pixels: img.changed_pixels,
+                primary_rays: img.primary_rays,
+            };
+            let path = dir.path().join(format!("part-{index}-of-{count}.exr"));
+            write_part(&path, &img, &layers, &info).unwrap();
+            paths.push(path);
+        }
+        let merged = merge_parts(&paths).unwrap();
+        assert_eq!(merged.image, whole, "{count} bands");
+        assert_eq!(merged.layers.object_id, whole_layers.object_id);
+        let exr = dir.path().join(format!("merged-{count}.exr"));
+        let png = dir.path().join(format!("merged-{count}.png"));
+        output::write_output(&exr, &merged.image, &merged.layers, &tm).unwrap();
+        output::write_output(&png, &merged.image, &OutputLayers::default(), &tm).unwrap();
+        assert_eq!(
+            std::fs::read(&exr).unwrap(),
+            std::fs::read(&whole_exr).unwrap()
+        );
+        assert_eq!(
+            std::fs::read(&png).unwrap(),
+            std::fs::read(&whole_png).unwrap()
+        );
+    }
+    // The spectral renderer cuts the same bands.
+    let whole_spectral = render_view_spectral(
+        &tracer,
+        &settings,
+        crate::colour::SampleSet::Durisch9,
+        &|_| {},
+        &cancel,
+    )
+    .unwrap();
+    let band = Band::new(2, 3).unwrap();
+    let part = render_band_spectral(
+        &tracer,
+        &settings,
+        crate::colour::SampleSet::Durisch9,
+        band,
+        &|_| {},
+        &cancel,
+    )
+    .unwrap();
+    let rows = band.pixel_rows(SIZE_PX[1], 4).unwrap();
+    let w = SIZE_PX[0] as usize;
+    assert_eq!(
+        part.rgba,
+        whole_spectral.rgba[rows.start as usize * w..rows.end as usize * w]
+    );
+    // More bands than tile rows: a clear error, no render.
+    let err = render_band_with_layers(
+        &tracer,
+        &settings,
+        all,
+        Band::new(1, 13).unwrap(),
+        &|_| {},
+        &cancel,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("at most 12"), "{err}");
+}

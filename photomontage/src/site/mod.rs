@@ -25,7 +25,6 @@ pub use schema::*;
 pub use solve::{SiteSolution, apply_solution, solve_site, stored_camera};
 pub use validate::SiteIssue;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The schema version this build reads and writes.
@@ -219,36 +218,7 @@ impl Site {
     }
 }
 
-/// Writes `bytes` to `path` atomically (temporary file beside it, fsync, rename, fsync folder).
-///
-/// # Errors
-/// Any I/O error; the temporary file is removed on failure.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let file_name = path
-        .file_name()
-        .map_or_else(|| "site".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)?;
-        // Make the rename itself durable.
-        if let Ok(d) = std::fs::File::open(&dir) {
-            let _ = d.sync_all();
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
+pub use crate::atomic_file::write_atomically;
 
 #[derive(serde::Deserialize)]
 struct VersionProbe {
