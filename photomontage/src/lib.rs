@@ -13,6 +13,7 @@ pub mod atomic_file;
 pub mod bvh;
 pub mod camera;
 pub mod colour;
+pub mod farm;
 pub mod fit;
 pub mod geo;
 pub mod luminaire;

@@ -5,105 +5,17 @@
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// Shadow pixels: computed in f64, stored as f32 (a few ulps).
 const F32_REL_TOL: f64 = 1e-5;
 
-const SIZE_PX: [u32; 2] = [96, 64];
-const FOCAL_PX: f64 = 160.0;
-const CAMERA: [f64; 3] = [0.5, -10.0, 1.5];
-const PHOTO_SRGB8: [u8; 3] = [150, 140, 130];
-const K_S: f64 = 2.0;
-const K_U: f64 = 0.1;
-const SUN_AZIMUTH_DEG: f64 = 135.0;
-const SUN_ELEVATION_DEG: f64 = 40.0;
-
-const BOX_OBJ: &str = "mtllib box.mtl\nusemtl black\n\
-v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
-f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
-
-fn site_toml(model_file: &str, scale: f64) -> String {
-    format!(
-        r#"schema_version = 1
-name = "cli render test"
-
-[lighting]
-sky_model = "uniform"
-sun_weight = [{K_S}, {K_S}, {K_S}]
-ambient_weight = [{K_U}, {K_U}, {K_U}]
-sky_weight = [0.0, 0.0, 0.0]
-sun_manual = {{ azimuth_deg = {SUN_AZIMUTH_DEG}, elevation_deg = {SUN_ELEVATION_DEG} }}
-
-[render]
-spp_min = 4
-spp_max = 8
-
-[[photos]]
-id = "p1"
-file = "p1.png"
-
-[photos.interior]
-focal_px = {FOCAL_PX}
-image_size_px = [{w}, {h}]
-
-[photos.exterior]
-camera_center = [{cx}, {cy}, {cz}]
-rotation_world_from_camera = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]
-
-[[photos]]
-id = "p2"
-file = "p1.png"
-
-[[control_points]]
-id = "a"
-xyz = [-10.0, -10.0, 0.0]
-
-[[control_points]]
-id = "b"
-xyz = [10.0, -10.0, 0.0]
-
-[[control_points]]
-id = "c"
-xyz = [10.0, 10.0, 0.0]
-
-[[control_points]]
-id = "d"
-xyz = [-10.0, 10.0, 0.0]
-
-[[polygons]]
-id = "ground"
-vertices = ["a", "b", "c", "d"]
-material = "asphalt"
-image = "p1"
-
-[[models]]
-id = "box"
-file = "{model_file}"
-
-[models.placement]
-scale = {scale}
-"#,
-        w = SIZE_PX[0],
-        h = SIZE_PX[1],
-        cx = CAMERA[0],
-        cy = CAMERA[1],
-        cz = CAMERA[2],
-    )
-}
-
-/// Writes the site, photo and box into `dir`; returns the site path.
-fn make_site(dir: &Path) -> PathBuf {
-    image::RgbImage::from_pixel(SIZE_PX[0], SIZE_PX[1], image::Rgb(PHOTO_SRGB8))
-        .save(dir.join("p1.png"))
-        .unwrap();
-    std::fs::write(dir.join("box.obj"), BOX_OBJ).unwrap();
-    std::fs::write(dir.join("box.mtl"), "newmtl black\nKd 0 0 0\n").unwrap();
-    let site = dir.join("site.toml");
-    std::fs::write(&site, site_toml("box.obj", 1.0)).unwrap();
-    site
-}
+mod common;
+use common::{
+    CAMERA, FOCAL_PX, K_S, K_U, PHOTO_SRGB8, SIZE_PX, SUN_AZIMUTH_DEG, SUN_ELEVATION_DEG,
+};
+use common::{make_site, site_toml};
 
 fn render(site: &Path, view: &str, out: &Path, extra: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_photomontage"))

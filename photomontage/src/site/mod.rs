@@ -17,6 +17,7 @@ mod locate;
 pub mod luminaires;
 pub mod new;
 pub mod render;
+pub mod render_photo;
 mod schema;
 pub mod solve;
 mod validate;

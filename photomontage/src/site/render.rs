@@ -131,6 +131,15 @@ pub enum SiteRenderError {
         field: &'static str,
         reason: String,
     },
+    /// A render request the renderer cannot take (checked before anything loads).
+    #[error("{field}: {reason}")]
+    Request { field: &'static str, reason: String },
+    #[error(transparent)]
+    Tracer(#[from] crate::render::DifferentialError),
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    #[error(transparent)]
+    Spectral(#[from] crate::render::SpectralError),
 }
 
 /// Something worth telling the user that does not stop the render.

@@ -1,8 +1,10 @@
 //! The `photomontage` command-line tool.
 
+mod farm;
 mod fit;
 mod info;
 mod luminaire;
+mod merge;
 mod render;
 mod report;
 mod resect;
@@ -45,6 +47,19 @@ enum Command {
     /// Fit the atmosphere and daylight weights to the site's colour samples (Durisch §4.2–4.3),
     /// cross-check the sun against shadows, and write the lighting back atomically.
     Fit(fit::Args),
+    /// Merge the partial EXRs of one view (`render --tile I/N`) into the whole image.
+    Merge(merge::Args),
+    /// List a site's views cut into tiles as independent jobs (JSON) for a render farm.
+    Jobs(farm::JobsArgs),
+    /// Run one job of a job list (`--index K`), or merge its views (`--merge`); a job whose
+    /// part is already complete is skipped.
+    RunJob(farm::RunJobArgs),
+    /// Write a job list and Slurm scripts: an sbatch job array plus a dependent merge job.
+    Slurm(farm::SlurmArgs),
+    /// Write a job list and Kubernetes manifests: an Indexed Job plus a merge Job.
+    K8s(farm::K8sArgs),
+    /// Write a job list and a Flamenco job type with its submission body.
+    Flamenco(farm::FlamencoArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -58,5 +73,11 @@ fn main() -> anyhow::Result<()> {
         Command::Sky(args) => sky::run(&args),
         Command::Luminaire(args) => luminaire::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Merge(args) => merge::run(&args),
+        Command::Jobs(args) => farm::jobs(&args),
+        Command::RunJob(args) => farm::run_job(&args),
+        Command::Slurm(args) => farm::slurm(&args),
+        Command::K8s(args) => farm::k8s(&args),
+        Command::Flamenco(args) => farm::flamenco(&args),
     }
 }

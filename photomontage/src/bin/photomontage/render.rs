@@ -4,13 +4,11 @@
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use photomontage::colour::SampleSet;
-use photomontage::colour::ToneMap;
-use photomontage::colour::tonemap::ToneCurve;
+use photomontage::render::Band;
 use photomontage::render::output::{self, LayerSet, OutputFormat};
-use photomontage::render::{DifferentialTracer, render_view_spectral, render_view_with_layers};
+use photomontage::render::partial::write_part;
 use photomontage::site::SiteDocument;
-use photomontage::site::render::prepare_view;
+use photomontage::site::render_photo::{RenderPlan, RenderRequest};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -51,17 +49,14 @@ pub struct Args {
     /// render.exposure.
     #[arg(long, value_name = "X")]
     exposure: Option<f64>,
-}
-
-fn check_spp(name: &str, n: u32) -> anyhow::Result<u32> {
-    if !(4..=64).contains(&n) || !n.is_multiple_of(4) {
-        bail!("--{name} {n}: rays per pixel must be a multiple of 4 between 4 and 64");
-    }
-    Ok(n)
+    /// Render only horizontal band I of N (1-based, whole rows of render tiles) into a partial
+    /// EXR for `photomontage merge`; the band's pixels are bit for bit those of the whole render.
+    #[arg(long, value_name = "I/N")]
+    tile: Option<String>,
 }
 
 /// Fails early (before the render) when `path` cannot be created or written.
-fn check_writable(path: &Path) -> anyhow::Result<()> {
+pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     let existed = path.exists();
     std::fs::OpenOptions::new()
         .write(true)
@@ -75,6 +70,38 @@ fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A progress bar over `tiles` render tiles with a time estimate.
+pub fn tile_bar(tiles: u64) -> ProgressBar {
+    let bar = ProgressBar::new(tiles);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} tiles {elapsed} (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Runs `work` on `threads` worker threads (all cores for `None`).
+pub fn with_threads<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> anyhow::Result<T> + Send,
+) -> anyhow::Result<T> {
+    match threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t.max(1))
+            .build()
+            .context("building the thread pool")?
+            .install(work),
+        None => work(),
+    }
+}
+
+/// Installs the Ctrl-C handler that raises [`CANCEL`].
+pub fn install_cancel() -> anyhow::Result<&'static AtomicBool> {
+    ctrlc::set_handler(|| CANCEL.store(true, Ordering::SeqCst))
+        .context("installing the Ctrl-C handler")?;
+    Ok(&CANCEL)
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     // Cheap checks first, so a typo does not cost a render.
     let format = OutputFormat::from_path(&args.out)?;
@@ -86,89 +113,48 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             args.out.display()
         );
     }
+    let band = match &args.tile {
+        Some(text) => {
+            let band = Band::parse(text)?;
+            if format != OutputFormat::Exr {
+                bail!(
+                    "--tile {band} writes a partial EXR for `photomontage merge`; name an .exr \
+                     output, not {}",
+                    args.out.display()
+                );
+            }
+            Some(band)
+        }
+        None => None,
+    };
     let doc = SiteDocument::load(&args.site)?;
-    let spectral = args.spectral || doc.site.render.spectral;
-    if spectral && !layers.is_empty() {
-        bail!(
-            "--layers {} are computed in RGB mode only; render without --spectral (and with \
-             render.spectral = false) to get them",
-            layers.names()
-        );
-    }
-    let exposure = args.exposure.unwrap_or(doc.site.render.exposure);
-    if !(exposure.is_finite() && exposure > 0.0) {
-        bail!("exposure {exposure} must be a finite positive multiplier");
-    }
-    let mut job = prepare_view(&doc, &args.view)?;
-    for w in &job.warnings {
-        eprintln!("warning: {w}");
-    }
-    if let Some(n) = args.spp_min {
-        job.settings.min_rays_per_pixel = check_spp("spp-min", n)?;
-    }
-    if let Some(n) = args.spp_max {
-        job.settings.max_rays_per_pixel = check_spp("spp-max", n)?;
-    }
-    if job.settings.min_rays_per_pixel > job.settings.max_rays_per_pixel {
-        bail!(
-            "spp-min {} is above spp-max {}",
-            job.settings.min_rays_per_pixel,
-            job.settings.max_rays_per_pixel
-        );
-    }
-    if let Some(seed) = args.seed {
-        job.settings.seed = seed;
-    }
+    let request = RenderRequest {
+        view: args.view.clone(),
+        spp_min: args.spp_min,
+        spp_max: args.spp_max,
+        seed: args.seed,
+        spectral: args.spectral,
+        layers,
+        exposure: args.exposure,
+        band: band.unwrap_or(Band::WHOLE),
+    };
+    let plan = RenderPlan::new(&doc, &request)?;
     check_writable(&args.out)?;
 
     let start = Instant::now();
-    let tracer = DifferentialTracer::new(
-        &job.scene.scene,
-        &job.lighting,
-        &job.camera,
-        &job.photo_linear,
-        job.settings.max_depth,
-    )?;
-    let [w, h] = job.camera.intrinsics.image_size_px;
-    let ts = job.settings.tile_size_px.max(1);
-    let bar = ProgressBar::new(u64::from(w.div_ceil(ts) * h.div_ceil(ts)));
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} tiles {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    ctrlc::set_handler(|| CANCEL.store(true, Ordering::SeqCst))
-        .context("installing the Ctrl-C handler")?;
-    eprintln!("rendering {w}×{h} px (Ctrl-C cancels)");
-    let cancel = &CANCEL;
-    let render = || -> anyhow::Result<_> {
-        let on_tile = |_| bar.inc(1);
-        if spectral {
-            let image = render_view_spectral(
-                &tracer,
-                &job.settings,
-                SampleSet::Durisch9,
-                &on_tile,
-                cancel,
-            )?;
-            Ok((image, output::OutputLayers::default()))
-        } else {
-            Ok(render_view_with_layers(
-                &tracer,
-                &job.settings,
-                layers,
-                &on_tile,
-                cancel,
-            )?)
-        }
-    };
-    let result = match args.threads {
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t.max(1))
-            .build()
-            .context("building the thread pool")?
-            .install(render),
-        None => render(),
-    };
+    let [w, h] = plan.full_size_px;
+    let bar = tile_bar(plan.tile_count());
+    let cancel = install_cancel()?;
+    match band {
+        Some(b) => eprintln!(
+            "rendering tile {b}: rows {}..{} of {w}×{h} px (Ctrl-C cancels)",
+            plan.rows_px[0], plan.rows_px[1]
+        ),
+        None => eprintln!("rendering {w}×{h} px (Ctrl-C cancels)"),
+    }
+    let result = with_threads(args.threads, || {
+        Ok(plan.render(&doc, &|_| bar.inc(1), cancel)?)
+    });
     bar.finish_and_clear();
     if CANCEL.load(Ordering::SeqCst) {
         bail!(
@@ -176,43 +162,57 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             args.out.display()
         );
     }
-    let (image, out_layers) = result?;
+    let rendered = result?;
+    for warning in &rendered.warnings {
+        eprintln!("warning: {warning}");
+    }
     let elapsed_s = start.elapsed().as_secs_f64();
-
-    let tone_map = ToneMap {
-        exposure_stops: exposure.log2(),
-        curve: ToneCurve::Clamp,
-    };
-    output::write_output(&args.out, &image, &out_layers, &tone_map)?;
-    let table = if layers.object_id {
-        let names: Vec<String> = job
-            .scene
-            .object_sources
-            .iter()
-            .map(photomontage::site::render::ObjectSource::label)
-            .collect();
-        Some(output::write_object_table(&args.out, &names)?)
-    } else {
+    let image = &rendered.image;
+    let table = if band.is_some() {
+        write_part(
+            &args.out,
+            image,
+            &rendered.layers,
+            &plan.part_info(&rendered),
+        )?;
         None
+    } else {
+        output::write_output(&args.out, image, &rendered.layers, &plan.tone_map())?;
+        if layers.object_id {
+            Some(output::write_object_table(
+                &args.out,
+                &rendered.object_names,
+            )?)
+        } else {
+            None
+        }
     };
 
-    let pixels = f64::from(w) * f64::from(h);
+    let pixels = f64::from(w) * f64::from(plan.rows_px[1] - plan.rows_px[0]);
     #[allow(clippy::cast_precision_loss)]
     let (changed_pct, rays_per_pixel) = (
         100.0 * image.changed_pixels as f64 / pixels,
         image.primary_rays as f64 / pixels,
     );
+    let what = match band {
+        Some(b) => format!("tile {b} of view"),
+        None => "view".to_owned(),
+    };
     println!(
-        "rendered view {} ({w}×{h} px, {}) into {}",
+        "rendered {what} {} ({w}×{h} px, {}) into {}",
         args.view,
-        if spectral { "spectral, 9 bands" } else { "RGB" },
+        if plan.spectral {
+            "spectral, 9 bands"
+        } else {
+            "RGB"
+        },
         args.out.display()
     );
     println!(
         "  changed pixels {} ({changed_pct:.1} %), {rays_per_pixel:.2} rays/pixel, {elapsed_s:.2} s",
         image.changed_pixels
     );
-    match job.sun_dir_in_world {
+    match rendered.sun_dir_in_world {
         Some(d) => println!(
             "  sun elevation {:.2}°, grid azimuth {:.2}°",
             d.z.asin().to_degrees(),
