@@ -56,6 +56,17 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// Checks, before any work, that `path` can be written the way [`write_atomically`] will write
+/// it: creates and removes its temporary file. The target itself is not touched.
+///
+/// # Errors
+/// The I/O error of creating the temporary file (a missing or read-only folder).
+pub fn probe_writable(path: &Path) -> std::io::Result<()> {
+    let tmp = temporary_path(path);
+    std::fs::File::create(&tmp)?;
+    std::fs::remove_file(&tmp)
+}
+
 /// Removes temporaries of `path` left by writers that were killed (any process id but this
 /// one's); returns how many were removed. Errors reading the folder are ignored (nothing to
 /// clean then).
@@ -110,6 +121,15 @@ mod tests {
         assert!(write_atomically(&path, b"data").is_err());
         assert!(path.join("inside").exists());
         assert!(!temporary_path(&path).exists());
+    }
+
+    #[test]
+    fn probing_touches_nothing_and_fails_in_a_missing_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.exr");
+        probe_writable(&path).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        assert!(probe_writable(&dir.path().join("missing/out.exr")).is_err());
     }
 
     #[test]

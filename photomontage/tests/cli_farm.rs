@@ -355,3 +355,24 @@ fn scheduler_files_are_written_for_slurm_kubernetes_and_flamenco() {
         "--throttle must be at least 1",
     );
 }
+
+#[test]
+fn a_part_folder_that_cannot_be_written_fails_before_the_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = tall_site(dir.path());
+    let list = dir.path().join("farm/jobs.json");
+    ok(&pm(&["jobs", s(&site), "--tiles", "2", "--out", s(&list)]));
+    // `parts` is a file, not a folder (permissions would not stop root): no part can go there.
+    let parts = dir.path().join("farm/parts");
+    std::fs::remove_dir(&parts).unwrap();
+    std::fs::write(&parts, b"in the way").unwrap();
+    let start = std::time::Instant::now();
+    let o = pm(&["run-job", s(&list), "--index", "0"]);
+    fails(&o, "cannot write in");
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("rendered"));
+    fails(
+        &pm(&["run-job", s(&list), "--merge"]),
+        "missing tiles 1, 2 of 2",
+    );
+    eprintln!("refused in {:.2} s", start.elapsed().as_secs_f64());
+}

@@ -418,12 +418,15 @@ pub fn run_job(
     {
         return Ok(JobOutcome::AlreadyDone { output });
     }
+    // The part's folder must take the file before the render starts, not after.
+    let folder = |e: std::io::Error| FarmError::Folder {
+        path: output.parent().unwrap_or(Path::new(".")).to_path_buf(),
+        message: e.to_string(),
+    };
     if let Some(parent) = output.parent() {
-        std::fs::create_dir_all(parent).map_err(|e| FarmError::Folder {
-            path: parent.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        std::fs::create_dir_all(parent).map_err(folder)?;
     }
+    crate::atomic_file::probe_writable(&output).map_err(folder)?;
     let rendered = plan.render(&doc, on_tile, cancel)?;
     write_part(
         &output,
@@ -479,6 +482,10 @@ pub fn run_merges(list_path: &Path, view: Option<&str>) -> Result<Vec<PathBuf>, 
             .into());
         }
         let out = dir.join(&merge.output);
+        crate::atomic_file::probe_writable(&out).map_err(|e| FarmError::Folder {
+            path: out.parent().unwrap_or(Path::new(".")).to_path_buf(),
+            message: e.to_string(),
+        })?;
         merge_to_file(&parts, &out)?;
         written.push(out);
     }

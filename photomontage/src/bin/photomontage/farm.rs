@@ -123,6 +123,7 @@ pub fn run_job(args: &RunJobArgs) -> anyhow::Result<()> {
         bail!("give --index K or --merge");
     };
     let cancel = super::render::install_cancel()?;
+    let start = std::time::Instant::now();
     let bar = super::render::tile_bar(0);
     let outcome = super::render::with_threads(args.threads, || {
         Ok(photomontage::farm::jobs::run_job(
@@ -144,8 +145,9 @@ pub fn run_job(args: &RunJobArgs) -> anyhow::Result<()> {
             output,
             changed_pixels,
         } => println!(
-            "job {index}: rendered {} ({changed_pixels} changed pixels)",
-            output.display()
+            "job {index}: rendered {} in {:.2} s ({changed_pixels} changed pixels)",
+            output.display(),
+            start.elapsed().as_secs_f64()
         ),
         JobOutcome::AlreadyDone { output } => {
             println!(
