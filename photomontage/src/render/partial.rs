@@ -174,8 +174,10 @@ pub fn write_part(
     }
     let json = ascii_json(info).map_err(|e| fail(e.to_string()))?;
     let text = Text::new_or_none(&json).ok_or_else(|| fail("unencodable part info".into()))?;
-    let mut attributes = LayerAttributes::default();
-    attributes.layer_position = Vec2(0, i32::try_from(y0).map_err(|e| fail(e.to_string()))?);
+    let mut attributes = LayerAttributes {
+        layer_position: Vec2(0, i32::try_from(y0).map_err(|e| fail(e.to_string()))?),
+        ..LayerAttributes::default()
+    };
     attributes
         .other
         .insert(Text::from(PART_ATTRIBUTE), AttributeValue::Text(text));
