@@ -9,6 +9,7 @@ mod resect;
 mod sky;
 mod solve;
 mod sun;
+mod view_report;
 
 use clap::{Parser, Subcommand};
 
@@ -45,6 +46,10 @@ enum Command {
     /// Fit the atmosphere and daylight weights to the site's colour samples (Durisch §4.2–4.3),
     /// cross-check the sun against shadows, and write the lighting back atomically.
     Fit(fit::Args),
+    /// The view geometry report of one solved photo (TGN 06/19 / LVMF verified view): camera
+    /// position and height, bearing, pitch, roll, fields of view, 35 mm equivalent, sun at
+    /// capture, residuals, distance to the proposal, viewing distance of the sheet.
+    Report(view_report::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -58,5 +63,6 @@ fn main() -> anyhow::Result<()> {
         Command::Sky(args) => sky::run(&args),
         Command::Luminaire(args) => luminaire::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Report(args) => view_report::run(&args),
     }
 }

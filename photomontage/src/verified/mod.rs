@@ -1,0 +1,21 @@
+//! Verified views: what a planning authority receives besides the montage itself (Landscape
+//! Institute, *Technical Guidance Note 06/19: Visual Representation of Development Proposals*,
+//! 2019, Type 4 "photomontage/photowire, survey/scale verifiable", its Appendix 1 methodology and
+//! photograph/photomontage information templates; Greater London Authority, *London View
+//! Management Framework SPG*, 2012, Appendix C "Accurate Visual Representations" AVR0–AVR3).
+//!
+//! - [`geometry`]: the view geometry report of a solved photo (camera position, bearing, pitch,
+//!   roll, fields of view, 35 mm equivalent, sun at capture, residuals, distance to the proposal,
+//!   viewing distance);
+//! - [`paper`]: sheet paper sizes and the printed image size the viewing distance follows from;
+//! - [`measure`]: ground below the camera, nearest point and centroid of the proposal.
+//!
+//! # Known limitations
+//! See each module. The sheet (PDF), the AVR render modes and re-projected views are not here yet.
+
+pub mod geometry;
+pub mod measure;
+pub mod paper;
+
+pub use geometry::{ViewGeometry, ViewGeometryError, ViewGeometryOptions, view_geometry};
+pub use paper::PaperSize;
