@@ -8,9 +8,10 @@
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use nalgebra::{Matrix3, Point3, Vector3};
-use photomontage::site::{Exterior, SiteDocument, apply_solution, solve_site};
+use photomontage::site::{SiteDocument, apply_solution, solve_site};
 use photomontage::verified::geometry::{GroundSource, focal_35mm_equiv_mm};
 use photomontage::verified::{ViewGeometryOptions, view_geometry};
+use photomontage_tests::truth::{true_rotation_rows, truth, vec3};
 use photomontage_tests::{sample_site, shared_file};
 
 /// The bound on bearing, pitch, roll and HFoV against the generator (the formulas are
@@ -45,15 +46,6 @@ const COURTYARD_VIEWS: [View; 3] = [
 const STREET_ORIGIN: [f64; 3] = [2_683_400.0, 1_247_600.0, 408.0];
 const COURTYARD_ORIGIN: [f64; 3] = [2_683_000.0, 1_247_000.0, 400.0];
 
-fn truth(site: &str) -> serde_json::Value {
-    let text = std::fs::read_to_string(sample_site(site).join("truth.json")).unwrap();
-    serde_json::from_str(&text).unwrap()
-}
-
-fn vec3(v: &serde_json::Value) -> [f64; 3] {
-    [0, 1, 2].map(|k| v[k].as_f64().unwrap())
-}
-
 /// The generators' `rotation_look_at` (world_from_camera), to check the constants above against
 /// truth.json.
 fn look_at(center: [f64; 3], target: [f64; 3], roll_deg: f64) -> Matrix3<f64> {
@@ -64,33 +56,19 @@ fn look_at(center: [f64; 3], target: [f64; 3], roll_deg: f64) -> Matrix3<f64> {
     Matrix3::from_columns(&[x, y, z]) * Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
-/// The site with truth.json's cameras written in as solved exteriors.
+/// The site with truth.json's cameras written in as solved exteriors, after checking that the
+/// generator constants above give truth.json's rotations.
 fn site_with_true_cameras(site: &str, views: &[View]) -> SiteDocument {
-    let mut doc = SiteDocument::load(&sample_site(site).join("site.toml")).unwrap();
     let t = truth(site);
     for (id, center, target, roll) in views {
-        let cam = &t["cameras"][id];
-        let rows: Vec<[f64; 3]> = cam["rotation_world_from_camera"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(vec3)
-            .collect();
+        let rows = true_rotation_rows(&t, id);
         let m = Matrix3::from_fn(|r, c| rows[r][c]);
         assert!(
             (m - look_at(*center, *target, *roll)).norm() < 1e-12,
             "{site} {id}: the generator constants here do not give truth.json's rotation"
         );
-        let photo = doc.site.photos.iter_mut().find(|p| p.id == *id).unwrap();
-        photo.exterior = Some(Exterior {
-            camera_center: vec3(&cam["camera_center"]),
-            rotation_world_from_camera: [rows[0], rows[1], rows[2]],
-            rms_px: 0.0,
-            sigma_center_m: [0.0; 3],
-            solved_by: "truth".into(),
-        });
     }
-    doc
+    photomontage_tests::truth::site_with_true_cameras(site)
 }
 
 /// Bearing (clockwise from grid north), pitch, roll of a generator view.

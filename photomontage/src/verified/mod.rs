@@ -8,14 +8,19 @@
 //!   roll, fields of view, 35 mm equivalent, sun at capture, residuals, distance to the proposal,
 //!   viewing distance);
 //! - [`paper`]: sheet paper sizes and the printed image size the viewing distance follows from;
-//! - [`measure`]: ground below the camera, nearest point and centroid of the proposal.
+//! - [`measure`]: ground below the camera, nearest point and centroid of the proposal;
+//! - [`avr`]: the AVR0–AVR3 render modes (silhouette, wireline, massing, full montage);
+//! - [`wireline`]: the proposal's feature edges with hidden-line removal.
 //!
 //! # Known limitations
-//! See each module. The sheet (PDF), the AVR render modes and re-projected views are not here yet.
+//! See each module. The sheet (PDF) and re-projected views are not here yet.
 
+pub mod avr;
 pub mod geometry;
 pub mod measure;
 pub mod paper;
+pub mod wireline;
 
+pub use avr::{AvrLevel, AvrOverlay, apply_massing, avr_overlay};
 pub use geometry::{ViewGeometry, ViewGeometryError, ViewGeometryOptions, view_geometry};
 pub use paper::PaperSize;

@@ -11,6 +11,7 @@ use photomontage::render::output::{self, LayerSet, OutputFormat};
 use photomontage::render::{DifferentialTracer, render_view_spectral, render_view_with_layers};
 use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
+use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -51,6 +52,40 @@ pub struct Args {
     /// render.exposure.
     #[arg(long, value_name = "X")]
     exposure: Option<f64>,
+    /// Accurate Visual Representation level (LVMF): 0 silhouette, 1 wireline (hidden edges
+    /// dashed), 2 massing in a neutral material under the site's light, 3 the full montage.
+    #[arg(long, value_name = "LEVEL", default_value_t = 3)]
+    avr: u8,
+}
+
+/// AVR0/AVR1: the silhouette or wireline drawn over the photo, written like a render.
+fn draw_overlay(
+    args: &Args,
+    doc: &SiteDocument,
+    avr: AvrLevel,
+    exposure: f64,
+) -> anyhow::Result<()> {
+    check_writable(&args.out)?;
+    let overlay = avr_overlay(doc, &args.view, avr)?;
+    let tone_map = ToneMap {
+        exposure_stops: exposure.log2(),
+        curve: ToneCurve::Clamp,
+    };
+    output::write_output(
+        &args.out,
+        &overlay.image,
+        &output::OutputLayers::default(),
+        &tone_map,
+    )?;
+    println!(
+        "drew {} ({}) of view {} into {}: {} pixels",
+        avr.name(),
+        avr.description(),
+        args.view,
+        args.out.display(),
+        overlay.image.changed_pixels
+    );
+    Ok(())
 }
 
 fn check_spp(name: &str, n: u32) -> anyhow::Result<u32> {
@@ -99,7 +134,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if !(exposure.is_finite() && exposure > 0.0) {
         bail!("exposure {exposure} must be a finite positive multiplier");
     }
+    let avr = AvrLevel::from_number(args.avr)?;
+    if matches!(avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
+        if spectral || !layers.is_empty() {
+            bail!(
+                "--avr {} draws over the photo: no --spectral or --layers",
+                args.avr
+            );
+        }
+        return draw_overlay(args, &doc, avr, exposure);
+    }
     let mut job = prepare_view(&doc, &args.view)?;
+    if avr == AvrLevel::Avr2 {
+        apply_massing(&mut job.scene.scene)?;
+    }
     for w in &job.warnings {
         eprintln!("warning: {w}");
     }
