@@ -10,15 +10,17 @@
 //! - [`paper`]: sheet paper sizes and the printed image size the viewing distance follows from;
 //! - [`measure`]: ground below the camera, nearest point and centroid of the proposal;
 //! - [`avr`]: the AVR0–AVR3 render modes (silhouette, wireline, massing, full montage);
-//! - [`wireline`]: the proposal's feature edges with hidden-line removal.
+//! - [`wireline`]: the proposal's feature edges with hidden-line removal;
+//! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length.
 //!
 //! # Known limitations
-//! See each module. The sheet (PDF) and re-projected views are not here yet.
+//! See each module. The sheet (PDF) and cylindrical panoramas are not here yet.
 
 pub mod avr;
 pub mod geometry;
 pub mod measure;
 pub mod paper;
+pub mod planar_view;
 pub mod wireline;
 
 pub use avr::{AvrLevel, AvrOverlay, apply_massing, avr_overlay};

@@ -8,6 +8,7 @@ mod report;
 mod resect;
 mod sky;
 mod solve;
+mod standard_view;
 mod sun;
 mod view_report;
 
@@ -50,6 +51,9 @@ enum Command {
     /// position and height, bearing, pitch, roll, fields of view, 35 mm equivalent, sun at
     /// capture, residuals, distance to the proposal, viewing distance of the sheet.
     Report(view_report::Args),
+    /// A solved photo re-projected to a standard focal length (planar view at a 50 mm or 75 mm
+    /// equivalent), with its virtual camera.
+    View(standard_view::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -64,5 +68,6 @@ fn main() -> anyhow::Result<()> {
         Command::Luminaire(args) => luminaire::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Report(args) => view_report::run(&args),
+        Command::View(args) => standard_view::run(&args),
     }
 }
