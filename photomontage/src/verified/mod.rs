@@ -11,16 +11,20 @@
 //! - [`measure`]: ground below the camera, nearest point and centroid of the proposal;
 //! - [`avr`]: the AVR0–AVR3 render modes (silhouette, wireline, massing, full montage);
 //! - [`wireline`]: the proposal's feature edges with hidden-line removal;
-//! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length.
+//! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length;
+//! - [`sheet`] and [`sheet_content`]: the PDF sheet (view at print scale, viewing distance,
+//!   ruler, geometry table, map inset, AVR level, methodology and residuals).
 //!
 //! # Known limitations
-//! See each module. The sheet (PDF) and cylindrical panoramas are not here yet.
+//! See each module. Cylindrical panoramas are not here yet.
 
 pub mod avr;
 pub mod geometry;
 pub mod measure;
 pub mod paper;
 pub mod planar_view;
+pub mod sheet;
+pub mod sheet_content;
 pub mod wireline;
 
 pub use avr::{AvrLevel, AvrOverlay, apply_massing, avr_overlay};

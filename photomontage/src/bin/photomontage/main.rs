@@ -6,6 +6,7 @@ mod luminaire;
 mod render;
 mod report;
 mod resect;
+mod sheet;
 mod sky;
 mod solve;
 mod standard_view;
@@ -54,6 +55,9 @@ enum Command {
     /// A solved photo re-projected to a standard focal length (planar view at a 50 mm or 75 mm
     /// equivalent), with its virtual camera.
     View(standard_view::Args),
+    /// The verified-view sheet (PDF) of one solved photo: the view at print scale with its
+    /// viewing distance, ruler, geometry table, map inset, AVR level, methodology and residuals.
+    Sheet(sheet::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -69,5 +73,6 @@ fn main() -> anyhow::Result<()> {
         Command::Fit(args) => fit::run(&args),
         Command::Report(args) => view_report::run(&args),
         Command::View(args) => standard_view::run(&args),
+        Command::Sheet(args) => sheet::run(&args),
     }
 }
