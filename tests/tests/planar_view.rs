@@ -60,3 +60,26 @@ fn bad_input_is_refused_by_name() {
         .to_string();
     assert!(err.contains("V3") && err.contains("not solved"), "{err}");
 }
+
+#[test]
+fn cylindrical_view_refuses_photos_from_different_points() {
+    use photomontage::verified::cylindrical_view::{
+        CylindricalError, CylindricalOptions, site_cylindrical_view,
+    };
+    // The street's views stand metres apart; V3 (9 m up) is farthest from their mean centre.
+    let doc = site_with_true_cameras("street");
+    let err = site_cylindrical_view(&doc, &["V1", "V2", "V3"], &CylindricalOptions::default())
+        .unwrap_err();
+    assert!(
+        matches!(&err, CylindricalError::NotOnePoint { photo, .. } if photo == "V3"),
+        "{err}"
+    );
+    let unsolved = photomontage::site::SiteDocument::load(
+        &photomontage_tests::sample_site("street").join("site.toml"),
+    )
+    .unwrap();
+    let err = site_cylindrical_view(&unsolved, &["V1"], &CylindricalOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("V1") && err.contains("not solved"), "{err}");
+}

@@ -171,32 +171,16 @@ pub fn avr_overlay(
     if matches!(level, AvrLevel::Avr2 | AvrLevel::Avr3) {
         return Err(AvrError::NotAnOverlay { level });
     }
-    let camera = site_camera(doc, photo_id)?;
     if !doc.site.models.iter().any(|m| m.visible) {
+        // Name an unknown or unsolved view first, then the missing proposal.
+        site_camera(doc, photo_id)?;
         return Err(AvrError::NoProposal {
             photo: photo_id.to_owned(),
         });
     }
+    let (camera, photo_linear) = super::planar_view::solved_photo(doc, photo_id)?;
+    let size_px = camera.intrinsics.image_size_px;
     let scene = site_scene(doc)?.scene;
-    let photo = doc
-        .site
-        .photos
-        .iter()
-        .find(|p| p.id == photo_id)
-        .ok_or_else(|| SiteRenderError::NotSolved {
-            photo: photo_id.to_owned(),
-        })?;
-    let loaded = crate::photo::load(&doc.resolve(&photo.file)).map_err(SiteRenderError::from)?;
-    let photo_linear = crate::render::linear_photo(&loaded);
-    let size_px = [photo_linear.width(), photo_linear.height()];
-    if size_px != camera.intrinsics.image_size_px {
-        return Err(SiteRenderError::SizeMismatch {
-            photo: photo_id.to_owned(),
-            photo_px: size_px,
-            camera_px: camera.intrinsics.image_size_px,
-        }
-        .into());
-    }
     let tracer = SceneTracer::new(&scene, BuildQuality::default())?;
     let mut rgba: Vec<[f32; 4]> = photo_linear
         .pixels()

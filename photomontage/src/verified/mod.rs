@@ -12,13 +12,15 @@
 //! - [`avr`]: the AVR0–AVR3 render modes (silhouette, wireline, massing, full montage);
 //! - [`wireline`]: the proposal's feature edges with hidden-line removal;
 //! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length;
+//! - [`cylindrical_view`]: a panorama from several photos taken from one point;
 //! - [`sheet`] and [`sheet_content`]: the PDF sheet (view at print scale, viewing distance,
 //!   ruler, geometry table, map inset, AVR level, methodology and residuals).
 //!
 //! # Known limitations
-//! See each module. Cylindrical panoramas are not here yet.
+//! See each module.
 
 pub mod avr;
+pub mod cylindrical_view;
 pub mod geometry;
 pub mod measure;
 pub mod paper;

@@ -111,6 +111,37 @@ pub fn reproject(source: &Camera, photo: &Rgb32FImage, target: &Camera) -> Rende
     }
 }
 
+/// The solved camera of photo `photo_id` and the photo itself, linear, checked to be the
+/// camera's size.
+///
+/// # Errors
+/// [`SiteRenderError`]: an unknown or unsolved view, an unreadable photo, a size mismatch.
+pub fn solved_photo(
+    doc: &SiteDocument,
+    photo_id: &str,
+) -> Result<(Camera, Rgb32FImage), SiteRenderError> {
+    let camera = site_camera(doc, photo_id)?;
+    let photo = doc
+        .site
+        .photos
+        .iter()
+        .find(|p| p.id == photo_id)
+        .ok_or_else(|| SiteRenderError::NotSolved {
+            photo: photo_id.to_owned(),
+        })?;
+    let loaded = crate::photo::load(&doc.resolve(&photo.file))?;
+    let photo_linear = crate::render::linear_photo(&loaded);
+    let photo_px = [photo_linear.width(), photo_linear.height()];
+    if photo_px != camera.intrinsics.image_size_px {
+        return Err(SiteRenderError::SizeMismatch {
+            photo: photo_id.to_owned(),
+            photo_px,
+            camera_px: camera.intrinsics.image_size_px,
+        });
+    }
+    Ok((camera, photo_linear))
+}
+
 /// A planar view with its virtual camera.
 #[derive(Debug, Clone)]
 pub struct PlanarView {
@@ -149,25 +180,7 @@ pub fn planar_view(
             focal_equiv_mm,
         }
     })?;
-    let photo = doc
-        .site
-        .photos
-        .iter()
-        .find(|p| p.id == photo_id)
-        .ok_or_else(|| SiteRenderError::NotSolved {
-            photo: photo_id.to_owned(),
-        })?;
-    let loaded = crate::photo::load(&doc.resolve(&photo.file)).map_err(SiteRenderError::from)?;
-    let photo_linear = crate::render::linear_photo(&loaded);
-    let photo_px = [photo_linear.width(), photo_linear.height()];
-    if photo_px != source.intrinsics.image_size_px {
-        return Err(SiteRenderError::SizeMismatch {
-            photo: photo_id.to_owned(),
-            photo_px,
-            camera_px: source.intrinsics.image_size_px,
-        }
-        .into());
-    }
+    let (_, photo_linear) = solved_photo(doc, photo_id)?;
     let camera = planar_camera(&source, focal_px, size_px);
     let image = reproject(&source, &photo_linear, &camera);
     #[allow(clippy::cast_precision_loss)]
