@@ -13,6 +13,7 @@
 //! - [`wireline`]: the proposal's feature edges with hidden-line removal;
 //! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length;
 //! - [`cylindrical_view`]: a panorama from several photos taken from one point;
+//! - [`image_metadata`]: the view geometry as EXIF in JPEG/PNG output;
 //! - [`sheet`] and [`sheet_content`]: the PDF sheet (view at print scale, viewing distance,
 //!   ruler, geometry table, map inset, AVR level, methodology and residuals).
 //!
@@ -22,6 +23,7 @@
 pub mod avr;
 pub mod cylindrical_view;
 pub mod geometry;
+pub mod image_metadata;
 pub mod measure;
 pub mod paper;
 pub mod planar_view;

@@ -6,12 +6,17 @@ use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use photomontage::colour::SampleSet;
 use photomontage::colour::ToneMap;
+use photomontage::colour::encode_srgb8;
 use photomontage::colour::tonemap::ToneCurve;
+use photomontage::render::RenderedImage;
 use photomontage::render::output::{self, LayerSet, OutputFormat};
 use photomontage::render::{DifferentialTracer, render_view_spectral, render_view_with_layers};
 use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
-use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
+use photomontage::verified::image_metadata::{exif_block, write_8bit_with_exif};
+use photomontage::verified::{
+    AvrLevel, ViewGeometryOptions, apply_massing, avr_overlay, view_geometry,
+};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -58,6 +63,38 @@ pub struct Args {
     avr: u8,
 }
 
+/// Writes a render: JPEG and PNG carry the view geometry as EXIF (camera position as GPS,
+/// bearing, capture time, 35 mm equivalent, the report's key numbers); other formats as before.
+fn write_image(
+    path: &Path,
+    doc: &SiteDocument,
+    view: &str,
+    image: &RenderedImage,
+    layers: &output::OutputLayers,
+    tone_map: &ToneMap,
+) -> anyhow::Result<()> {
+    let format = OutputFormat::from_path(path)?;
+    if !matches!(format, OutputFormat::Jpeg | OutputFormat::Png) {
+        output::write_output(path, image, layers, tone_map)?;
+        return Ok(());
+    }
+    match view_geometry(doc, view, &ViewGeometryOptions::default()) {
+        Ok(report) => {
+            let [w, h] = image.size_px;
+            let rgb = image::RgbImage::from_fn(w, h, |x, y| {
+                let p = image.rgba[(y * w + x) as usize];
+                image::Rgb(encode_srgb8([p[0], p[1], p[2]], tone_map))
+            });
+            write_8bit_with_exif(path, &rgb, exif_block(&report), output::JPEG_QUALITY)?;
+        }
+        Err(e) => {
+            eprintln!("warning: no view geometry in the image's EXIF: {e}");
+            output::write_output(path, image, layers, tone_map)?;
+        }
+    }
+    Ok(())
+}
+
 /// AVR0/AVR1: the silhouette or wireline drawn over the photo, written like a render.
 fn draw_overlay(
     args: &Args,
@@ -71,8 +108,10 @@ fn draw_overlay(
         exposure_stops: exposure.log2(),
         curve: ToneCurve::Clamp,
     };
-    output::write_output(
+    write_image(
         &args.out,
+        doc,
+        &args.view,
         &overlay.image,
         &output::OutputLayers::default(),
         &tone_map,
@@ -231,7 +270,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         exposure_stops: exposure.log2(),
         curve: ToneCurve::Clamp,
     };
-    output::write_output(&args.out, &image, &out_layers, &tone_map)?;
+    write_image(&args.out, &doc, &args.view, &image, &out_layers, &tone_map)?;
     let table = if layers.object_id {
         let names: Vec<String> = job
             .scene
