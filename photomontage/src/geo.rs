@@ -32,6 +32,15 @@ pub enum GeoError {
         /// What `proj4rs` said.
         message: String,
     },
+    /// A CRS name that is neither a PROJ.4 string nor one of the supported EPSG codes.
+    #[error(
+        "unknown coordinate system {name:?}: give a PROJ.4 string or one of EPSG:2056, \
+         EPSG:27700, EPSG:326NN, EPSG:327NN"
+    )]
+    UnknownName {
+        /// The name given.
+        name: String,
+    },
     /// The conversion of a point failed (outside the projection's domain, NaN, …).
     #[error("cannot convert ({x}, {y}): {message}")]
     Conversion {
@@ -75,6 +84,10 @@ pub const SWISS_LV95: &str = "+proj=somerc +lat_0=46.9524055555556 +lon_0=7.4395
 /// PROJ.4 definition of the British National Grid (EPSG:27700).
 pub const BRITISH_NATIONAL_GRID: &str = "+proj=tmerc +lat_0=49 +lon_0=-2 +k=0.9996012717 +x_0=400000 +y_0=-100000 +ellps=airy +towgs84=446.448,-125.157,542.06,0.15,0.247,0.842,-20.489 +units=m +no_defs";
 
+/// Latitude step of [`ProjectedCrs::grid_convergence_deg`]: 1e-5° (about 1 m), where the
+/// meridian's curvature in the grid moves its direction by far less than 1e-6°.
+pub const CONVERGENCE_STEP_DEG: f64 = 1e-5;
+
 impl ProjectedCrs {
     /// A CRS from a PROJ.4 definition string.
     ///
@@ -110,6 +123,66 @@ impl ProjectedCrs {
         Self::from_proj_string(&format!(
             "+proj=utm +zone={zone}{south} +datum=WGS84 +units=m +no_defs"
         ))
+    }
+
+    /// A CRS from the name a site file gives (`location.crs`): a PROJ.4 string (`+proj=…`),
+    /// `EPSG:2056` (Swiss LV95), `EPSG:27700` (British National Grid), `EPSG:326NN` or
+    /// `EPSG:327NN` (UTM zone NN north or south on WGS84). Case and surrounding blanks are
+    /// ignored.
+    ///
+    /// # Errors
+    /// [`GeoError::UnknownName`] for any other name, [`GeoError::InvalidDefinition`] for a PROJ.4
+    /// string `proj4rs` rejects, [`GeoError::UtmZoneOutOfRange`].
+    pub fn from_name(name: &str) -> Result<Self, GeoError> {
+        let trimmed = name.trim();
+        if trimmed.starts_with('+') {
+            return Self::from_proj_string(trimmed);
+        }
+        let unknown = || GeoError::UnknownName {
+            name: name.to_owned(),
+        };
+        let code = trimmed
+            .to_ascii_uppercase()
+            .strip_prefix("EPSG:")
+            .and_then(|c| c.parse::<u32>().ok())
+            .ok_or_else(unknown)?;
+        match code {
+            2056 => Self::from_proj_string(SWISS_LV95),
+            27700 => Self::from_proj_string(BRITISH_NATIONAL_GRID),
+            32601..=32660 => Self::utm(
+                u8::try_from(code - 32600).map_err(|_| unknown())?,
+                Hemisphere::North,
+            ),
+            32701..=32760 => Self::utm(
+                u8::try_from(code - 32700).map_err(|_| unknown())?,
+                Hemisphere::South,
+            ),
+            _ => Err(unknown()),
+        }
+    }
+
+    /// Grid convergence at a projected point, in the site file's convention: the angle from grid
+    /// north (+northing) to true north, degrees, clockwise. Computed numerically: the point is
+    /// converted to latitude/longitude, moved [`CONVERGENCE_STEP_DEG`] north along its meridian
+    /// and converted back; the direction of that step in the grid is true north.
+    ///
+    /// # Errors
+    /// [`GeoError::Conversion`] when the point (or its neighbour) cannot be converted.
+    pub fn grid_convergence_deg(&self, easting_m: f64, northing_m: f64) -> Result<f64, GeoError> {
+        let (lat, lon) = self.to_lat_lon_deg(easting_m, northing_m)?;
+        // Step away from the pole so the neighbour exists.
+        let step = if lat > 0.0 {
+            -CONVERGENCE_STEP_DEG
+        } else {
+            CONVERGENCE_STEP_DEG
+        };
+        let (e1, n1) = self.from_lat_lon_deg(lat + step, lon)?;
+        let (de, dn) = if step > 0.0 {
+            (e1 - easting_m, n1 - northing_m)
+        } else {
+            (easting_m - e1, northing_m - n1)
+        };
+        Ok(de.atan2(dn).to_degrees())
     }
 
     /// The PROJ.4 definition.
@@ -217,6 +290,61 @@ mod tests {
         let want_lon = 8.0 + 43.0 / 60.0 + 49.79 / 3600.0;
         assert!((lat - want_lat).abs() < 3e-5, "{lat}");
         assert!((lon - want_lon).abs() < 3e-5, "{lon}");
+    }
+
+    /// Convergence against the ellipsoidal series (Snyder 1987, eq. 8-11 with its second term):
+    /// γ = Δλ sin φ (1 + Δλ² cos²φ (1 + 3η² + 2η⁴)/3), good to ~1e-6° at Δλ = 3°.
+    const CONVERGENCE_TOL_DEG: f64 = 1e-4;
+
+    #[test]
+    fn grid_convergence_follows_snyder_and_the_site_sign() {
+        let zone32 = ProjectedCrs::from_name("EPSG:32632").expect("valid");
+        // On the central meridian (9°E) grid north is true north.
+        let (e, n) = zone32.from_lat_lon_deg(47.0, 9.0).expect("converts");
+        assert!(zone32.grid_convergence_deg(e, n).expect("converts").abs() < 1e-6);
+        // 3° east of it at 47°N: meridians lean towards the pole, so true north lies
+        // anticlockwise of grid north and the site's convention (clockwise) is negative.
+        let (lat, dlon) = (47.0_f64.to_radians(), 3.0_f64.to_radians());
+        let e2 = 0.006_694_379_990_14; // WGS84 first eccentricity squared
+        let eta2 = e2 / (1.0 - e2) * lat.cos().powi(2);
+        let gamma = dlon
+            * lat.sin()
+            * (1.0
+                + dlon * dlon * lat.cos().powi(2) * (1.0 + 3.0 * eta2 + 2.0 * eta2 * eta2) / 3.0);
+        let (e, n) = zone32.from_lat_lon_deg(47.0, 12.0).expect("converts");
+        let got = zone32.grid_convergence_deg(e, n).expect("converts");
+        assert!(
+            (got + gamma.to_degrees()).abs() < CONVERGENCE_TOL_DEG,
+            "{got} vs {}",
+            -gamma.to_degrees()
+        );
+        // Southern hemisphere, west of the central meridian: again from the series.
+        let south = ProjectedCrs::from_name(" epsg:32733 ").expect("valid");
+        let (e, n) = south.from_lat_lon_deg(-33.0, 13.0).expect("converts");
+        let (lat, dlon) = ((-33.0_f64).to_radians(), (-2.0_f64).to_radians());
+        let eta2 = e2 / (1.0 - e2) * lat.cos().powi(2);
+        let gamma = dlon
+            * lat.sin()
+            * (1.0
+                + dlon * dlon * lat.cos().powi(2) * (1.0 + 3.0 * eta2 + 2.0 * eta2 * eta2) / 3.0);
+        let got = south.grid_convergence_deg(e, n).expect("converts");
+        assert!(
+            (got + gamma.to_degrees()).abs() < CONVERGENCE_TOL_DEG,
+            "{got}"
+        );
+    }
+
+    #[test]
+    fn names_of_coordinate_systems() {
+        assert!(ProjectedCrs::from_name("EPSG:2056").is_ok());
+        assert!(ProjectedCrs::from_name("EPSG:27700").is_ok());
+        assert!(ProjectedCrs::from_name("+proj=utm +zone=11 +datum=WGS84").is_ok());
+        assert!(matches!(
+            ProjectedCrs::from_name("EPSG:4326"),
+            Err(GeoError::UnknownName { .. })
+        ));
+        assert!(ProjectedCrs::from_name("EPSG:32661").is_err());
+        assert!(ProjectedCrs::from_name("Swiss grid").is_err());
     }
 
     #[test]

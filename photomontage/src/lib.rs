@@ -26,3 +26,4 @@ pub mod site;
 pub mod sky;
 pub mod sky_dome;
 pub mod sun;
+pub mod verified;

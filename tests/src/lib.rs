@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 pub mod street;
+pub mod truth;
 
 /// The repository root (the folder holding the workspace `Cargo.toml`).
 #[must_use]

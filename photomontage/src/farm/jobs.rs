@@ -16,11 +16,14 @@ use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use crate::render::output::{LayerSet, OutputFormat, write_object_table, write_output};
-use crate::render::partial::{PartError, merge_parts, read_part_info, write_part};
+use crate::render::partial::{
+    PartError, from_hex, merge_parts, read_part_info, to_hex, write_part,
+};
 use crate::render::{Band, TileProgress};
 use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 use crate::site::render_photo::{RenderPlan, RenderRequest, site_content_sha256};
+use crate::verified::image_metadata::{view_exif, write_render};
 
 /// The `format` of a job list this version writes and reads.
 pub const JOBS_FORMAT: &str = "photomontage-jobs/1";
@@ -128,6 +131,9 @@ pub enum FarmError {
     /// Writing failed.
     #[error(transparent)]
     Output(#[from] crate::render::OutputError),
+    /// Writing an 8-bit image with its EXIF failed.
+    #[error(transparent)]
+    Metadata(#[from] crate::verified::image_metadata::ImageMetadataError),
     /// A folder could not be made or written.
     #[error("cannot write in {path}: {message}")]
     Folder {
@@ -428,12 +434,10 @@ pub fn run_job(
     }
     crate::atomic_file::probe_writable(&output).map_err(folder)?;
     let rendered = plan.render(&doc, on_tile, cancel)?;
-    write_part(
-        &output,
-        &rendered.image,
-        &rendered.layers,
-        &plan.part_info(&rendered),
-    )?;
+    let mut info = plan.part_info(&rendered);
+    // 8-bit merges carry the view geometry as EXIF, as a whole-image `render` writes it.
+    info.exif_hex = view_exif(&doc, &job.view).ok().map(|b| to_hex(&b));
+    write_part(&output, &rendered.image, &rendered.layers, &info)?;
     Ok(JobOutcome::Rendered {
         output,
         changed_pixels: rendered.image.changed_pixels,
@@ -513,12 +517,14 @@ pub fn merge_to_file(
             write_object_table(out, names)?;
         }
     } else {
-        // 8-bit images drop the layers, as `render` does for them.
-        write_output(
+        // 8-bit images drop the layers and carry the view's EXIF, as `render` writes them.
+        let exif = merged.info.exif_hex.as_deref().and_then(from_hex);
+        write_render(
             out,
             &merged.image,
             &crate::render::output::OutputLayers::default(),
             &tone_map,
+            exif,
         )?;
     }
     Ok(merged)

@@ -19,7 +19,7 @@ use std::path::Path;
 use super::PhotoError;
 
 /// Diagonal of the 36 × 24 mm frame that "35 mm equivalent" focal lengths refer to.
-const FULL_FRAME_DIAGONAL_MM: f64 = 43.266_615_305_567_87;
+pub const FULL_FRAME_DIAGONAL_MM: f64 = 43.266_615_305_567_87;
 
 /// Sensor sizes (width × height, mm) of camera bodies whose EXIF lacks a usable focal-plane
 /// resolution. Sources: the manufacturers' specification sheets.

@@ -52,6 +52,28 @@ pub struct PartInfo {
     pub changed_pixels: usize,
     /// Primary rays shot in the band.
     pub primary_rays: u64,
+    /// EXIF block (TIFF-structured bytes, hex) that 8-bit outputs of the merged image carry:
+    /// the view geometry, so that a merged JPEG/PNG equals the whole render's byte for byte.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exif_hex: Option<String>,
+}
+
+/// Lower-case hex of `bytes` (for [`PartInfo::exif_hex`]).
+#[must_use]
+pub fn to_hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The bytes of lower-case or upper-case hex; `None` if it is not hex.
+#[must_use]
+pub fn from_hex(text: &str) -> Option<Vec<u8>> {
+    if !text.len().is_multiple_of(2) {
+        return None;
+    }
+    (0..text.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(text.get(i..i + 2)?, 16).ok())
+        .collect()
 }
 
 impl PartInfo {

@@ -277,6 +277,32 @@ impl Scene {
         Ok((id, model.warnings))
     }
 
+    /// Gives every triangle of every object of `kind` the material `material` (e.g. a neutral
+    /// massing material for the planned objects); returns how many triangles changed.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownId`] when `material` is not in the scene.
+    pub fn set_material_of_kind(
+        &mut self,
+        kind: ObjectKind,
+        material: MaterialId,
+    ) -> Result<usize, SceneError> {
+        if self.materials.len() <= material.0 as usize {
+            return Err(SceneError::UnknownId {
+                what: "material",
+                id: material.0,
+            });
+        }
+        let mut changed = 0;
+        for t in &mut self.triangles {
+            if self.objects.get(t.object.0 as usize).map(|o| o.kind) == Some(kind) {
+                t.material = material;
+                changed += 1;
+            }
+        }
+        Ok(changed)
+    }
+
     /// Replaces every scene material whose name appears in the library by the library's
     /// definition; returns how many were replaced.
     pub fn apply_material_library(&mut self, library: &MaterialLibrary) -> usize {

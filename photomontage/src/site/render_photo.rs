@@ -28,6 +28,7 @@ use crate::render::{
     Band, DifferentialTracer, RenderSettings, RenderedImage, TileProgress, render_band_spectral,
     render_band_with_layers,
 };
+use crate::scene::{Scene, SceneError};
 
 /// Rays per pixel the renderer accepts: multiples of 4 in this range.
 pub const SPP_RANGE: std::ops::RangeInclusive<u32> = 4..=64;
@@ -236,7 +237,23 @@ impl RenderPlan {
         on_tile: &(dyn Fn(TileProgress) + Sync),
         cancel: &AtomicBool,
     ) -> Result<RenderedPhoto, SiteRenderError> {
-        let job = prepare_view(doc, &self.request.view)?;
+        self.render_edited(doc, &|_| Ok(()), on_tile, cancel)
+    }
+
+    /// [`RenderPlan::render`] with `edit` applied to the scene before tracing (e.g. the AVR2
+    /// massing material). Record the edit in [`RenderPlan::identity`] when parts are written.
+    ///
+    /// # Errors
+    /// As [`RenderPlan::render`], and the edit's [`SceneError`].
+    pub fn render_edited(
+        &self,
+        doc: &SiteDocument,
+        edit: &dyn Fn(&mut Scene) -> Result<(), SceneError>,
+        on_tile: &(dyn Fn(TileProgress) + Sync),
+        cancel: &AtomicBool,
+    ) -> Result<RenderedPhoto, SiteRenderError> {
+        let mut job = prepare_view(doc, &self.request.view)?;
+        edit(&mut job.scene.scene)?;
         let tracer = DifferentialTracer::new(
             &job.scene.scene,
             &job.lighting,
@@ -299,6 +316,7 @@ impl RenderPlan {
                 .then(|| rendered.object_names.clone()),
             changed_pixels: rendered.image.changed_pixels,
             primary_rays: rendered.image.primary_rays,
+            exif_hex: None,
         }
     }
 }

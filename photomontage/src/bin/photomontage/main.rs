@@ -8,9 +8,12 @@ mod merge;
 mod render;
 mod report;
 mod resect;
+mod sheet;
 mod sky;
 mod solve;
+mod standard_view;
 mod sun;
+mod view_report;
 
 use clap::{Parser, Subcommand};
 
@@ -60,6 +63,16 @@ enum Command {
     K8s(farm::K8sArgs),
     /// Write a job list and a Flamenco job type with its submission body.
     Flamenco(farm::FlamencoArgs),
+    /// The view geometry report of one solved photo (TGN 06/19 / LVMF verified view): camera
+    /// position and height, bearing, pitch, roll, fields of view, 35 mm equivalent, sun at
+    /// capture, residuals, distance to the proposal, viewing distance of the sheet.
+    Report(view_report::Args),
+    /// A solved photo re-projected to a standard focal length (planar view at a 50 mm or 75 mm
+    /// equivalent), with its virtual camera.
+    View(standard_view::Args),
+    /// The verified-view sheet (PDF) of one solved photo: the view at print scale with its
+    /// viewing distance, ruler, geometry table, map inset, AVR level, methodology and residuals.
+    Sheet(sheet::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -79,5 +92,8 @@ fn main() -> anyhow::Result<()> {
         Command::Slurm(args) => farm::slurm(&args),
         Command::K8s(args) => farm::k8s(&args),
         Command::Flamenco(args) => farm::flamenco(&args),
+        Command::Report(args) => view_report::run(&args),
+        Command::View(args) => standard_view::run(&args),
+        Command::Sheet(args) => sheet::run(&args),
     }
 }

@@ -4,11 +4,16 @@
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
+use photomontage::colour::ToneMap;
+use photomontage::colour::tonemap::ToneCurve;
 use photomontage::render::Band;
 use photomontage::render::output::{self, LayerSet, OutputFormat};
+use photomontage::render::partial::to_hex;
 use photomontage::render::partial::write_part;
 use photomontage::site::SiteDocument;
 use photomontage::site::render_photo::{RenderPlan, RenderRequest};
+use photomontage::verified::image_metadata::{view_exif, write_render};
+use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -53,6 +58,52 @@ pub struct Args {
     /// EXR for `photomontage merge`; the band's pixels are bit for bit those of the whole render.
     #[arg(long, value_name = "I/N")]
     tile: Option<String>,
+    /// Accurate Visual Representation level (LVMF): 0 silhouette, 1 wireline (hidden edges
+    /// dashed), 2 massing in a neutral material under the site's light, 3 the full montage.
+    #[arg(long, value_name = "LEVEL", default_value_t = 3)]
+    avr: u8,
+}
+
+/// The view geometry as EXIF for 8-bit outputs; a warning (and no EXIF) when it cannot be had.
+fn exif_of(doc: &SiteDocument, view: &str) -> Option<Vec<u8>> {
+    match view_exif(doc, view) {
+        Ok(exif) => Some(exif),
+        Err(e) => {
+            eprintln!("warning: no view geometry in the image's EXIF: {e}");
+            None
+        }
+    }
+}
+
+/// AVR0/AVR1: the silhouette or wireline drawn over the photo, written like a render.
+fn draw_overlay(
+    args: &Args,
+    doc: &SiteDocument,
+    avr: AvrLevel,
+    exposure: f64,
+) -> anyhow::Result<()> {
+    check_writable(&args.out)?;
+    let overlay = avr_overlay(doc, &args.view, avr)?;
+    let tone_map = ToneMap {
+        exposure_stops: exposure.log2(),
+        curve: ToneCurve::Clamp,
+    };
+    write_render(
+        &args.out,
+        &overlay.image,
+        &output::OutputLayers::default(),
+        &tone_map,
+        exif_of(doc, &args.view),
+    )?;
+    println!(
+        "drew {} ({}) of view {} into {}: {} pixels",
+        avr.name(),
+        avr.description(),
+        args.view,
+        args.out.display(),
+        overlay.image.changed_pixels
+    );
+    Ok(())
 }
 
 /// Fails early (before the render) when `path` cannot be created or written.
@@ -138,7 +189,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         exposure: args.exposure,
         band: band.unwrap_or(Band::WHOLE),
     };
-    let plan = RenderPlan::new(&doc, &request)?;
+    let mut plan = RenderPlan::new(&doc, &request)?;
+    let avr = AvrLevel::from_number(args.avr)?;
+    if matches!(avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
+        if plan.spectral || !layers.is_empty() || band.is_some() {
+            bail!(
+                "--avr {} draws over the photo: no --spectral, --layers or --tile",
+                args.avr
+            );
+        }
+        return draw_overlay(args, &doc, avr, plan.exposure);
+    }
+    if avr == AvrLevel::Avr2 {
+        // Parts of a massing render must not merge with parts of the montage.
+        plan.identity.insert("avr".into(), avr.name().into());
+    }
     check_writable(&args.out)?;
 
     let start = Instant::now();
@@ -152,8 +217,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         ),
         None => eprintln!("rendering {w}×{h} px (Ctrl-C cancels)"),
     }
+    let massing = |scene: &mut photomontage::scene::Scene| {
+        if avr == AvrLevel::Avr2 {
+            apply_massing(scene)?;
+        }
+        Ok(())
+    };
     let result = with_threads(args.threads, || {
-        Ok(plan.render(&doc, &|_| bar.inc(1), cancel)?)
+        Ok(plan.render_edited(&doc, &massing, &|_| bar.inc(1), cancel)?)
     });
     bar.finish_and_clear();
     if CANCEL.load(Ordering::SeqCst) {
@@ -168,16 +239,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let elapsed_s = start.elapsed().as_secs_f64();
     let image = &rendered.image;
-    let table = if band.is_some() {
-        write_part(
-            &args.out,
-            image,
-            &rendered.layers,
-            &plan.part_info(&rendered),
-        )?;
+    let exif = if format == OutputFormat::Exr && band.is_none() {
         None
     } else {
-        output::write_output(&args.out, image, &rendered.layers, &plan.tone_map())?;
+        exif_of(&doc, &args.view)
+    };
+    let table = if band.is_some() {
+        let mut info = plan.part_info(&rendered);
+        info.exif_hex = exif.as_deref().map(to_hex);
+        write_part(&args.out, image, &rendered.layers, &info)?;
+        None
+    } else {
+        write_render(&args.out, image, &rendered.layers, &plan.tone_map(), exif)?;
         if layers.object_id {
             Some(output::write_object_table(
                 &args.out,
