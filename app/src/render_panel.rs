@@ -133,6 +133,8 @@ pub struct RenderPanel {
     pub export_path: String,
     /// Path of the verified-view sheet (PDF) typed by the user.
     pub sheet_path: String,
+    /// The last view geometry report (Report button).
+    pub report: Option<photomontage::verified::ViewGeometry>,
     worker: Option<Worker>,
     tiles_done: Vec<TileProgress>,
     tile_count: usize,
@@ -239,6 +241,7 @@ impl Default for RenderPanel {
             ab_split: 0.5,
             export_path: String::new(),
             sheet_path: String::new(),
+            report: None,
             worker: None,
             tiles_done: Vec::new(),
             tile_count: 0,
@@ -796,5 +799,6 @@ impl crate::Studio {
                 self.export_sheet();
             }
         });
+        self.report_ui(ui);
     }
 }

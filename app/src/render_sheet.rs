@@ -1,13 +1,17 @@
-//! The Render panel's Sheet button: the verified-view PDF (`photomontage::verified::sheet`) of
-//! the finished view, at the AVR level it was made with, on A3 (the library's default paper).
+//! The Render panel's verified-view controls: the Sheet button (the verified-view PDF,
+//! `photomontage::verified::sheet`, of the finished view at the AVR level it was made with, on
+//! A3, the library's default paper) and the Report button (the view geometry report of the
+//! current photo, `photomontage::verified::view_geometry`, shown as the sheet's table).
 
 use std::path::Path;
 
+use eframe::egui;
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::encode_srgb8;
 use photomontage::site::SiteDocument;
-use photomontage::verified::ViewGeometryOptions;
 use photomontage::verified::sheet::{sheet_for_view, write_sheet};
+use photomontage::verified::sheet_content::geometry_rows;
+use photomontage::verified::{ViewGeometryOptions, view_geometry};
 
 use crate::render_panel::{RenderPanel, RenderPanelError, site_tone_map};
 
@@ -42,6 +46,43 @@ impl RenderPanel {
 }
 
 impl crate::Studio {
+    /// Computes the view geometry report of the current photo (shown in the Render panel).
+    pub fn make_report(&mut self) {
+        let (Some(doc), Some(id)) = (self.doc.as_ref(), self.current_photo.clone()) else {
+            self.say("open a site with a photo first", true);
+            return;
+        };
+        match view_geometry(doc, &id, &ViewGeometryOptions::default()) {
+            Ok(report) => {
+                self.render.report = Some(report);
+                self.say(format!("view geometry of {id}"), false);
+            }
+            Err(e) => {
+                self.render.report = None;
+                self.say(e.to_string(), true);
+            }
+        }
+    }
+
+    /// The Report button and the report's table (label, value rows as on the sheet).
+    pub(crate) fn report_ui(&mut self, ui: &mut egui::Ui) {
+        if ui.button("Report").clicked() {
+            self.make_report();
+        }
+        let id = self.current_photo.clone().unwrap_or_default();
+        if let Some(report) = self.render.report.as_ref().filter(|r| r.photo_id == id) {
+            egui::Grid::new("view geometry")
+                .striped(true)
+                .show(ui, |ui| {
+                    for (label, value) in geometry_rows(report) {
+                        ui.label(label);
+                        ui.label(value);
+                        ui.end_row();
+                    }
+                });
+        }
+    }
+
     /// Writes the verified-view sheet of the finished view to the path typed in the panel.
     pub fn export_sheet(&mut self) {
         let Some(doc) = self.doc.as_ref() else {

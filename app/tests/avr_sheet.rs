@@ -1,5 +1,6 @@
-//! The Render panel's AVR level and Sheet button on the courtyard sample (with the small OBJ box
-//! as its planned model): AVR1 shows exactly the library's wireline overlay of the solved photo,
+//! The Render panel's Report button, AVR level and Sheet button on the courtyard sample (with the
+//! small OBJ box as its planned model): the report is the library's and its bearing is on
+//! screen; AVR1 shows exactly the library's wireline overlay of the solved photo,
 //! and the Sheet button writes a two-page PDF whose image placement matches the report's
 //! viewing distance; without a finished view, no sheet is written.
 
@@ -20,6 +21,17 @@ fn avr1_view_and_sheet_from_the_studio() {
     step_until(&mut h, "solve", |s| s.solution().is_some() && s.is_idle());
     h.get_by_label("Render").click();
     h.run();
+    // The Report button: the view geometry of the current photo, as the library computes it.
+    h.get_by_label("Report").click();
+    h.run();
+    let doc = h.state().document().unwrap().clone();
+    let shown = h.state().render_panel().report.clone().expect("a report");
+    let library = view_geometry(&doc, "P1", &ViewGeometryOptions::default()).unwrap();
+    assert_eq!(shown, library);
+    h.get_by_label("Bearing (true N)");
+    // The courtyard states grid convergence 0: true and grid bearing are the same number.
+    let bearing = format!("{:.3} deg", library.bearing_true_deg);
+    assert_eq!(h.query_all_by_label(&bearing).count(), 2);
     // No view yet: the Sheet button is disabled, nothing is written.
     let sheet = dir.path().join("P1-avr1.pdf");
     h.state_mut().render_panel_mut().sheet_path = sheet.display().to_string();
