@@ -28,6 +28,7 @@ pub mod photo_settings;
 mod photo_view;
 pub mod points;
 pub mod render_panel;
+pub mod render_sheet;
 pub mod scene_panel;
 pub mod scene_pick;
 pub mod solve;

@@ -10,6 +10,11 @@
 //! Tone mapping for display and 8-bit export is the site's `render.exposure` with a clamp, as in
 //! the CLI.
 //!
+//! The AVR level (LVMF Appendix C) is chosen here like the CLI's `render --avr`: AVR0/AVR1 are
+//! drawn by `photomontage::verified::avr_overlay` (no tiles), AVR2 renders with
+//! `photomontage::verified::apply_massing`, AVR3 is the montage. The Sheet button writes the
+//! verified-view PDF of the finished view ([`crate::render_sheet`]).
+//!
 //! # Known limitations
 //! During the render the preview covers the whole photo (the A/B split applies to the finished
 //! montage). The display texture is subsampled (nearest pixel) to at most
@@ -24,6 +29,7 @@ use photomontage::render::{
 };
 use photomontage::site::SiteDocument;
 use photomontage::site::render::{ViewJob, prepare_view};
+use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -43,6 +49,8 @@ pub struct Quality {
     pub spp_max: u32,
     /// Seed of the sample positions.
     pub seed: u64,
+    /// Accurate Visual Representation level of the view.
+    pub avr: AvrLevel,
 }
 
 impl Default for Quality {
@@ -51,6 +59,7 @@ impl Default for Quality {
             spp_min: 4,
             spp_max: 16,
             seed: 0,
+            avr: AvrLevel::Avr3,
         }
     }
 }
@@ -81,6 +90,9 @@ pub enum RenderPanelError {
     /// Writing the file failed.
     #[error(transparent)]
     Export(#[from] photomontage::render::OutputError),
+    /// The verified-view sheet could not be made or written.
+    #[error(transparent)]
+    Sheet(#[from] Box<photomontage::verified::sheet::SheetError>),
 }
 
 enum WorkerMsg {
@@ -95,6 +107,7 @@ enum WorkerMsg {
 
 struct Worker {
     photo_id: String,
+    avr: AvrLevel,
     cancel: Arc<AtomicBool>,
     rx: Receiver<WorkerMsg>,
 }
@@ -105,6 +118,8 @@ pub struct Montage {
     pub photo_id: String,
     /// The render, linear RGBA at the photo's size.
     pub image: RenderedImage,
+    /// The AVR level it shows.
+    pub avr: AvrLevel,
     texture: Option<egui::TextureHandle>,
 }
 
@@ -116,6 +131,10 @@ pub struct RenderPanel {
     pub ab_split: f32,
     /// Export path typed by the user.
     pub export_path: String,
+    /// Path of the verified-view sheet (PDF) typed by the user.
+    pub sheet_path: String,
+    /// The last view geometry report (Report button).
+    pub report: Option<photomontage::verified::ViewGeometry>,
     worker: Option<Worker>,
     tiles_done: Vec<TileProgress>,
     tile_count: usize,
@@ -221,6 +240,8 @@ impl Default for RenderPanel {
             quality: Quality::default(),
             ab_split: 0.5,
             export_path: String::new(),
+            sheet_path: String::new(),
+            report: None,
             worker: None,
             tiles_done: Vec::new(),
             tile_count: 0,
@@ -282,6 +303,7 @@ pub fn prepare_photo(
         spp_min,
         spp_max,
         seed,
+        avr,
     } = quality;
     if spp_min < 4 || spp_min % 4 != 0 || spp_max % 4 != 0 || spp_min > spp_max {
         return Err(RenderPanelError::BadQuality { spp_min, spp_max });
@@ -293,7 +315,30 @@ pub fn prepare_photo(
     job.settings.min_rays_per_pixel = spp_min;
     job.settings.max_rays_per_pixel = spp_max;
     job.settings.seed = seed;
+    if avr == AvrLevel::Avr2 {
+        apply_massing(&mut job.scene.scene).map_err(|e| RenderPanelError::Prepare {
+            photo: photo.clone(),
+            message: e.to_string(),
+        })?;
+    }
     Ok(job)
+}
+
+/// AVR0/AVR1: the silhouette or wireline of `photo_id` drawn over the photo.
+///
+/// # Errors
+/// [`RenderPanelError::Prepare`] with the library's message (unsolved photo, no model, …).
+pub fn overlay_photo(
+    doc: &SiteDocument,
+    photo_id: &str,
+    avr: AvrLevel,
+) -> Result<RenderedImage, RenderPanelError> {
+    avr_overlay(doc, photo_id, avr)
+        .map(|o| o.image)
+        .map_err(|e| RenderPanelError::Prepare {
+            photo: photo_id.to_owned(),
+            message: e.to_string(),
+        })
 }
 
 /// Traces a prepared job, calling `on_tile` per finished tile.
@@ -448,14 +493,18 @@ impl RenderPanel {
                 let _ = tile_tx.send(WorkerMsg::Tile(t));
                 tile_ctx.request_repaint();
             };
-            let result = prepare_photo(&doc, &id, quality).and_then(|job| {
-                let photo = &job.photo_linear;
-                let _ = tx.send(WorkerMsg::Photo {
-                    size_px: [photo.width(), photo.height()],
-                    image: display_photo(photo, &tone_map),
-                });
-                trace_photo(&job, &id, &on_tile, &flag)
-            });
+            let result = if matches!(quality.avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
+                overlay_photo(&doc, &id, quality.avr)
+            } else {
+                prepare_photo(&doc, &id, quality).and_then(|job| {
+                    let photo = &job.photo_linear;
+                    let _ = tx.send(WorkerMsg::Photo {
+                        size_px: [photo.width(), photo.height()],
+                        image: display_photo(photo, &tone_map),
+                    });
+                    trace_photo(&job, &id, &on_tile, &flag)
+                })
+            };
             let _ = tx.send(WorkerMsg::Done(result));
             ctx.request_repaint();
         });
@@ -464,6 +513,7 @@ impl RenderPanel {
         self.preview = None;
         self.worker = Some(Worker {
             photo_id: photo_id.to_owned(),
+            avr: self.quality.avr,
             cancel,
             rx,
         });
@@ -499,16 +549,20 @@ impl RenderPanel {
             }
         }
         let photo_id = worker.photo_id.clone();
+        let avr = worker.avr;
         let result = done?;
         self.worker = None;
         Some(result.map(|image| {
             let text = format!(
-                "rendered {photo_id}: {} changed pixels, {} primary rays",
-                image.changed_pixels, image.primary_rays
+                "rendered {photo_id} ({}): {} changed pixels, {} primary rays",
+                avr.name(),
+                image.changed_pixels,
+                image.primary_rays
             );
             self.montage = Some(Montage {
                 photo_id,
                 image,
+                avr,
                 texture: None,
             });
             text
@@ -681,6 +735,24 @@ impl crate::Studio {
             ui.label("seed");
         });
         ui.horizontal(|ui| {
+            ui.label("AVR level");
+            let r = egui::ComboBox::from_id_salt("avr level")
+                .selected_text(q.avr.name())
+                .show_ui(ui, |ui| {
+                    for level in [
+                        AvrLevel::Avr0,
+                        AvrLevel::Avr1,
+                        AvrLevel::Avr2,
+                        AvrLevel::Avr3,
+                    ] {
+                        ui.selectable_value(&mut q.avr, level, level.name())
+                            .on_hover_text(level.description());
+                    }
+                })
+                .response;
+            crate::points::name_widget(ui, &r, "AVR level");
+        });
+        ui.horizontal(|ui| {
             let busy = self.render.busy();
             if ui.add_enabled(!busy, egui::Button::new("Start")).clicked() {
                 let ctx = ui.ctx().clone();
@@ -715,5 +787,18 @@ impl crate::Studio {
                 self.export_render();
             }
         });
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.render.sheet_path)
+                    .hint_text("sheet.pdf")
+                    .desired_width(260.0),
+            );
+            crate::points::name_widget(ui, &r, "sheet path");
+            let has = self.render.montage().is_some_and(|m| m.photo_id == id);
+            if ui.add_enabled(has, egui::Button::new("Sheet")).clicked() {
+                self.export_sheet();
+            }
+        });
+        self.report_ui(ui);
     }
 }

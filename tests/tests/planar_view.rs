@@ -83,3 +83,66 @@ fn cylindrical_view_refuses_photos_from_different_points() {
         .to_string();
     assert!(err.contains("V1") && err.contains("not solved"), "{err}");
 }
+
+/// The montage rendered into a 50 mm view agrees with the generator's truth image (the street
+/// with the building, rendered by Mitsuba) re-projected into the same view, over the building's
+/// interior pixels: the tolerance of street_render.rs (4.5 % mean relative error of the building)
+/// plus 1 % for the truth's resampling.
+const BUILDING_MEAN_REL_TOL: f64 = 0.055;
+
+#[test]
+fn the_montage_renders_into_a_planar_view_as_into_a_photo() {
+    use photomontage::render::{DifferentialTracer, render_view};
+    use photomontage::verified::planar_view::{planar_view_job, reproject};
+    let doc = site_with_true_cameras("street");
+    let size = [320, 240];
+    let (view, job) = planar_view_job(&doc, "V1", 50.0, Some(size)).unwrap();
+    assert_eq!(job.camera, view.camera);
+    assert_eq!([job.photo_linear.width(), job.photo_linear.height()], size);
+    let tracer = DifferentialTracer::new(
+        &job.scene.scene,
+        &job.lighting,
+        &job.camera,
+        &job.photo_linear,
+        job.settings.max_depth,
+    )
+    .unwrap();
+    let montage = render_view(
+        &tracer,
+        &job.settings,
+        &|_| {},
+        &std::sync::atomic::AtomicBool::new(false),
+    )
+    .unwrap();
+    // The truth, re-projected from the photo's camera into the view.
+    let truth = photomontage_tests::street::load_linear(
+        &photomontage_tests::sample_site("street").join("truth/V1.png"),
+    );
+    let source = photomontage::site::render::site_camera(&doc, "V1").unwrap();
+    let truth_view = reproject(&source, &truth, &view.camera);
+    let [w, h] = size.map(|v| v as usize);
+    let (mut err, mut n) = (0.0, 0);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let i = y * w + x;
+            // Interior of the building: it and its four neighbours fully covered.
+            if [i, i - 1, i + 1, i - w, i + w]
+                .iter()
+                .all(|&j| montage.rgba[j][3] >= 1.0)
+            {
+                let (o, t) = (montage.rgba[i], truth_view.rgba[i]);
+                err += (0..3)
+                    .map(|k| (f64::from(o[k]) - f64::from(t[k])).abs() / f64::from(t[k]).max(1e-3))
+                    .sum::<f64>()
+                    / 3.0;
+                n += 1;
+            }
+        }
+    }
+    let mre = err / f64::from(n);
+    println!(
+        "50 mm view: {n} building pixels, mean relative error vs the re-projected truth {mre:.4}"
+    );
+    assert!(n > 1000, "the building is in the 50 mm view");
+    assert!(mre < BUILDING_MEAN_REL_TOL, "{mre}");
+}

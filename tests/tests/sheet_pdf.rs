@@ -250,3 +250,50 @@ fn bad_input_leaves_no_pdf() {
     assert!(!bad.exists() && !Path::new(&dir.path().join("missing")).exists());
     assert!(!path.exists());
 }
+
+#[test]
+fn html_sheet_of_the_street() {
+    use photomontage::verified::sheet::{SheetFormat, sheet_for_view_as};
+    let doc = site_with_true_cameras("street");
+    let options = ViewGeometryOptions::default();
+    let report = view_geometry(&doc, "V1", &options).unwrap();
+    let html = sheet_for_view_as(
+        &doc,
+        "V1",
+        &sheet_image(&doc, "V1"),
+        AvrLevel::Avr1,
+        &options,
+        SheetFormat::Html,
+    )
+    .unwrap();
+    let html = String::from_utf8(html).unwrap();
+    // The image's CSS width against the viewing-distance formula (computed here).
+    let style = html.split("img.view {").nth(1).unwrap();
+    let width_mm: f64 = style
+        .split("width: ")
+        .nth(1)
+        .unwrap()
+        .split("mm")
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let want_mm = report.viewing_distance_mm * 2.0 * (report.hfov_deg.to_radians() / 2.0).tan();
+    assert!(
+        (width_mm - want_mm).abs() < PRINTED_WIDTH_TOL_MM,
+        "{width_mm} vs {want_mm}"
+    );
+    assert!(html.contains("@page { size: 420mm 297mm;"));
+    // The image is embedded as a JPEG (base64 of the SOI marker FF D8 FF is "/9j/").
+    assert!(html.contains("src=\"data:image/jpeg;base64,/9j/"));
+    let json = serde_json::to_value(&report).unwrap();
+    let missing: Vec<String> = number_strings(&json)
+        .into_iter()
+        .filter(|s| !html.contains(s.as_str()))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "numbers missing from the HTML: {missing:?}"
+    );
+    assert!(html.contains("TGN 06/19 Type 4") && html.contains("Methodology"));
+}

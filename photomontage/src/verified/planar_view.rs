@@ -12,6 +12,9 @@
 //! centres at integer coordinates). A world point therefore lands where the virtual pinhole puts
 //! it.
 //!
+//! [`planar_view_job`] turns the site's render job for the photo into one for the view (virtual
+//! camera, re-projected photo), so the montage renders into the view as into a photo.
+//!
 //! # Known limitations
 //! Bilinear resampling: enlarging (a longer focal length than the photo's) softens, and there is no
 //! prefilter when reducing. Output pixels whose ray falls outside the photo (a shorter focal length
@@ -25,7 +28,7 @@ use crate::camera::{Camera, Intrinsics};
 use crate::photo::exif::FULL_FRAME_DIAGONAL_MM;
 use crate::render::RenderedImage;
 use crate::site::SiteDocument;
-use crate::site::render::{SiteRenderError, site_camera};
+use crate::site::render::{SiteRenderError, ViewJob, prepare_view, site_camera};
 
 /// What can go wrong making a planar view.
 #[derive(Debug, thiserror::Error)]
@@ -190,6 +193,32 @@ pub fn planar_view(
         image,
         coverage,
     })
+}
+
+/// The render job of a planar view, so that the montage renders into the view as into a photo:
+/// the site's job for `photo_id` ([`crate::site::render::prepare_view`]) with the virtual
+/// camera and the re-projected photo in place of the photo's own (pixels the photo does not
+/// cover are black there). Also returns the view itself.
+///
+/// # Errors
+/// As [`planar_view`], and [`crate::site::render::prepare_view`]'s errors (no visible model,
+/// lighting).
+pub fn planar_view_job(
+    doc: &SiteDocument,
+    photo_id: &str,
+    focal_equiv_mm: f64,
+    size_px: Option<[u32; 2]>,
+) -> Result<(PlanarView, ViewJob), PlanarViewError> {
+    let view = planar_view(doc, photo_id, focal_equiv_mm, size_px)?;
+    let mut job = prepare_view(doc, photo_id)?;
+    let [w, h] = view.image.size_px;
+    let rgba = &view.image.rgba;
+    job.photo_linear = Rgb32FImage::from_fn(w, h, |x, y| {
+        let p = rgba[(y * w + x) as usize];
+        image::Rgb([p[0], p[1], p[2]])
+    });
+    job.camera = view.camera;
+    Ok((view, job))
 }
 
 #[cfg(test)]

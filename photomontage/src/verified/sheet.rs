@@ -502,18 +502,59 @@ pub fn sheet_pdf(input: &SheetInput<'_>) -> Result<Vec<u8>, SheetError> {
     Ok(pdf.finish())
 }
 
+/// The file format of a sheet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SheetFormat {
+    /// PDF ([`sheet_pdf`]).
+    Pdf,
+    /// One self-contained HTML file ([`super::sheet_html::sheet_html`]).
+    Html,
+}
+
+impl SheetFormat {
+    /// The format a file name's extension names (`.pdf`, `.html`/`.htm`), if any.
+    #[must_use]
+    pub fn from_path(path: &Path) -> Option<Self> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("pdf") => Some(Self::Pdf),
+            Some("html" | "htm") => Some(Self::Html),
+            _ => None,
+        }
+    }
+}
+
 /// The sheet of photo `photo_id` showing `image` (the view at `avr`, 8-bit sRGB, the photo's
-/// size): the report, map and methodology gathered from the site, then [`sheet_pdf`].
+/// size) as PDF: the report, map and methodology gathered from the site, then [`sheet_pdf`].
 ///
 /// # Errors
-/// The report's errors (unknown or unsolved view, scene), [`SheetError::SizeMismatch`] when the
-/// image is not the photo's size, and [`sheet_pdf`]'s.
+/// As [`sheet_for_view_as`].
 pub fn sheet_for_view(
     doc: &SiteDocument,
     photo_id: &str,
     image: &RgbImage,
     avr: AvrLevel,
     options: &ViewGeometryOptions,
+) -> Result<Vec<u8>, SheetError> {
+    sheet_for_view_as(doc, photo_id, image, avr, options, SheetFormat::Pdf)
+}
+
+/// The sheet of photo `photo_id` in `format`.
+///
+/// # Errors
+/// The report's errors (unknown or unsolved view, scene), [`SheetError::SizeMismatch`] when the
+/// image is not the photo's size, and the writer's.
+pub fn sheet_for_view_as(
+    doc: &SiteDocument,
+    photo_id: &str,
+    image: &RgbImage,
+    avr: AvrLevel,
+    options: &ViewGeometryOptions,
+    format: SheetFormat,
 ) -> Result<Vec<u8>, SheetError> {
     let report = view_geometry(doc, photo_id, options)?;
     let (w, h) = image.dimensions();
@@ -526,13 +567,17 @@ pub fn sheet_for_view(
     }
     let map = map_inset(doc, &report)?;
     let methodology = methodology(doc, &report, avr);
-    sheet_pdf(&SheetInput {
+    let input = SheetInput {
         report: &report,
         image,
         avr,
         map,
         methodology,
-    })
+    };
+    match format {
+        SheetFormat::Pdf => sheet_pdf(&input),
+        SheetFormat::Html => super::sheet_html::sheet_html(&input).map(String::into_bytes),
+    }
 }
 
 /// Writes `bytes` to `path` through a temporary file beside it and a rename: either the whole

@@ -70,7 +70,7 @@ enum Command {
     /// A solved photo re-projected to a standard focal length (planar view at a 50 mm or 75 mm
     /// equivalent), with its virtual camera.
     View(standard_view::Args),
-    /// The verified-view sheet (PDF) of one solved photo: the view at print scale with its
+    /// The verified-view sheet (PDF or HTML) of one solved photo: the view at print scale with its
     /// viewing distance, ruler, geometry table, map inset, AVR level, methodology and residuals.
     Sheet(sheet::Args),
 }

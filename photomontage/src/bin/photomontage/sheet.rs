@@ -1,14 +1,14 @@
-//! `photomontage sheet SITE --view V --avr LEVEL --out sheet.pdf`: the verified-view sheet (PDF)
+//! `photomontage sheet SITE --view V --avr LEVEL --out sheet.pdf|.html`: the verified-view sheet
 //! of one solved photo. The view is drawn (AVR0/1) or rendered (AVR2/3, the site's render
 //! settings) unless `--image` gives it; the sheet itself is `photomontage::verified::sheet`.
-//! The PDF is written through a temporary file and a rename: never a partial file.
+//! The file is written through a temporary file and a rename: never a partial file.
 
 use anyhow::{Context, bail};
 use photomontage::colour::{ToneCurve, ToneMap, encode_srgb8};
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
-use photomontage::verified::sheet::{sheet_for_view, write_sheet};
+use photomontage::verified::sheet::{SheetFormat, sheet_for_view_as, write_sheet};
 use photomontage::verified::{
     AvrLevel, PaperSize, ViewGeometryOptions, apply_massing, avr_overlay,
 };
@@ -35,7 +35,7 @@ pub struct Args {
     /// Ground level below the camera (survey height, metres); default: the scene polygon below.
     #[arg(long, value_name = "Z", allow_hyphen_values = true)]
     ground_level_m: Option<f64>,
-    /// The PDF to write.
+    /// The sheet to write: .pdf, or .html (one self-contained file).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
 }
@@ -80,9 +80,12 @@ fn view_image(doc: &SiteDocument, view: &str, avr: AvrLevel) -> anyhow::Result<R
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    if args.out.extension().and_then(|e| e.to_str()) != Some("pdf") {
-        bail!("--out {}: the sheet is a PDF (.pdf)", args.out.display());
-    }
+    let Some(format) = SheetFormat::from_path(&args.out) else {
+        bail!(
+            "--out {}: the sheet is a PDF (.pdf) or an HTML file (.html)",
+            args.out.display()
+        );
+    };
     let avr = AvrLevel::from_number(args.avr)?;
     let doc = SiteDocument::load(&args.site)?;
     let exposure = doc.site.render.exposure;
@@ -112,7 +115,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         paper: args.paper,
         ground_level_m: args.ground_level_m,
     };
-    let pdf = sheet_for_view(&doc, &args.view, &rgb, avr, &options)?;
+    let pdf = sheet_for_view_as(&doc, &args.view, &rgb, avr, &options, format)?;
     write_sheet(&args.out, &pdf)?;
     println!(
         "wrote the {} {} sheet of view {} to {} ({} bytes)",

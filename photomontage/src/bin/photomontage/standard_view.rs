@@ -9,11 +9,13 @@ use anyhow::{Context, bail};
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::ToneCurve;
 use photomontage::render::output;
+use photomontage::render::{DifferentialTracer, render_view};
 use photomontage::site::{SiteDocument, write_atomically};
 use photomontage::verified::cylindrical_view::{CylindricalOptions, site_cylindrical_view};
 use photomontage::verified::geometry::fields_of_view_deg;
-use photomontage::verified::planar_view::planar_view;
+use photomontage::verified::planar_view::{planar_view, planar_view_job};
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 
 /// How the view is projected.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -47,6 +49,10 @@ pub struct Args {
     /// refused (metres).
     #[arg(long, value_name = "M", default_value_t = 0.1)]
     max_centre_spread_m: f64,
+    /// Planar: render the montage (AVR3, the site's render settings) into the view, as into a
+    /// photo, instead of writing the re-projected photo alone.
+    #[arg(long)]
+    montage: bool,
     /// Planar: output size WIDTHxHEIGHT in pixels; default: the photo's size.
     #[arg(long, value_name = "WxH")]
     size: Option<String>,
@@ -83,7 +89,27 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     args.from
                 );
             };
-            let view = planar_view(&doc, id, args.focal_equiv_mm, size)?;
+            let (view, image) = if args.montage {
+                let (view, job) = planar_view_job(&doc, id, args.focal_equiv_mm, size)?;
+                for w in &job.warnings {
+                    eprintln!("warning: {w}");
+                }
+                let tracer = DifferentialTracer::new(
+                    &job.scene.scene,
+                    &job.lighting,
+                    &job.camera,
+                    &job.photo_linear,
+                    job.settings.max_depth,
+                )?;
+                eprintln!("rendering the montage into the view");
+                let montage =
+                    render_view(&tracer, &job.settings, &|_| {}, &AtomicBool::new(false))?;
+                (view, montage)
+            } else {
+                let view = planar_view(&doc, id, args.focal_equiv_mm, size)?;
+                let image = view.image.clone();
+                (view, image)
+            };
             let [hfov, vfov] = fields_of_view_deg(&view.camera.intrinsics);
             let [w, h] = view.camera.intrinsics.image_size_px;
             if view.coverage < 1.0 {
@@ -101,12 +127,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 100.0 * view.coverage
             );
             (
-                view.image,
+                image,
                 ("camera.json", serde_json::to_string_pretty(&view.camera)?),
                 summary,
             )
         }
         Projection::Cylindrical => {
+            if args.montage {
+                bail!("--montage is for planar views (the renderer needs a pinhole camera)");
+            }
             if size.is_some() {
                 bail!(
                     "--size is for planar views; a cylindrical view's size follows from its photos"
