@@ -331,3 +331,17 @@ fn absurd_focal_length_is_refused_naming_the_photo() {
         "{err}"
     );
 }
+
+#[test]
+fn stated_image_size_above_the_photo_limit_is_refused() {
+    let err = parse(&EXAMPLE.replace(
+        "image_size_px = [4000, 3000]",
+        "image_size_px = [100000, 100000]",
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "photos[0].interior.image_size_px"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("100000×100000"), "{err}");
+}

@@ -123,6 +123,18 @@ impl Site {
                         "width and height must be positive",
                     ));
                 }
+                let max_pixels = crate::photo::DecodeLimits::default().max_pixels;
+                if let Some([w, h]) = interior.image_size_px
+                    && u64::from(w) * u64::from(h) > max_pixels
+                {
+                    issues.push(issue(
+                        format!("photos[{i}].interior.image_size_px"),
+                        format!(
+                            "{w}×{h} px is more than the {} MP a photo may have",
+                            max_pixels / 1_000_000
+                        ),
+                    ));
+                }
                 if let Some(size) = interior.image_size_px
                     && size.iter().all(|s| *s > 0)
                 {
