@@ -10,6 +10,7 @@
 
 pub mod atmosphere;
 pub mod atomic_file;
+pub mod bounded_read;
 pub mod bvh;
 pub mod camera;
 pub mod colour;

@@ -406,6 +406,7 @@ impl EulumdatFile {
         let c_angles_deg = read(0..mc, "C angle")?;
         let gamma_deg = read(mc..mc + ng, "gamma angle")?;
         let intensity_cd_per_klm = read(mc + ng..needed, "intensity (cd/klm)")?;
+        warnings.extend(super::intensity_warning(&intensity_cd_per_klm, "cd/klm"));
         if tokens.len() > needed {
             warnings.push(format!(
                 "{} extra values after the intensities ignored",

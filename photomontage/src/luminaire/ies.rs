@@ -135,6 +135,20 @@ pub enum IesError {
         /// The allowed codes.
         expected: &'static str,
     },
+    /// Angles that do not increase strictly.
+    #[error(
+        "line {line}: {field} must increase strictly, but {previous_deg}° is followed by {next_deg}°"
+    )]
+    AngleOrder {
+        /// Line of the angle that does not exceed its predecessor.
+        line: usize,
+        /// "vertical angles" or "horizontal angles".
+        field: &'static str,
+        /// The earlier angle.
+        previous_deg: f64,
+        /// The angle that does not exceed it.
+        next_deg: f64,
+    },
     /// The angles or values do not form a valid web.
     #[error("{0}")]
     Distribution(#[from] DistributionError),
@@ -250,6 +264,32 @@ impl<'a> Tokens<'a> {
             });
         }
         Ok(v as usize)
+    }
+
+    /// Reads `n` angles (`n` already bounded) that must increase strictly.
+    fn increasing_angles(&mut self, n: usize, field: &'static str) -> Result<Vec<f64>, IesError> {
+        if self.remaining() < n {
+            return Err(IesError::UnexpectedEnd {
+                line: self.last_line,
+                expected: format!("{n} {field}, found only {}", self.remaining()),
+            });
+        }
+        let mut out: Vec<f64> = Vec::with_capacity(n);
+        for _ in 0..n {
+            let (v, line) = self.number(field)?;
+            if let Some(&previous_deg) = out.last()
+                && v <= previous_deg
+            {
+                return Err(IesError::AngleOrder {
+                    line,
+                    field,
+                    previous_deg,
+                    next_deg: v,
+                });
+            }
+            out.push(v);
+        }
+        Ok(out)
     }
 
     /// Reads `n` numbers; `n` must already be bounded.
@@ -501,9 +541,11 @@ impl IesFile {
         let (file_generation_type, _) = tokens.number("future use / file generation type")?;
         let (input_watts, _) = tokens.number("input watts")?;
         // Data.
-        let vertical_deg = tokens.numbers(nv, "vertical angles")?;
-        let horizontal_deg = tokens.numbers(nh, "horizontal angles")?;
+        let vertical_deg = tokens.increasing_angles(nv, "vertical angles")?;
+        let horizontal_deg = tokens.increasing_angles(nh, "horizontal angles")?;
         let candela = tokens.numbers(nv * nh, "candela values")?;
+        let scaled: Vec<f64> = candela.iter().map(|c| c * candela_multiplier).collect();
+        warnings.extend(super::intensity_warning(&scaled, "cd"));
         if tokens.remaining() > 0 {
             warnings.push(format!(
                 "{} extra values after the candela table (from line {}) ignored",

@@ -36,6 +36,40 @@ pub use source::Luminaire;
 use std::path::Path;
 use thiserror::Error;
 
+/// Intensities above this are implausible for any luminaire (the brightest searchlights reach
+/// ~10⁹ cd; floodlights ~10⁶ cd) and usually mean a wrong multiplier or a corrupt file.
+pub const IMPLAUSIBLE_INTENSITY: f64 = 1e9;
+
+/// A warning for negative or implausibly large values in an intensity table, naming the first
+/// offender; `None` when all values are plausible.
+pub(crate) fn intensity_warning(values: &[f64], unit: &str) -> Option<String> {
+    let negative = values.iter().filter(|v| **v < 0.0).count();
+    let huge = values
+        .iter()
+        .filter(|v| **v > IMPLAUSIBLE_INTENSITY)
+        .count();
+    let first = |pred: &dyn Fn(f64) -> bool| values.iter().position(|v| pred(*v)).unwrap_or(0);
+    match (negative, huge) {
+        (0, 0) => None,
+        (n, 0) => {
+            let i = first(&|v| v < 0.0);
+            Some(format!(
+                "{n} negative intensities (the first, value {} of the table, is {} {unit}); read as given",
+                i + 1,
+                values[i]
+            ))
+        }
+        (_, h) => {
+            let i = first(&|v| v > IMPLAUSIBLE_INTENSITY);
+            Some(format!(
+                "{h} intensities above {IMPLAUSIBLE_INTENSITY:e} {unit} (the first, value {} of the table, is {:e} {unit}): check the multiplier and the file; {negative} negative",
+                i + 1,
+                values[i]
+            ))
+        }
+    }
+}
+
 /// Most angles (horizontal + vertical) a parser accepts from a header before allocating.
 pub const MAX_ANGLES: usize = 100_000;
 /// Most intensity values (planes × angles) a parser accepts from a header before allocating.
@@ -54,16 +88,13 @@ pub fn decode_text(bytes: &[u8]) -> (String, bool) {
     }
 }
 
-/// Reads a whole file, refusing files larger than [`MAX_FILE_BYTES`].
+/// Reads a whole file, refusing files larger than [`MAX_FILE_BYTES`] and anything but a regular
+/// file (a TILT or photometric path naming `/dev/zero` would otherwise read for ever).
 pub(crate) fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "{} bytes is more than the {MAX_FILE_BYTES} accepted",
-            meta.len()
-        ));
-    }
-    std::fs::read(path).map_err(|e| e.to_string())
+    crate::bounded_read::read_bounded(path, MAX_FILE_BYTES).map_err(|e| match e {
+        crate::bounded_read::BoundedReadError::Io { source, .. } => source.to_string(),
+        other => other.to_string(),
+    })
 }
 
 /// Either kind of photometric file.
@@ -170,5 +201,83 @@ impl PhotometricFile {
             Self::Ies(f) => &f.warnings,
             Self::Eulumdat(f) => &f.warnings,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An IESNA91 file with 3 vertical angles on line 10, one horizontal angle on line 11 and
+    /// candela values on line 12.
+    fn ies(vertical: &str, candela: &str) -> String {
+        format!(
+            "IESNA91\n[TEST] x\n   TILT=NONE\n1 1000. 1\n3 1\n1\n1\n.5 .5 .0\n1 1 10\n{vertical}\n0\n{candela}\n"
+        )
+    }
+
+    #[test]
+    fn ies_angle_order_error_names_its_line() {
+        let err = IesFile::parse(ies("0, 90, 45", "10 5 0").as_bytes()).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                IesError::AngleOrder {
+                    line: 10,
+                    field: "vertical angles",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        assert!(
+            err.to_string().starts_with("line 10: vertical angles"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn negative_and_huge_candela_warn() {
+        let plain = IesFile::parse(ies("0 45 90", "10 5 0").as_bytes()).unwrap();
+        assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);
+        let huge = IesFile::parse(ies("0 45 90", "1e308 5 0").as_bytes()).unwrap();
+        assert!(
+            huge.warnings.iter().any(|w| w.contains("1e308")),
+            "{:?}",
+            huge.warnings
+        );
+        let negative = IesFile::parse(ies("0 45 90", "10 -5 0").as_bytes()).unwrap();
+        assert!(
+            negative
+                .warnings
+                .iter()
+                .any(|w| w.contains("1 negative") && w.contains("value 2")),
+            "{:?}",
+            negative.warnings
+        );
+    }
+
+    #[test]
+    fn a_device_file_is_refused_naming_it() {
+        let err = PhotometricFile::read(Path::new("/dev/zero")).unwrap_err();
+        assert!(
+            err.to_string().contains("/dev/zero") && err.to_string().contains("regular file"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn intensity_warning_counts_and_names_the_first() {
+        assert_eq!(intensity_warning(&[0.0, 10.0, 1e6], "cd"), None);
+        let w = intensity_warning(&[1.0, -2.0, -3.0], "cd/klm").unwrap();
+        assert!(
+            w.starts_with("2 negative") && w.contains("-2 cd/klm"),
+            "{w}"
+        );
+        let w = intensity_warning(&[1.0, 2e9, -1.0], "cd").unwrap();
+        assert!(
+            w.starts_with("1 intensities above") && w.contains("2e9"),
+            "{w}"
+        );
     }
 }

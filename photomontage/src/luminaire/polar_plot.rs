@@ -66,11 +66,13 @@ pub fn nice_scale(value: f64) -> f64 {
     }
     let decade = 10f64.powf(value.log10().floor());
     for m in [1.0, 2.0, 5.0, 10.0] {
-        if m * decade >= value * (1.0 - 1e-12) {
-            return m * decade;
+        let scale = m * decade;
+        if scale >= value * (1.0 - 1e-12) {
+            // Near f64::MAX the rounded scale overflows: keep the value itself.
+            return if scale.is_finite() { scale } else { value };
         }
     }
-    10.0 * decade
+    value
 }
 
 fn put(img: &mut RgbImage, x: f64, y: f64, colour: Rgb<u8>) {
@@ -80,7 +82,54 @@ fn put(img: &mut RgbImage, x: f64, y: f64, colour: Rgb<u8>) {
     }
 }
 
+/// The part of the segment `from`–`to` inside the box `min`–`max` (Liang–Barsky), or `None`
+/// when it misses the box or is not finite.
+fn clip_to_box(
+    from: (f64, f64),
+    to: (f64, f64),
+    min: (f64, f64),
+    max: (f64, f64),
+) -> Option<((f64, f64), (f64, f64))> {
+    let (dx, dy) = (to.0 - from.0, to.1 - from.1);
+    if ![from.0, from.1, dx, dy].iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+    for (p, q) in [
+        (-dx, from.0 - min.0),
+        (dx, max.0 - from.0),
+        (-dy, from.1 - min.1),
+        (dy, max.1 - from.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else if p < 0.0 {
+            t0 = t0.max(q / p);
+        } else {
+            t1 = t1.min(q / p);
+        }
+    }
+    (t0 <= t1).then_some((
+        (from.0 + t0 * dx, from.1 + t0 * dy),
+        (from.0 + t1 * dx, from.1 + t1 * dy),
+    ))
+}
+
+/// Draws a segment pixel by pixel. The segment is clipped to the image first, so the step
+/// count is bounded by the image size whatever the intensities (1e308 cd once meant 10³⁰⁸
+/// steps).
 fn line(img: &mut RgbImage, from: (f64, f64), to: (f64, f64), colour: Rgb<u8>) {
+    let (w, h) = img.dimensions();
+    let Some((from, to)) = clip_to_box(
+        from,
+        to,
+        (-1.0, -1.0),
+        (f64::from(w) + 1.0, f64::from(h) + 1.0),
+    ) else {
+        return;
+    };
     let steps = ((to.0 - from.0).abs().max((to.1 - from.1).abs()).ceil() as usize).max(1);
     for i in 0..=steps {
         let t = i as f64 / steps as f64;
@@ -220,6 +269,51 @@ mod tests {
         assert_relative_eq!(nice_scale(1500.0), 2000.0);
         assert_relative_eq!(nice_scale(1000.0), 1000.0);
         assert_relative_eq!(nice_scale(0.0), 1.0);
+    }
+
+    #[test]
+    fn huge_intensities_plot_in_bounded_time() {
+        // 1e308 cd with the automatic scale and with a 1 cd scale: the curve runs 10³⁰⁸ px off
+        // the image; the plot must still return (it once looped for ever) and draw the part
+        // inside the image.
+        let g: Vec<f64> = (0..=36).map(|i| f64::from(i) * 5.0).collect();
+        let web = PhotometricWeb::from_planes(
+            PhotometricType::C,
+            Symmetry::Axial,
+            &[0.0],
+            &g,
+            &vec![1e308; g.len()],
+        )
+        .unwrap();
+        for scale_cd in [None, Some(1.0)] {
+            let start = std::time::Instant::now();
+            let img = polar_plot(
+                &web,
+                &PolarPlotOptions {
+                    size_px: 256,
+                    scale_cd,
+                },
+            )
+            .unwrap();
+            assert!(start.elapsed().as_secs() < 10, "{:?}", start.elapsed());
+            assert_eq!(img.dimensions(), (256, 256));
+        }
+        assert_relative_eq!(nice_scale(1.7e308), 1.7e308);
+        assert!(nice_scale(f64::MAX).is_finite());
+    }
+
+    #[test]
+    fn clipping_keeps_the_part_inside() {
+        let clipped = clip_to_box((-10.0, 5.0), (20.0, 5.0), (0.0, 0.0), (10.0, 10.0));
+        assert_eq!(clipped, Some(((0.0, 5.0), (10.0, 5.0))));
+        assert_eq!(
+            clip_to_box((-10.0, -5.0), (20.0, -5.0), (0.0, 0.0), (10.0, 10.0)),
+            None
+        );
+        assert_eq!(
+            clip_to_box((0.0, 0.0), (f64::INFINITY, 1.0), (0.0, 0.0), (10.0, 10.0)),
+            None
+        );
     }
 
     #[test]

@@ -24,6 +24,73 @@ pub enum PhotoError {
     Decode { path: PathBuf, message: String },
     #[error("cannot read EXIF of {path}: {message}")]
     Exif { path: PathBuf, message: String },
+    #[error(
+        "photo {path} declares {width}×{height} px ({:.0} MP, {} bytes to decode), over the limit of {:.0} MP / {} bytes",
+        megapixels(*width, *height),
+        decode_bytes(*width, *height),
+        limits.max_pixels as f64 / 1e6,
+        limits.max_bytes
+    )]
+    TooLarge {
+        path: PathBuf,
+        width: u32,
+        height: u32,
+        limits: DecodeLimits,
+    },
+}
+
+/// Caps on decoding a photo, checked against the header before any pixel is allocated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DecodeLimits {
+    /// Most pixels (width × height) a photo may have.
+    pub max_pixels: u64,
+    /// Most bytes the decoder and the float RGB copy may need together.
+    pub max_bytes: u64,
+}
+
+impl Default for DecodeLimits {
+    /// 250 MP and 8 GiB: a 250 MP photo needs at most 2 GB (16-bit RGBA) + 3 GB (float RGB), so
+    /// the default leaves room for rendering on a 24 GB machine.
+    fn default() -> Self {
+        Self {
+            max_pixels: 250_000_000,
+            max_bytes: 8 << 30,
+        }
+    }
+}
+
+/// Bytes of the float RGB copy [`load`] keeps per pixel.
+const FLOAT_RGB_BYTES_PER_PIXEL: u64 = 12;
+/// Most bytes per pixel a decoder needs (16-bit RGBA).
+const MAX_DECODED_BYTES_PER_PIXEL: u64 = 8;
+
+fn megapixels(width: u32, height: u32) -> f64 {
+    f64::from(width) * f64::from(height) / 1e6
+}
+
+/// Bytes the decoded image and its float RGB copy need together (an upper bound).
+fn decode_bytes(width: u32, height: u32) -> u64 {
+    (u64::from(width) * u64::from(height))
+        .saturating_mul(MAX_DECODED_BYTES_PER_PIXEL + FLOAT_RGB_BYTES_PER_PIXEL)
+}
+
+fn check_limits(
+    path: &Path,
+    width: u32,
+    height: u32,
+    limits: &DecodeLimits,
+) -> Result<(), PhotoError> {
+    if u64::from(width) * u64::from(height) > limits.max_pixels
+        || decode_bytes(width, height) > limits.max_bytes
+    {
+        return Err(PhotoError::TooLarge {
+            path: path.to_path_buf(),
+            width,
+            height,
+            limits: *limits,
+        });
+    }
+    Ok(())
 }
 
 /// How the stored pixel values relate to light.
@@ -50,7 +117,10 @@ impl PhotoImage {
     }
 }
 
-fn open_decoder(path: &Path) -> Result<impl ImageDecoder, PhotoError> {
+fn open_decoder(
+    path: &Path,
+    limits: &DecodeLimits,
+) -> Result<impl ImageDecoder + use<>, PhotoError> {
     if !path.exists() {
         return Err(PhotoError::Missing {
             path: path.to_path_buf(),
@@ -60,12 +130,19 @@ fn open_decoder(path: &Path) -> Result<impl ImageDecoder, PhotoError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    ImageReader::open(path)
+    let mut reader = ImageReader::open(path)
         .map_err(|e| decode_err(&e))?
         .with_guessed_format()
-        .map_err(|e| decode_err(&e))?
-        .into_decoder()
-        .map_err(|e| decode_err(&e))
+        .map_err(|e| decode_err(&e))?;
+    // The decoders' own allocations (e.g. PNG's text chunks, EXR's buffers) stay under the cap
+    // too; the header check below names the declared size.
+    let mut image_limits = image::Limits::default();
+    image_limits.max_alloc = Some(limits.max_bytes);
+    reader.limits(image_limits);
+    let decoder = reader.into_decoder().map_err(|e| decode_err(&e))?;
+    let (width, height) = decoder.dimensions();
+    check_limits(path, width, height, limits)?;
+    Ok(decoder)
 }
 
 fn is_exr(path: &Path) -> bool {
@@ -77,9 +154,10 @@ fn is_exr(path: &Path) -> bool {
 /// Width and height of a photo as displayed, without decoding its pixels.
 ///
 /// # Errors
-/// [`PhotoError::Missing`] or [`PhotoError::Decode`].
+/// [`PhotoError::Missing`], [`PhotoError::Decode`], or [`PhotoError::TooLarge`] over the
+/// default [`DecodeLimits`].
 pub fn size_px(path: &Path) -> Result<[u32; 2], PhotoError> {
-    let mut decoder = open_decoder(path)?;
+    let mut decoder = open_decoder(path, &DecodeLimits::default())?;
     let (w, h) = decoder.dimensions();
     let orientation = decoder
         .orientation()
@@ -99,12 +177,22 @@ fn swaps_axes(o: image::metadata::Orientation) -> bool {
     )
 }
 
-/// Decodes a photo, applies its EXIF orientation and converts it to float RGB.
+/// Decodes a photo, applies its EXIF orientation and converts it to float RGB, within the
+/// default [`DecodeLimits`].
 ///
 /// # Errors
-/// [`PhotoError::Missing`] or [`PhotoError::Decode`].
+/// [`PhotoError::Missing`], [`PhotoError::Decode`] or [`PhotoError::TooLarge`].
 pub fn load(path: &Path) -> Result<PhotoImage, PhotoError> {
-    let mut decoder = open_decoder(path)?;
+    load_with_limits(path, &DecodeLimits::default())
+}
+
+/// [`load`] with caps of the caller's choice.
+///
+/// # Errors
+/// [`PhotoError::Missing`], [`PhotoError::Decode`] or [`PhotoError::TooLarge`] when the header
+/// declares more pixels or bytes than `limits` allow (checked before any pixel is allocated).
+pub fn load_with_limits(path: &Path, limits: &DecodeLimits) -> Result<PhotoImage, PhotoError> {
+    let mut decoder = open_decoder(path, limits)?;
     let orientation = decoder
         .orientation()
         .unwrap_or(image::metadata::Orientation::NoTransforms);
@@ -140,6 +228,88 @@ mod tests {
         let path = dir.path().join("bad.jpg");
         std::fs::write(&path, b"\xff\xd8\xff\xe0 not really a jpeg").unwrap();
         assert!(matches!(load(&path), Err(PhotoError::Decode { .. })));
+    }
+
+    /// A valid PNG signature and IHDR declaring `width`×`height` 8-bit RGB, then a short IDAT:
+    /// a tiny file whose header lies about its size.
+    pub(crate) fn lying_png(width: u32, height: u32) -> Vec<u8> {
+        fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
+            out.extend_from_slice(&u32::try_from(data.len()).unwrap().to_be_bytes());
+            let start = out.len();
+            out.extend_from_slice(kind);
+            out.extend_from_slice(data);
+            let crc = crc32(&out[start..]);
+            out.extend_from_slice(&crc.to_be_bytes());
+        }
+        fn crc32(bytes: &[u8]) -> u32 {
+            let mut crc = 0xffff_ffff_u32;
+            for &b in bytes {
+                crc ^= u32::from(b);
+                for _ in 0..8 {
+                    crc = if crc & 1 == 1 {
+                        (crc >> 1) ^ 0xedb8_8320
+                    } else {
+                        crc >> 1
+                    };
+                }
+            }
+            !crc
+        }
+        let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut ihdr = Vec::new();
+        ihdr.extend_from_slice(&width.to_be_bytes());
+        ihdr.extend_from_slice(&height.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+        chunk(&mut out, b"IHDR", &ihdr);
+        chunk(
+            &mut out,
+            b"IDAT",
+            &[0x78, 0x9c, 0x63, 0x00, 0x00, 0x00, 0x01, 0x00, 0x01],
+        );
+        chunk(&mut out, b"IEND", &[]);
+        out
+    }
+
+    #[test]
+    fn lying_header_is_refused_before_allocating() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        std::fs::write(&path, lying_png(100_000, 100_000)).unwrap();
+        for result in [load(&path).map(|p| p.size_px()), size_px(&path)] {
+            let err = result.unwrap_err();
+            assert!(
+                matches!(
+                    err,
+                    PhotoError::TooLarge {
+                        width: 100_000,
+                        height: 100_000,
+                        ..
+                    }
+                ),
+                "{err}"
+            );
+            let message = err.to_string();
+            assert!(
+                message.contains("huge.png") && message.contains("100000×100000"),
+                "{message}"
+            );
+        }
+    }
+
+    #[test]
+    fn limits_are_configurable() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.png");
+        image::RgbImage::new(40, 30).save(&path).unwrap();
+        let small = DecodeLimits {
+            max_pixels: 1000,
+            ..DecodeLimits::default()
+        };
+        assert!(matches!(
+            load_with_limits(&path, &small),
+            Err(PhotoError::TooLarge { .. })
+        ));
+        assert_eq!(load(&path).unwrap().size_px(), [40, 30]);
     }
 
     #[test]

@@ -366,6 +366,18 @@ pub fn bundle_adjust(
     let mut ids = std::collections::HashSet::new();
     for p in photos {
         validate_intrinsics(&p.camera.intrinsics)?;
+        let pose = &p.camera.pose;
+        if !(pose.camera_center_in_world.iter().all(|v| v.is_finite())
+            && pose
+                .rotation_world_from_camera
+                .matrix()
+                .iter()
+                .all(|v| v.is_finite()))
+        {
+            return Err(PhotogrammetryError::NonFinite {
+                what: format!("start pose of photo {}", p.id),
+            });
+        }
         validate_observations(&p.observations)?;
         if !ids.insert(p.id.as_str()) {
             return Err(PhotogrammetryError::DuplicateId { id: p.id.clone() });

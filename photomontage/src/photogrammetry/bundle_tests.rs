@@ -186,3 +186,36 @@ fn focal_lengths_are_estimated_per_photo_where_supported() {
         );
     }
 }
+
+#[test]
+fn non_finite_start_pose_or_absurd_focal_is_refused_naming_it() {
+    let spec = BlockSpec {
+        photos: 3,
+        points: 20,
+        control: 6,
+        control_sigma_m: 0.0,
+        sigma_px: 0.5,
+        initial_center_error_m: 0.1,
+        initial_rotation_error: 0.001,
+        seed: 15,
+    };
+    let b = block(&spec);
+    let mut nan_pose = photos(&b);
+    nan_pose[1].camera.pose.camera_center_in_world.x = f64::NAN;
+    let err = bundle_adjust(&nan_pose, &b.control, &BundleOptions::default()).unwrap_err();
+    assert_eq!(
+        err,
+        PhotogrammetryError::NonFinite {
+            what: "start pose of photo photo01".to_owned()
+        }
+    );
+    let mut tiny_focal = photos(&b);
+    tiny_focal[2].camera.intrinsics.focal_px = 1e-200;
+    assert!(matches!(
+        bundle_adjust(&tiny_focal, &b.control, &BundleOptions::default()),
+        Err(PhotogrammetryError::IntrinsicOutOfRange {
+            field: "focal_px",
+            ..
+        })
+    ));
+}

@@ -30,6 +30,44 @@ pub enum ControlIoError {
     TooManyRows { limit: usize },
     #[error("line {line}: point {id} was given different coordinates earlier")]
     ConflictingCoordinates { id: String, line: usize },
+    #[error("line {line}: duplicate id {id} (first on line {first_line})")]
+    DuplicateId {
+        id: String,
+        line: usize,
+        first_line: usize,
+    },
+    #[error(
+        "line {line}: {reason}; an OpenDroneMap GCP list starts with a line naming the coordinate system (e.g. EPSG:32632)"
+    )]
+    NotOdmHeader { line: usize, reason: String },
+}
+
+/// Refuses a first line that cannot be an ODM CRS header: a GCP row (the header was left out,
+/// and the row would be lost) or a tab-separated table header (a TSV points file is not a GCP
+/// list).
+fn check_odm_header(line: usize, header: &str) -> Result<(), ControlIoError> {
+    let tokens: Vec<&str> = header.split_whitespace().collect();
+    let numeric = tokens
+        .iter()
+        .take(5)
+        .filter(|t| t.parse::<f64>().is_ok())
+        .count();
+    if tokens.len() >= 6 && numeric == 5 {
+        return Err(ControlIoError::NotOdmHeader {
+            line,
+            reason: "the first line is a GCP row, not a header".to_owned(),
+        });
+    }
+    if header.trim().contains('\t') {
+        return Err(ControlIoError::NotOdmHeader {
+            line,
+            reason: format!(
+                "the first line `{}` is tab-separated, like a table header (for points use a comma-separated id,X,Y,Z,x,y file)",
+                header.trim().chars().take(80).collect::<String>()
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// One row of an ODM GCP list.
@@ -76,7 +114,8 @@ pub fn parse_odm_gcp_list(text: &str) -> Result<OdmGcpList, ControlIoError> {
         let t = l.trim();
         !t.is_empty() && !t.starts_with('#')
     });
-    let (_, header) = lines.next().ok_or(ControlIoError::Empty)?;
+    let (header_index, header) = lines.next().ok_or(ControlIoError::Empty)?;
+    check_odm_header(header_index + 1, header)?;
     let mut rows = Vec::new();
     for (index, raw) in lines {
         let line = index + 1;
@@ -237,10 +276,20 @@ fn csv_records<'a>(
 /// lines and lines starting with `#` are skipped.
 ///
 /// # Errors
-/// `Parse` with the line for a wrong field count, a bad number or σ ≤ 0; `TooManyRows`.
+/// `Parse` with the line for a wrong field count, a bad number or σ ≤ 0; `DuplicateId` with
+/// both lines; `TooManyRows`.
 pub fn parse_points_csv(text: &str) -> Result<PointsCsv, ControlIoError> {
-    let mut rows = Vec::new();
+    let mut rows: Vec<PointRow> = Vec::new();
+    let mut first_line_of = std::collections::HashMap::new();
     for (line, fields) in csv_records(text, 6..=7, "id,X,Y,Z,x,y[,sigma_px]")? {
+        if let Some(&first_line) = first_line_of.get(fields[0]) {
+            return Err(ControlIoError::DuplicateId {
+                id: fields[0].to_owned(),
+                line,
+                first_line,
+            });
+        }
+        first_line_of.insert(fields[0], line);
         let sigma_px = match fields.get(6) {
             Some(s) if !s.is_empty() => {
                 let v = number(s, line, "sigma_px")?;
@@ -353,6 +402,44 @@ pub fn parse_control_points_csv(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn duplicate_id_in_points_csv_names_both_lines() {
+        let text = "id,X,Y,Z,x,y\nA,0,0,0,10,10\nB,1,0,0,20,10\nA,0,1,0,10,20\n";
+        assert_eq!(
+            parse_points_csv(text),
+            Err(ControlIoError::DuplicateId {
+                id: "A".to_owned(),
+                line: 4,
+                first_line: 2
+            })
+        );
+    }
+
+    #[test]
+    fn odm_list_without_header_is_refused_not_shortened() {
+        let text = "100 200 10 1500 900 p1.jpg gcp1\n101 200 10 1600 900 p1.jpg gcp2\n";
+        let err = parse_odm_gcp_list(text).unwrap_err();
+        assert!(
+            matches!(err, ControlIoError::NotOdmHeader { line: 1, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn tab_separated_table_is_not_an_odm_list() {
+        let text = "id\tX\tY\tZ\tx\ty\nA\t0\t0\t0\t10\t10\n";
+        let err = parse_odm_gcp_list(text).unwrap_err();
+        assert!(
+            matches!(err, ControlIoError::NotOdmHeader { line: 1, .. }),
+            "{err}"
+        );
+        assert!(err.to_string().contains("tab-separated"), "{err}");
+        // Tabs between the fields of the rows, and a trailing tab after the header (as in
+        // ODM's own copr example), stay allowed.
+        let odm = "EPSG:32632\t\n100\t200\t10\t1500\t900\tp1.jpg\tgcp1\n";
+        assert_eq!(parse_odm_gcp_list(odm).unwrap().rows.len(), 1);
+    }
 
     #[test]
     // Parsed decimal literals must equal the same literals exactly.

@@ -109,6 +109,17 @@ pub enum PhotogrammetryError {
     Collinear,
     #[error("point {point_id} lies behind the camera")]
     PointBehindCamera { point_id: String },
+    #[error(
+        "intrinsics: {field} = {value:e} px is outside {min:e}–{max:e} px, the sane range for a {width}×{height} px image"
+    )]
+    IntrinsicOutOfRange {
+        field: &'static str,
+        value: f64,
+        min: f64,
+        max: f64,
+        width: u32,
+        height: u32,
+    },
     #[error("non-finite value in {what}")]
     NonFinite { what: String },
     #[error("duplicate id {id}")]
@@ -182,24 +193,37 @@ pub(crate) fn validate_observations(
     Ok(())
 }
 
-/// Rejects non-finite intrinsics or a focal length ≤ 0.
+/// The focal length may be at least this fraction of the larger image side: a rectilinear lens
+/// with f = 0.01·w would see 176° across, beyond any real lens, and smaller values only feed
+/// NaN into P3P.
+pub const MIN_FOCAL_FRACTION_OF_IMAGE: f64 = 0.01;
+/// The focal length may be at most this multiple of the larger image side (a 2000 mm lens on a
+/// full-frame sensor is ≈ 56 × the width; 1000 leaves ample room for crops).
+pub const MAX_FOCAL_MULTIPLE_OF_IMAGE: f64 = 1000.0;
+/// The principal point may lie at most this many image sides outside the image (shifted-lens
+/// crops put it outside, but never by more than an image or two).
+pub const PRINCIPAL_POINT_MARGIN_IMAGES: f64 = 10.0;
+
+/// Rejects non-finite intrinsics, an empty image, and a focal length or principal point
+/// outside the sane range for the image size (checked before any work: values far outside send
+/// NaN into the solvers).
 pub(crate) fn validate_intrinsics(
     intrinsics: &crate::camera::Intrinsics,
 ) -> Result<(), PhotogrammetryError> {
     let d = &intrinsics.distortion;
-    let values = [
-        intrinsics.focal_px,
-        intrinsics.principal_point_px[0],
-        intrinsics.principal_point_px[1],
-        d.k1,
-        d.k2,
-        d.k3,
-        d.p1,
-        d.p2,
+    let named = [
+        ("focal_px", intrinsics.focal_px),
+        ("principal_point_px[0]", intrinsics.principal_point_px[0]),
+        ("principal_point_px[1]", intrinsics.principal_point_px[1]),
+        ("distortion.k1", d.k1),
+        ("distortion.k2", d.k2),
+        ("distortion.k3", d.k3),
+        ("distortion.p1", d.p1),
+        ("distortion.p2", d.p2),
     ];
-    if !values.iter().all(|v| v.is_finite()) {
+    if let Some((field, _)) = named.iter().find(|(_, v)| !v.is_finite()) {
         return Err(PhotogrammetryError::NonFinite {
-            what: "intrinsics".to_owned(),
+            what: format!("intrinsics {field}"),
         });
     }
     if intrinsics.focal_px <= 0.0 {
@@ -207,5 +231,50 @@ pub(crate) fn validate_intrinsics(
             reason: format!("focal length {} px is not positive", intrinsics.focal_px),
         });
     }
-    Ok(())
+    let [width, height] = intrinsics.image_size_px;
+    if width == 0 || height == 0 {
+        return Err(PhotogrammetryError::Degenerate {
+            reason: format!("image size {width}×{height} px is empty"),
+        });
+    }
+    let out_of_range = |field: &'static str, value: f64, min: f64, max: f64| {
+        (!(min..=max).contains(&value)).then_some(PhotogrammetryError::IntrinsicOutOfRange {
+            field,
+            value,
+            min,
+            max,
+            width,
+            height,
+        })
+    };
+    let side = f64::from(width.max(height));
+    let focal = out_of_range(
+        "focal_px",
+        intrinsics.focal_px,
+        MIN_FOCAL_FRACTION_OF_IMAGE * side,
+        MAX_FOCAL_MULTIPLE_OF_IMAGE * side,
+    );
+    let pp = |field, value: f64, size: u32| {
+        let size = f64::from(size);
+        out_of_range(
+            field,
+            value,
+            -PRINCIPAL_POINT_MARGIN_IMAGES * size,
+            (1.0 + PRINCIPAL_POINT_MARGIN_IMAGES) * size,
+        )
+    };
+    let pp_x = pp(
+        "principal_point_px[0]",
+        intrinsics.principal_point_px[0],
+        width,
+    );
+    let pp_y = pp(
+        "principal_point_px[1]",
+        intrinsics.principal_point_px[1],
+        height,
+    );
+    match focal.or(pp_x).or(pp_y) {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }

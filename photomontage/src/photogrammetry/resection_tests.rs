@@ -346,3 +346,27 @@ fn control_sigma_propagates_into_the_pose_sigma() {
     // σ₀ stays near 1 because the weights include the control σ.
     assert!(r.sigma0 < 1.5, "σ0 {}", r.sigma0);
 }
+
+#[test]
+fn absurd_focal_or_principal_point_is_refused_before_any_work() {
+    // A focal length of 1e-200 px (or a principal point of 1e300 px) once sent NaN into the P3P
+    // quartic and the eigenvalue solver never returned.
+    let s = scene(12);
+    let mut tiny_focal = s.camera.intrinsics;
+    tiny_focal.focal_px = 1e-200;
+    let mut far_pp = s.camera.intrinsics;
+    far_pp.principal_point_px = [1e300, 1500.0];
+    for (intrinsics, field) in [(tiny_focal, "focal_px"), (far_pp, "principal_point_px[0]")] {
+        let err = resect(
+            &s.control,
+            &s.observations,
+            &ResectionOptions::new(intrinsics),
+        )
+        .expect_err("out of range");
+        assert!(
+            matches!(err, PhotogrammetryError::IntrinsicOutOfRange { field: f, .. } if f == field),
+            "{err}"
+        );
+        assert!(err.to_string().contains(field), "{err}");
+    }
+}

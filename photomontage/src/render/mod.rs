@@ -98,6 +98,11 @@ pub enum RenderError {
     },
 }
 
+/// The largest mirror/glass recursion depth the renderer accepts. Each level is a native stack
+/// frame chain of the tracer (5000 levels overflowed the stack); after 32 bounces on mirrors of
+/// reflectance ≤ 0.9 less than 4 % of the light is left.
+pub const MAX_DEPTH_LIMIT: u32 = 32;
+
 /// Sampling and tiling settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderSettings {
@@ -112,7 +117,7 @@ pub struct RenderSettings {
     pub max_standard_error: f64,
     /// Seed of the sample positions.
     pub seed: u64,
-    /// Mirror recursion depth limit.
+    /// Mirror recursion depth limit (at most [`MAX_DEPTH_LIMIT`]).
     pub max_depth: u32,
 }
 

@@ -19,6 +19,7 @@ use super::import::{
     ImportOptions, ImportWarning, ImportedModel, LengthUnit, ModelBuilder, ModelError, UpAxis,
 };
 use super::material::{Material, Specular};
+use crate::bounded_read::{MAX_MODEL_FILE_BYTES, check_regular_file};
 
 /// Node nesting depth at which traversal stops (guards against malicious recursion).
 pub const MAX_NODE_DEPTH: usize = 64;
@@ -33,6 +34,41 @@ pub enum GltfError {
         path: String,
         /// The gltf crate's description.
         reason: String,
+    },
+    /// The file or a buffer file it names is not a regular file under the size cap.
+    #[error("glTF {path}: {source}")]
+    Referenced {
+        /// The glTF file.
+        path: String,
+        /// Which file and why (boxed: keeps the error enums small).
+        source: Box<crate::bounded_read::BoundedReadError>,
+    },
+    /// A buffer holds fewer bytes than its `byteLength` says.
+    #[error(
+        "glTF {path}: buffers[{buffer}] ({origin}) holds {actual} bytes but its byteLength is {expected}"
+    )]
+    ShortBuffer {
+        /// The glTF file.
+        path: String,
+        /// Index of the buffer.
+        buffer: usize,
+        /// Where its bytes come from (a file, a data URI, the GLB binary chunk); boxed to keep
+        /// the error enums small.
+        origin: Box<str>,
+        /// `byteLength`.
+        expected: usize,
+        /// Bytes present.
+        actual: usize,
+    },
+    /// A node is its own ancestor.
+    #[error("glTF {path}: nodes[{node}]{} is its own ancestor (a cycle in the node hierarchy)", name.as_ref().map(|n| format!(" `{n}`")).unwrap_or_default())]
+    NodeCycle {
+        /// The glTF file.
+        path: String,
+        /// Index of a node on the cycle.
+        node: usize,
+        /// Its name, when it has one.
+        name: Option<String>,
     },
     /// The geometry failed a model check.
     #[error("glTF {path}: {source}")]
@@ -192,6 +228,138 @@ impl Walker<'_> {
     }
 }
 
+/// Refuses a node hierarchy with a cycle (the glTF crate would follow it until the depth cap,
+/// compounding transforms into a 10¹⁰ m bounding box), by depth-first search over all nodes.
+fn check_node_cycles(document: &gltf::Document, path: &str) -> Result<(), GltfError> {
+    #[derive(Clone, Copy, PartialEq)]
+    enum Mark {
+        New,
+        OnPath,
+        Done,
+    }
+    let nodes: Vec<gltf::Node<'_>> = document.nodes().collect();
+    let mut marks = vec![Mark::New; nodes.len()];
+    for root in 0..nodes.len() {
+        if marks[root] != Mark::New {
+            continue;
+        }
+        // Explicit stack of (node, next child position): no recursion on untrusted depth.
+        let mut stack = vec![(root, 0usize)];
+        marks[root] = Mark::OnPath;
+        while let Some(&mut (node, ref mut next)) = stack.last_mut() {
+            let child = nodes[node].children().nth(*next).map(|c| c.index());
+            *next += 1;
+            match child {
+                None => {
+                    marks[node] = Mark::Done;
+                    stack.pop();
+                }
+                Some(c) if marks.get(c) == Some(&Mark::OnPath) => {
+                    return Err(GltfError::NodeCycle {
+                        path: path.to_owned(),
+                        node: c,
+                        name: nodes[c].name().map(str::to_owned),
+                    });
+                }
+                Some(c) if marks.get(c) == Some(&Mark::New) => {
+                    marks[c] = Mark::OnPath;
+                    stack.push((c, 0));
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `%XX` decoding of a relative URI; `None` when the result is not UTF-8 (the glTF crate would
+/// panic on it).
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%'
+            && let Some(v) = uri
+                .get(i + 1..i + 3)
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+        {
+            out.push(v);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Checks every buffer before it is read: external files must be regular files under the cap,
+/// and every source must hold at least `byteLength` bytes (the glTF crate pads short buffers to
+/// a multiple of 4 and so accepts up to 3 missing bytes).
+fn check_buffers(file: &gltf::Gltf, base: Option<&Path>, path: &str) -> Result<(), GltfError> {
+    for buffer in file.document.buffers() {
+        let (actual, origin) = match buffer.source() {
+            gltf::buffer::Source::Bin => (
+                file.blob.as_ref().map_or(0, Vec::len),
+                "the GLB binary chunk".to_owned(),
+            ),
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                let payload = uri.split_once(',').map_or("", |(_, p)| p);
+                let digits = payload.trim_end_matches('=').len();
+                (digits * 3 / 4, "its data URI".to_owned())
+            }
+            gltf::buffer::Source::Uri(uri) if !uri.contains(':') => {
+                let relative = percent_decode(uri).ok_or_else(|| GltfError::Load {
+                    path: path.to_owned(),
+                    reason: format!(
+                        "buffers[{}].uri `{uri}` is not UTF-8 after %-decoding",
+                        buffer.index()
+                    ),
+                })?;
+                let file_path = base.unwrap_or(Path::new("")).join(relative);
+                check_regular_file(&file_path, MAX_MODEL_FILE_BYTES).map_err(|source| {
+                    GltfError::Referenced {
+                        path: path.to_owned(),
+                        source: Box::new(source),
+                    }
+                })?;
+                let len = std::fs::metadata(&file_path).map_or(0, |m| m.len());
+                (
+                    usize::try_from(len).unwrap_or(usize::MAX),
+                    file_path.display().to_string(),
+                )
+            }
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("file:") => {
+                let file_path = Path::new(
+                    uri.strip_prefix("file://")
+                        .or_else(|| uri.strip_prefix("file:"))
+                        .unwrap_or(uri),
+                );
+                check_regular_file(file_path, MAX_MODEL_FILE_BYTES).map_err(|source| {
+                    GltfError::Referenced {
+                        path: path.to_owned(),
+                        source: Box::new(source),
+                    }
+                })?;
+                continue;
+            }
+            // Other schemes: the glTF crate reports them.
+            gltf::buffer::Source::Uri(_) => continue,
+        };
+        if actual < buffer.length() {
+            return Err(GltfError::ShortBuffer {
+                path: path.to_owned(),
+                buffer: buffer.index(),
+                origin: origin.into_boxed_str(),
+                expected: buffer.length(),
+                actual,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Reads a glTF 2.0 file into world coordinates.
 ///
 /// # Errors
@@ -207,7 +375,14 @@ pub fn load_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, 
         path: path_str.clone(),
         source,
     };
+    let referenced = |source| GltfError::Referenced {
+        path: path_str.clone(),
+        source: Box::new(source),
+    };
+    check_regular_file(path, MAX_MODEL_FILE_BYTES).map_err(referenced)?;
     let file = gltf::Gltf::open(path).map_err(load_err)?;
+    check_node_cycles(&file.document, &path_str)?;
+    check_buffers(&file, path.parent(), &path_str)?;
     let buffers =
         gltf::import_buffers(&file.document, path.parent(), file.blob.clone()).map_err(load_err)?;
     let builder = ModelBuilder::new(options, LengthUnit::Metre, UpAxis::Y).map_err(model_err)?;
@@ -239,4 +414,75 @@ pub fn load_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, 
             });
     }
     walker.builder.finish().map_err(model_err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const QUAD: &str = include_str!("../../tests/fixtures/quad_nodes.gltf");
+
+    /// Writes the quad fixture, edited by `edit`, as `model.gltf` in `dir`.
+    fn write_edited(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) -> std::path::PathBuf {
+        let mut json: serde_json::Value = serde_json::from_str(QUAD).unwrap();
+        edit(&mut json);
+        let path = dir.join("model.gltf");
+        std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+        path
+    }
+
+    #[test]
+    fn node_cycle_is_an_error_naming_the_node() {
+        // child → parent makes parent its own ancestor; this was once a 4.7e10 m model.
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_edited(dir.path(), |j| {
+            j["nodes"][1]["children"] = serde_json::json!([0])
+        });
+        let err = load_gltf(&path, &ImportOptions::default()).unwrap_err();
+        assert!(
+            matches!(&err, GltfError::NodeCycle { node: 0, .. }),
+            "{err}"
+        );
+        assert!(err.to_string().contains("nodes[0] `parent`"), "{err}");
+    }
+
+    #[test]
+    fn buffer_short_of_its_byte_length_is_refused() {
+        // 58 bytes for a byteLength of 60: the glTF crate pads to 60 and accepted it.
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("short.bin"), [0u8; 58]).unwrap();
+        let path = write_edited(dir.path(), |j| j["buffers"][0]["uri"] = "short.bin".into());
+        let err = load_gltf(&path, &ImportOptions::default()).unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                GltfError::ShortBuffer {
+                    buffer: 0,
+                    expected: 60,
+                    actual: 58,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("short.bin"), "{err}");
+    }
+
+    #[test]
+    fn buffer_naming_a_device_file_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        for uri in ["/dev/zero", "file:///dev/zero"] {
+            let path = write_edited(dir.path(), |j| j["buffers"][0]["uri"] = uri.into());
+            let err = load_gltf(&path, &ImportOptions::default()).unwrap_err();
+            assert!(matches!(&err, GltfError::Referenced { .. }), "{uri}: {err}");
+            assert!(err.to_string().contains("/dev/zero"), "{err}");
+        }
+    }
+
+    #[test]
+    fn the_fixture_still_loads() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_edited(dir.path(), |_| {});
+        assert!(load_gltf(&path, &ImportOptions::default()).is_ok());
+    }
 }

@@ -15,10 +15,15 @@
 
 use std::path::Path;
 
+use crate::bounded_read::{BoundedReadError, MAX_MODEL_FILE_BYTES, read_bounded};
+
 use super::import::{
     ImportOptions, ImportWarning, ImportedModel, LengthUnit, ModelBuilder, ModelError, UpAxis,
 };
 use super::material::{Glass, Material, Specular};
+
+/// Largest MTL library read (real ones are kilobytes).
+pub const MAX_MTL_FILE_BYTES: u64 = 64 << 20;
 
 /// Errors reading an OBJ file.
 #[derive(Debug, thiserror::Error)]
@@ -30,6 +35,14 @@ pub enum ObjError {
         path: String,
         /// tobj's description.
         reason: String,
+    },
+    /// The OBJ or an MTL library it names is not a regular file under the size cap.
+    #[error("OBJ {path}: {source}")]
+    Referenced {
+        /// The OBJ file.
+        path: String,
+        /// Which file and why (boxed: keeps the error enums small).
+        source: Box<crate::bounded_read::BoundedReadError>,
     },
     /// The geometry failed a model check.
     #[error("OBJ {path}: {source}")]
@@ -97,7 +110,38 @@ pub fn load_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, O
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &load_options).map_err(|e| ObjError::Load {
+    let referenced = |source| ObjError::Referenced {
+        path: path_str.clone(),
+        source: Box::new(source),
+    };
+    let obj_bytes = read_bounded(path, MAX_MODEL_FILE_BYTES).map_err(|e| match e {
+        BoundedReadError::Io { source, .. } => ObjError::Load {
+            path: path_str.clone(),
+            reason: source.to_string(),
+        },
+        other => referenced(other),
+    })?;
+    // MTL libraries go through the same check; tobj's loader can only say "failed", so the
+    // reason waits here.
+    let mtl_refusal = std::cell::RefCell::new(None);
+    let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let loaded =
+        tobj::load_obj_buf(
+            &mut obj_bytes.as_slice(),
+            &load_options,
+            |mtl_path| match read_bounded(&folder.join(mtl_path), MAX_MTL_FILE_BYTES) {
+                Ok(bytes) => tobj::load_mtl_buf(&mut bytes.as_slice()),
+                Err(BoundedReadError::Io { .. }) => Err(tobj::LoadError::OpenFileFailed),
+                Err(e) => {
+                    mtl_refusal.borrow_mut().get_or_insert(e);
+                    Err(tobj::LoadError::OpenFileFailed)
+                }
+            },
+        );
+    if let Some(e) = mtl_refusal.into_inner() {
+        return Err(referenced(e));
+    }
+    let (models, materials) = loaded.map_err(|e| ObjError::Load {
         path: path_str.clone(),
         reason: e.to_string(),
     })?;
@@ -112,7 +156,7 @@ pub fn load_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, O
             builder
                 .warnings
                 .push(ImportWarning::MissingMaterialLibrary {
-                    name: mtllib_names(path).join(", "),
+                    name: mtllib_names(&obj_bytes).join(", "),
                     reason: e.to_string(),
                 });
             Vec::new()
@@ -159,14 +203,68 @@ pub fn load_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, O
 }
 
 /// The `mtllib` names an OBJ file mentions (for the warning text only).
-fn mtllib_names(path: &Path) -> Vec<String> {
-    std::fs::read_to_string(path)
-        .map(|text| {
-            text.lines()
-                .filter_map(|l| l.trim().strip_prefix("mtllib "))
-                .map(|s| s.trim().to_owned())
-                .take(16)
-                .collect()
-        })
-        .unwrap_or_default()
+fn mtllib_names(obj_bytes: &[u8]) -> Vec<String> {
+    String::from_utf8_lossy(obj_bytes)
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mtllib "))
+        .map(|s| s.trim().to_owned())
+        .take(16)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+    #[test]
+    fn mtllib_naming_a_device_file_is_refused() {
+        // `mtllib /dev/zero` once read until the allocation of 8 GB aborted.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.obj");
+        std::fs::write(&path, format!("mtllib /dev/zero\n{TRIANGLE}")).unwrap();
+        let err = load_obj(&path, &ImportOptions::default()).unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                ObjError::Referenced {
+                    source,
+                    ..
+                } if matches!(**source, BoundedReadError::NotRegularFile { .. })
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("/dev/zero"), "{err}");
+    }
+
+    #[test]
+    fn missing_mtllib_stays_a_warning_and_a_real_one_loads() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.obj");
+        std::fs::write(&path, format!("mtllib gone.mtl\n{TRIANGLE}")).unwrap();
+        let model = load_obj(&path, &ImportOptions::default()).unwrap();
+        assert!(
+            model
+                .warnings
+                .iter()
+                .any(|w| matches!(w, ImportWarning::MissingMaterialLibrary { name, .. } if name == "gone.mtl"))
+        );
+        std::fs::write(dir.path().join("ok.mtl"), "newmtl red\nKd 0.8 0.1 0.1\n").unwrap();
+        std::fs::write(&path, format!("mtllib ok.mtl\nusemtl red\n{TRIANGLE}")).unwrap();
+        let model = load_obj(&path, &ImportOptions::default()).unwrap();
+        assert!(
+            model.materials.iter().any(|m| m.name == "red"),
+            "{:?}",
+            model.materials
+        );
+    }
+
+    #[test]
+    fn obj_that_is_a_device_is_refused() {
+        assert!(matches!(
+            load_obj(Path::new("/dev/zero"), &ImportOptions::default()),
+            Err(ObjError::Referenced { .. })
+        ));
+    }
 }

@@ -145,6 +145,16 @@ impl RenderPlan {
                 ),
             ));
         }
+        if settings.max_depth > crate::render::MAX_DEPTH_LIMIT {
+            return Err(request_error(
+                "max_depth",
+                format!(
+                    "{} is above the limit {}",
+                    settings.max_depth,
+                    crate::render::MAX_DEPTH_LIMIT
+                ),
+            ));
+        }
         if let Some(seed) = request.seed {
             settings.seed = seed;
         }

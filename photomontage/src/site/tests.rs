@@ -290,3 +290,58 @@ fn referenced_files(doc: &SiteDocument) -> Vec<PathBuf> {
         .map(|f| doc.resolve(f))
         .collect()
 }
+
+#[test]
+fn render_depth_above_the_limit_is_refused() {
+    // max_depth 5000 with mirrors once overflowed the stack.
+    let err = parse(&format!("{EXAMPLE}\n[render]\nmax_depth = 5000\n")).unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "render.max_depth"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("5000"), "{err}");
+    let limit = crate::render::MAX_DEPTH_LIMIT;
+    assert!(parse(&format!("{EXAMPLE}\n[render]\nmax_depth = {limit}\n")).is_ok());
+}
+
+#[test]
+fn non_positive_exposure_is_refused() {
+    let err = parse(&format!("{EXAMPLE}\n[render]\nexposure = -1.0\n")).unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "render.exposure"),
+        "{err}"
+    );
+}
+
+#[test]
+fn absurd_focal_length_is_refused_naming_the_photo() {
+    // A focal length of 1e-200 px once sent the solver into an endless loop.
+    let err = parse(&EXAMPLE.replace("focal_px = 3000.0", "focal_px = 1e-200")).unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "photos[0].interior.focal_px"),
+        "{err}"
+    );
+    let text = EXAMPLE.replace(
+        "focal_px = 3000.0",
+        "focal_px = 3000.0\nprincipal_point_px = [1e300, 1500.0]",
+    );
+    let err = parse(&text).unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "photos[0].interior.principal_point_px[0]"),
+        "{err}"
+    );
+}
+
+#[test]
+fn stated_image_size_above_the_photo_limit_is_refused() {
+    let err = parse(&EXAMPLE.replace(
+        "image_size_px = [4000, 3000]",
+        "image_size_px = [100000, 100000]",
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(&err, SiteError::Invalid { field, .. } if field == "photos[0].interior.image_size_px"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("100000×100000"), "{err}");
+}

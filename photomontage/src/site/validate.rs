@@ -27,6 +27,47 @@ fn check_finite(issues: &mut Vec<SiteIssue>, field: String, values: &[f64]) {
     }
 }
 
+/// The focal length and principal point of `photos[i]` within the solver's sane range for its
+/// image size (see [`crate::photogrammetry::MIN_FOCAL_FRACTION_OF_IMAGE`]); non-finite values
+/// are reported by the finiteness checks.
+fn check_interior_ranges(
+    issues: &mut Vec<SiteIssue>,
+    i: usize,
+    interior: &super::Interior,
+    [w, h]: [u32; 2],
+) {
+    use crate::photogrammetry::{
+        MAX_FOCAL_MULTIPLE_OF_IMAGE, MIN_FOCAL_FRACTION_OF_IMAGE, PRINCIPAL_POINT_MARGIN_IMAGES,
+    };
+    let side = f64::from(w.max(h));
+    let (lo, hi) = (
+        MIN_FOCAL_FRACTION_OF_IMAGE * side,
+        MAX_FOCAL_MULTIPLE_OF_IMAGE * side,
+    );
+    let f = interior.focal_px;
+    if f.is_finite() && f > 0.0 && !(lo..=hi).contains(&f) {
+        issues.push(issue(
+            format!("photos[{i}].interior.focal_px"),
+            format!("{f:e} px is outside {lo}…{hi} px, the sane range for a {w}×{h} px image"),
+        ));
+    }
+    if let Some(pp) = interior.principal_point_px {
+        for (axis, (value, size)) in pp.iter().zip([w, h]).enumerate() {
+            let size = f64::from(size);
+            let (lo, hi) = (
+                -PRINCIPAL_POINT_MARGIN_IMAGES * size,
+                (1.0 + PRINCIPAL_POINT_MARGIN_IMAGES) * size,
+            );
+            if value.is_finite() && !(lo..=hi).contains(value) {
+                issues.push(issue(
+                    format!("photos[{i}].interior.principal_point_px[{axis}]"),
+                    format!("{value:e} px is outside {lo}…{hi} px for a {w}×{h} px image"),
+                ));
+            }
+        }
+    }
+}
+
 impl Site {
     /// Every semantic problem in the site, in file order. Empty when the site is valid.
     #[must_use]
@@ -81,6 +122,23 @@ impl Site {
                         format!("photos[{i}].interior.image_size_px"),
                         "width and height must be positive",
                     ));
+                }
+                let max_pixels = crate::photo::DecodeLimits::default().max_pixels;
+                if let Some([w, h]) = interior.image_size_px
+                    && u64::from(w) * u64::from(h) > max_pixels
+                {
+                    issues.push(issue(
+                        format!("photos[{i}].interior.image_size_px"),
+                        format!(
+                            "{w}×{h} px is more than the {} MP a photo may have",
+                            max_pixels / 1_000_000
+                        ),
+                    ));
+                }
+                if let Some(size) = interior.image_size_px
+                    && size.iter().all(|s| *s > 0)
+                {
+                    check_interior_ranges(&mut issues, i, interior, size);
                 }
             }
             if let Some(ext) = &photo.exterior {
@@ -269,6 +327,22 @@ impl Site {
                     "need 1 ≤ spp_min ≤ spp_max, found spp_min = {}, spp_max = {}",
                     r.spp_min, r.spp_max
                 ),
+            ));
+        }
+        if r.max_depth > crate::render::MAX_DEPTH_LIMIT {
+            issues.push(issue(
+                "render.max_depth".into(),
+                format!(
+                    "{} is above the limit {} (deeper mirror recursion would overflow the stack)",
+                    r.max_depth,
+                    crate::render::MAX_DEPTH_LIMIT
+                ),
+            ));
+        }
+        if !(r.exposure.is_finite() && r.exposure > 0.0) {
+            issues.push(issue(
+                "render.exposure".into(),
+                format!("{} must be a positive finite number", r.exposure),
             ));
         }
         if let Some(loc) = &self.location {
