@@ -89,7 +89,10 @@ fn tiles_rendered_alone_and_merged_equal_the_whole_render_byte_for_byte() {
             if ext == "png" {
                 // The view geometry travels through the parts into the merged PNG's EXIF.
                 let bytes = std::fs::read(&merged).unwrap();
-                assert!(bytes.windows(4).any(|w| w == b"eXIf"), "merged PNG has EXIF");
+                assert!(
+                    bytes.windows(4).any(|w| w == b"eXIf"),
+                    "merged PNG has EXIF"
+                );
             }
             if ext == "exr" {
                 let table = |p: &Path| std::fs::read(p.with_extension("objects.json")).unwrap();
