@@ -59,6 +59,16 @@ impl ToneMap {
         Self::default()
     }
 
+    /// Clip after multiplying by `exposure` (a linear multiplier, as the site's
+    /// `render.exposure`): the 8-bit output of renders.
+    #[must_use]
+    pub fn clamp_with_exposure(exposure: f64) -> Self {
+        Self {
+            exposure_stops: exposure.log2(),
+            curve: ToneCurve::Clamp,
+        }
+    }
+
     /// Reinhard with an exposure change.
     #[must_use]
     pub fn reinhard(exposure_stops: f64) -> Self {

@@ -506,10 +506,7 @@ pub fn merge_to_file(
     out: &Path,
 ) -> Result<crate::render::partial::Merged, FarmError> {
     let merged = merge_parts(parts)?;
-    let tone_map = crate::colour::ToneMap {
-        exposure_stops: merged.info.exposure.log2(),
-        curve: crate::colour::tonemap::ToneCurve::Clamp,
-    };
+    let tone_map = crate::colour::ToneMap::clamp_with_exposure(merged.info.exposure);
     let format = OutputFormat::from_path(out).map_err(|e| FarmError::Argument(e.to_string()))?;
     if format == OutputFormat::Exr {
         write_output(out, &merged.image, &merged.layers, &tone_map)?;

@@ -256,13 +256,11 @@ pub fn render_band_with_layers(
 ) -> Result<(RenderedImage, OutputLayers), RenderError> {
     check_view(tracer, settings)?;
     let photo = tracer.photo();
-    let size_px = [photo.width(), photo.height()];
-    let rows = band.tile_rows(size_px[1], settings.tile_size_px)?;
     drive_tiles(
-        size_px,
+        [photo.width(), photo.height()],
         settings,
         layers,
-        rows,
+        band,
         on_tile,
         cancel,
         &|index, origin_px, tile_px| {

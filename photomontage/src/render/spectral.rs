@@ -282,15 +282,11 @@ pub fn render_band_spectral(
         conv: &conv,
         settings,
     };
-    let size_px = [tracer.photo().width(), tracer.photo().height()];
-    let rows = band
-        .tile_rows(size_px[1], settings.tile_size_px)
-        .map_err(RenderError::from)?;
     let (image, _) = drive_tiles(
-        size_px,
+        [tracer.photo().width(), tracer.photo().height()],
         settings,
         LayerSet::default(),
-        rows,
+        band,
         on_tile,
         cancel,
         &|index, origin_px, tile_px| job.tile(index, origin_px, tile_px),

@@ -136,7 +136,7 @@ pub(crate) struct TileOut {
     pub(crate) rays: u64,
 }
 
-/// Renders the tiles of `tile_rows` (whole image: `0..⌈h/ts⌉`) of a `size_px` image with
+/// Renders the tiles of `band` (whole image: [`Band::WHOLE`]) of a `size_px` image with
 /// `render_tile(tile_index, origin_px, size_px)` in parallel and assembles them into an image of
 /// the band (`size_px[0]` × the band's pixel rows). `on_tile` is called as each tile finishes;
 /// raising `cancel` stops at the next tile.
@@ -144,20 +144,16 @@ pub(crate) fn drive_tiles(
     size_px: [u32; 2],
     settings: &RenderSettings,
     layers: LayerSet,
-    tile_rows: Range<u32>,
+    band: Band,
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
     render_tile: &(dyn Fn(usize, [u32; 2], [u32; 2]) -> TileOut + Sync),
 ) -> Result<(RenderedImage, OutputLayers), RenderError> {
     let [w, h] = size_px;
     let ts = settings.tile_size_px;
-    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
-    if tile_rows.start > tile_rows.end || tile_rows.end > tiles_y {
-        return Err(RenderError::InvalidSetting {
-            name: "tile_rows",
-            reason: "the band's tile rows lie outside the image",
-        });
-    }
+    let tiles_x = w.div_ceil(ts);
+    let tiles_y = h.div_ceil(ts);
+    let tile_rows = band.tile_rows(h, ts)?;
     let tile_count = (tiles_x * tiles_y) as usize;
     let first = (tile_rows.start * tiles_x) as usize;
     let last = (tile_rows.end * tiles_x) as usize;

@@ -720,6 +720,38 @@ pub fn site_render_settings(r: &super::RenderSettings) -> (RenderSettings, Vec<S
     )
 }
 
+/// Photo `photo_id` decoded and linearised, checked to be the size `camera` images.
+///
+/// # Errors
+/// [`SiteRenderError::UnknownView`], the photo's decoding errors,
+/// [`SiteRenderError::SizeMismatch`].
+pub fn site_photo_linear(
+    doc: &SiteDocument,
+    photo_id: &str,
+    camera: &Camera,
+) -> Result<Rgb32FImage, SiteRenderError> {
+    let photo = doc
+        .site
+        .photos
+        .iter()
+        .find(|p| p.id == photo_id)
+        .ok_or_else(|| SiteRenderError::UnknownView {
+            id: photo_id.to_owned(),
+            valid: Vec::new(),
+        })?;
+    let loaded = crate::photo::load(&doc.resolve(&photo.file))?;
+    let photo_linear = crate::render::linear_photo(&loaded);
+    let photo_px = [photo_linear.width(), photo_linear.height()];
+    if photo_px != camera.intrinsics.image_size_px {
+        return Err(SiteRenderError::SizeMismatch {
+            photo: photo_id.to_owned(),
+            photo_px,
+            camera_px: camera.intrinsics.image_size_px,
+        });
+    }
+    Ok(photo_linear)
+}
+
 /// Everything to render photo `photo_id`: camera, scene, lighting, the photo (linearised, size
 /// checked against the camera) and the settings of the site's `[render]` table.
 ///
@@ -745,25 +777,7 @@ pub fn prepare_view_with(
     }
     let scene = site_scene(doc)?;
     let (lighting, sun_dir_in_world) = site_lighting(doc, photo_id, options)?;
-    let photo = doc
-        .site
-        .photos
-        .iter()
-        .find(|p| p.id == photo_id)
-        .ok_or_else(|| SiteRenderError::UnknownView {
-            id: photo_id.to_owned(),
-            valid: Vec::new(),
-        })?;
-    let loaded = crate::photo::load(&doc.resolve(&photo.file))?;
-    let photo_linear = crate::render::linear_photo(&loaded);
-    let photo_px = [photo_linear.width(), photo_linear.height()];
-    if photo_px != camera.intrinsics.image_size_px {
-        return Err(SiteRenderError::SizeMismatch {
-            photo: photo_id.to_owned(),
-            photo_px,
-            camera_px: camera.intrinsics.image_size_px,
-        });
-    }
+    let photo_linear = site_photo_linear(doc, photo_id, &camera)?;
     let (settings, setting_warnings) = site_render_settings(&doc.site.render);
     let mut warnings = scene.warnings.clone();
     warnings.extend(setting_warnings);

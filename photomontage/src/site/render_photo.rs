@@ -20,10 +20,9 @@ use sha2::{Digest, Sha256};
 
 use super::SiteDocument;
 use super::render::{ObjectSource, SiteRenderError, SiteWarning, prepare_view, site_camera};
-use crate::colour::tonemap::ToneCurve;
 use crate::colour::{SampleSet, ToneMap};
 use crate::render::output::{LayerSet, OutputLayers};
-use crate::render::partial::{PART_FORMAT, PartInfo};
+use crate::render::partial::{PART_FORMAT, PartInfo, to_hex};
 use crate::render::{
     Band, DifferentialTracer, RenderSettings, RenderedImage, TileProgress, render_band_spectral,
     render_band_with_layers,
@@ -113,11 +112,7 @@ fn check_spp(field: &'static str, n: u32) -> Result<u32, SiteRenderError> {
 pub fn site_content_sha256(doc: &SiteDocument) -> Result<String, SiteRenderError> {
     let text = toml::to_string(&doc.site)
         .map_err(|e| request_error("site", format!("cannot serialise the site: {e}")))?;
-    Ok(hex(&Sha256::digest(text.as_bytes())))
-}
-
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
+    Ok(to_hex(&Sha256::digest(text.as_bytes())))
 }
 
 impl RenderPlan {
@@ -230,10 +225,7 @@ impl RenderPlan {
     /// The tone map of 8-bit output: the exposure, clamped.
     #[must_use]
     pub fn tone_map(&self) -> ToneMap {
-        ToneMap {
-            exposure_stops: self.exposure.log2(),
-            curve: ToneCurve::Clamp,
-        }
+        ToneMap::clamp_with_exposure(self.exposure)
     }
 
     /// Loads the view (scene, lights, photo) and renders the band. `on_tile` reports each

@@ -28,7 +28,7 @@ use crate::camera::{Camera, Intrinsics};
 use crate::photo::exif::FULL_FRAME_DIAGONAL_MM;
 use crate::render::RenderedImage;
 use crate::site::SiteDocument;
-use crate::site::render::{SiteRenderError, ViewJob, prepare_view, site_camera};
+use crate::site::render::{SiteRenderError, ViewJob, prepare_view, site_camera, site_photo_linear};
 
 /// What can go wrong making a planar view.
 #[derive(Debug, thiserror::Error)]
@@ -124,24 +124,7 @@ pub fn solved_photo(
     photo_id: &str,
 ) -> Result<(Camera, Rgb32FImage), SiteRenderError> {
     let camera = site_camera(doc, photo_id)?;
-    let photo = doc
-        .site
-        .photos
-        .iter()
-        .find(|p| p.id == photo_id)
-        .ok_or_else(|| SiteRenderError::NotSolved {
-            photo: photo_id.to_owned(),
-        })?;
-    let loaded = crate::photo::load(&doc.resolve(&photo.file))?;
-    let photo_linear = crate::render::linear_photo(&loaded);
-    let photo_px = [photo_linear.width(), photo_linear.height()];
-    if photo_px != camera.intrinsics.image_size_px {
-        return Err(SiteRenderError::SizeMismatch {
-            photo: photo_id.to_owned(),
-            photo_px,
-            camera_px: camera.intrinsics.image_size_px,
-        });
-    }
+    let photo_linear = site_photo_linear(doc, photo_id, &camera)?;
     Ok((camera, photo_linear))
 }
 

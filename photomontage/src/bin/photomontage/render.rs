@@ -5,7 +5,6 @@
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use photomontage::colour::ToneMap;
-use photomontage::colour::tonemap::ToneCurve;
 use photomontage::render::Band;
 use photomontage::render::output::{self, LayerSet, OutputFormat};
 use photomontage::render::partial::to_hex;
@@ -84,10 +83,7 @@ fn draw_overlay(
 ) -> anyhow::Result<()> {
     check_writable(&args.out)?;
     let overlay = avr_overlay(doc, &args.view, avr)?;
-    let tone_map = ToneMap {
-        exposure_stops: exposure.log2(),
-        curve: ToneCurve::Clamp,
-    };
+    let tone_map = ToneMap::clamp_with_exposure(exposure);
     write_render(
         &args.out,
         &overlay.image,

@@ -4,7 +4,7 @@
 //! The file is written through a temporary file and a rename: never a partial file.
 
 use anyhow::{Context, bail};
-use photomontage::colour::{ToneCurve, ToneMap, encode_srgb8};
+use photomontage::colour::{ToneMap, encode_srgb8};
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
@@ -41,10 +41,7 @@ pub struct Args {
 }
 
 fn to_rgb8(image: &RenderedImage, exposure: f64) -> image::RgbImage {
-    let tone_map = ToneMap {
-        exposure_stops: exposure.log2(),
-        curve: ToneCurve::Clamp,
-    };
+    let tone_map = ToneMap::clamp_with_exposure(exposure);
     let [w, h] = image.size_px;
     image::RgbImage::from_fn(w, h, |x, y| {
         let p = image.rgba[(y * w + x) as usize];

@@ -7,7 +7,6 @@
 
 use anyhow::{Context, bail};
 use photomontage::colour::ToneMap;
-use photomontage::colour::tonemap::ToneCurve;
 use photomontage::render::output;
 use photomontage::render::{DifferentialTracer, render_view};
 use photomontage::site::{SiteDocument, write_atomically};
@@ -166,10 +165,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             )
         }
     };
-    let tone_map = ToneMap {
-        exposure_stops: doc.site.render.exposure.log2(),
-        curve: ToneCurve::Clamp,
-    };
+    let tone_map = ToneMap::clamp_with_exposure(doc.site.render.exposure);
     output::write_output(
         &args.out,
         &image,
