@@ -7,4 +7,4 @@
 
 pub mod schachter;
 
-pub use schachter::{AtmosphereError, Eq7Fit, SchachterAtmosphere};
+pub use schachter::{AtmosphereError, SchachterAtmosphere};

@@ -13,7 +13,7 @@
 //! - **Second inversion** (eq. 8, [`true_radiance`], [`SchachterAtmosphere::true_colour`]):
 //!   `L₀ = (L − L∞) · τₐ^(−d/dₐ) + L∞`, the true colour of a photographed object at a known
 //!   distance (Durisch §4.2; §6 case D).
-//! - **First inversion** (eq. 7, [`fit_transmittance`]): τₐ (and a common L₀) from n ≥ 2 samples
+//! - **First inversion** (eq. 7, [`crate::fit::atmosphere::solve_eq7`]): τₐ (and a common L₀) from n ≥ 2 samples
 //!   of one material at known distances, given L∞, by [`crate::fit::atmosphere`] (argmin
 //!   Gauss–Newton) started, as Durisch does, at τₐ = 1 and L₀ = the nearest sample.
 //! - Koschmieder's law ([`transmittance_from_visibility`]) turns a reported visibility into τₐ.
@@ -220,37 +220,6 @@ impl SchachterAtmosphere {
         }
     }
 
-    /// Durisch §4.2 first inversion for every channel: fits τₐ per channel (and the common
-    /// true colour of the samples) to `samples` of one material, each `(distance_m, apparent
-    /// colour)`, given the horizon colour. Returns the atmosphere and the fitted true colour.
-    ///
-    /// # Errors
-    /// As [`fit_transmittance`] for any channel, or an invalid result (τₐ underflowing to 0).
-    pub fn fit(
-        horizon: Colour,
-        samples: &[(f64, Colour)],
-        reference_distance_m: f64,
-        channels: usize,
-    ) -> Result<(Self, Colour), AtmosphereError> {
-        let channels = channels.min(MAX_CHANNELS);
-        let mut transmittance = Colour::BLACK;
-        let mut true_colour = Colour::BLACK;
-        let mut channel_samples = Vec::with_capacity(samples.len());
-        for k in 0..channels {
-            channel_samples.clear();
-            channel_samples.extend(samples.iter().map(|(d, c)| (*d, f64::from(c.channels[k]))));
-            let fit = fit_transmittance(
-                f64::from(horizon.channels[k]),
-                &channel_samples,
-                reference_distance_m,
-            )?;
-            transmittance.channels[k] = fit.transmittance as f32;
-            true_colour.channels[k] = fit.true_radiance as f32;
-        }
-        let atmosphere = Self::new(transmittance, horizon, reference_distance_m, channels)?;
-        Ok((atmosphere, true_colour))
-    }
-
     /// Per-channel transmittance τₐ over the reference distance.
     #[must_use]
     pub fn transmittance(&self) -> Colour {
@@ -340,43 +309,6 @@ impl SchachterAtmosphere {
         }
         Ok(out)
     }
-}
-
-/// Result of the eq. 7 fit for one channel.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Eq7Fit {
-    /// τₐ over the reference distance.
-    pub transmittance: f64,
-    /// The common true radiance L₀ of the samples.
-    pub true_radiance: f64,
-    /// Root-mean-square residual of eq. 7 at the solution.
-    pub rms_residual: f64,
-    /// Solver iterations taken.
-    pub iterations: usize,
-}
-
-/// Durisch eq. 7 (first inversion) for one channel: fits τₐ and L₀ to samples
-/// `(distance_m, apparent_radiance)` of one material, given the horizon radiance, started at
-/// τₐ = 1 and L₀ = the apparent radiance of the nearest sample. The solver is
-/// [`crate::fit::atmosphere::solve_eq7`] (argmin Gauss–Newton with a line search), which also
-/// gives σ(τₐ) and the residuals.
-///
-/// # Errors
-/// Fewer than two distinct distances, non-finite samples, or samples that do not determine τₐ
-/// (every sample equal to the horizon radiance).
-pub fn fit_transmittance(
-    horizon_radiance: f64,
-    samples: &[(f64, f64)],
-    reference_distance_m: f64,
-) -> Result<Eq7Fit, AtmosphereError> {
-    let s =
-        crate::fit::atmosphere::solve_eq7(horizon_radiance, samples, reference_distance_m, None)?;
-    Ok(Eq7Fit {
-        transmittance: s.transmittance,
-        true_radiance: s.true_radiance,
-        rms_residual: s.rms_residual,
-        iterations: usize::try_from(s.iterations).unwrap_or(usize::MAX),
-    })
 }
 
 #[cfg(test)]

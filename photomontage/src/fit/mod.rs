@@ -4,7 +4,7 @@
 //!
 //! - [`atmosphere`]: τₐ and L₀ per channel from samples of one material at different distances
 //!   (eq. 7), argmin's Gauss–Newton with a line search on a supplied Jacobian, σ(τₐ) from
-//!   (JᵀJ)⁻¹·s². [`crate::atmosphere::schachter::fit_transmittance`] calls it.
+//!   (JᵀJ)⁻¹·s². [`crate::fit::atmosphere::fit_schachter_atmosphere`] applies it per channel.
 //! - [`daylight`]: k_s, k_u, k_h per channel from samples of diffuse materials under different
 //!   illumination (eq. 9, with interreflection; several materials share absolute weights): the irradiance components E_s, E_u, E_h per sample with the scene's
 //!   visibility, non-negative least squares, robust flagging of outlying samples.

@@ -44,7 +44,6 @@ pub mod intersection;
 pub(crate) mod least_squares;
 pub mod p3p;
 pub(crate) mod projection;
-mod ransac;
 pub mod resection;
 pub mod synthetic;
 

@@ -32,14 +32,14 @@
 //! [`specular`], [`water`], [`luminaire_light`], [`spectral`] for those of each physical model.
 
 pub mod differential;
-pub mod glass;
+
 pub mod illumination;
 pub mod irradiance_cache;
 pub mod luminaire_light;
 pub mod output;
 pub mod partial;
 pub mod spectral;
-pub mod specular;
+
 pub mod tiling;
 pub mod water;
 

@@ -23,7 +23,7 @@
 
 use nalgebra::{Point3, Rotation3, Vector3};
 
-use super::render::{SiteRenderError, SiteWarning};
+use super::render_error::{SiteRenderError, SiteWarning};
 use super::{Site, SiteDocument, SiteLuminaire};
 use crate::luminaire::{Luminaire, PhotometricFile};
 use crate::render::{ArtificialLight, LuminaireLight};

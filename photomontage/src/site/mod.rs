@@ -17,8 +17,10 @@ mod locate;
 pub mod luminaires;
 pub mod new;
 pub mod render;
+pub mod render_error;
 pub mod render_photo;
 mod schema;
+pub mod site_scene;
 pub mod solve;
 mod validate;
 

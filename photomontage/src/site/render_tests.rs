@@ -1,6 +1,7 @@
 #![allow(clippy::float_cmp)] // weights and materials are copied, not computed: they must be equal bit for bit
 
 use super::*;
+use crate::scene::ObjectKind;
 use crate::site::{
     Atmosphere, ControlPoint, Exterior, Interior, Location, Photo, Polygon, Site, SunManual,
 };

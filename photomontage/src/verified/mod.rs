@@ -14,7 +14,7 @@
 //! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length;
 //! - [`cylindrical_view`]: a panorama from several photos taken from one point;
 //! - [`image_metadata`]: the view geometry as EXIF in JPEG/PNG output;
-//! - [`sheet`], [`sheet_content`] and [`sheet_html`]: the sheet as PDF or HTML (view at print
+//! - [`sheet`] (with [`sheet::html`]) and [`sheet_content`]: the sheet as PDF or HTML (view at print
 //!   scale, viewing distance, ruler, geometry table, map inset, AVR level, methodology and
 //!   residuals).
 //!
@@ -30,7 +30,6 @@ pub mod paper;
 pub mod planar_view;
 pub mod sheet;
 pub mod sheet_content;
-pub mod sheet_html;
 pub mod wireline;
 
 pub use avr::{AvrLevel, AvrOverlay, apply_massing, avr_overlay};

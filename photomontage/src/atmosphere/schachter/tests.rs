@@ -1,20 +1,13 @@
-//! Tests of Schachter's model: closed-form round trips, limits, Koschmieder's law, and the eq. 7
-//! fit on seeded synthetic ground truth.
+//! Tests of Schachter's model: closed-form round trips, limits, Koschmieder's law, (the eq. 7 fit is tested in
+//! `fit/atmosphere_tests.rs`).
 
 use super::*;
 use proptest::prelude::*;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 /// Forward then inverse in f64 loses only round-off, amplified by 1/τ^(d/dₐ) ≤ 1e3 here.
 const ROUND_TRIP_TOL: f64 = 1e-10;
 /// The `Colour` path stores f32 (7 digits), amplified by 1/τ^(d/dₐ) ≤ ~20 in these cases.
 const COLOUR_ROUND_TRIP_TOL: f32 = 1e-5;
-/// Eq. 7 fit from samples stored as f32 colours: their 7-digit rounding (≈6e-8 relative) is
-/// amplified by the fit's conditioning (distances 0.15–4 dₐ) to ≲1e-6; 1e-5 leaves margin.
-const COLOUR_FIT_TOL: f32 = 1e-5;
-/// Noise-free synthetic data: Gauss–Newton converges quadratically to round-off.
-const FIT_TOL: f64 = 1e-9;
 
 #[test]
 fn distance_zero_is_identity_and_infinity_is_horizon() {
@@ -103,73 +96,6 @@ fn invalid_atmospheres_are_errors() {
     assert!(SchachterAtmosphere::new(ok, h, f64::NAN, 3).is_err());
     let atm = SchachterAtmosphere::new(ok, h, 1000.0, 3).unwrap();
     assert!(atm.true_colour(&ok, -1.0).is_err());
-}
-
-#[test]
-fn eq7_fit_recovers_seeded_ground_truth() {
-    let mut rng = ChaCha8Rng::seed_from_u64(7);
-    for _ in 0..20 {
-        let tau: f64 = rng.random_range(0.3..0.99);
-        let l0: f64 = rng.random_range(0.0..2.0);
-        let linf: f64 = rng.random_range(0.2..1.5);
-        if (l0 - linf).abs() < 0.05 {
-            continue; // an object of the horizon's colour shows no haze
-        }
-        let samples: Vec<(f64, f64)> = (0..6)
-            .map(|_| {
-                let d = rng.random_range(100.0..4000.0);
-                (d, apparent_radiance(l0, linf, tau, d, 1000.0))
-            })
-            .collect();
-        let fit = fit_transmittance(linf, &samples, 1000.0).unwrap();
-        assert!(
-            (fit.transmittance - tau).abs() < FIT_TOL,
-            "{fit:?} vs τ {tau}"
-        );
-        assert!(
-            (fit.true_radiance - l0).abs() < FIT_TOL,
-            "{fit:?} vs L0 {l0}"
-        );
-        assert!(fit.rms_residual < FIT_TOL);
-    }
-}
-
-#[test]
-fn colour_fit_recovers_per_channel_haze() {
-    // Bluish haze: short wavelengths are scattered more, so τ is lowest in blue.
-    let tau = Colour::from_slice(&[0.85, 0.80, 0.70]);
-    let horizon = Colour::from_slice(&[0.70, 0.75, 0.90]);
-    let truth = SchachterAtmosphere::new(tau, horizon, 1000.0, 3).unwrap();
-    let wall = Colour::from_slice(&[0.35, 0.30, 0.20]);
-    let samples: Vec<(f64, Colour)> = [150.0, 600.0, 1400.0, 2500.0, 4000.0]
-        .iter()
-        .map(|&d| (d, truth.apparent(&wall, d)))
-        .collect();
-    let (fitted, l0) = SchachterAtmosphere::fit(horizon, &samples, 1000.0, 3).unwrap();
-    for k in 0..3 {
-        assert!((fitted.transmittance().channels[k] - tau.channels[k]).abs() < COLOUR_FIT_TOL);
-        assert!((l0.channels[k] - wall.channels[k]).abs() < COLOUR_FIT_TOL);
-    }
-}
-
-#[test]
-fn eq7_fit_rejects_undetermined_input() {
-    assert!(matches!(
-        fit_transmittance(0.5, &[(100.0, 0.3)], 1000.0),
-        Err(AtmosphereError::NotEnoughSamples { .. })
-    ));
-    assert!(matches!(
-        fit_transmittance(0.5, &[(100.0, 0.3), (100.0, 0.31)], 1000.0),
-        Err(AtmosphereError::NotEnoughSamples { .. })
-    ));
-    assert!(matches!(
-        fit_transmittance(0.5, &[(100.0, 0.5), (300.0, 0.5)], 1000.0),
-        Err(AtmosphereError::Undetermined { .. })
-    ));
-    assert!(matches!(
-        fit_transmittance(0.5, &[(100.0, f64::NAN), (300.0, 0.5)], 1000.0),
-        Err(AtmosphereError::InvalidSample { index: 0 })
-    ));
 }
 
 proptest! {

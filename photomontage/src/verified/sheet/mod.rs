@@ -17,6 +17,8 @@
 //! One font, one size per block, no text wrapping (long lines are cut at the page margin); the
 //! map inset shows plan positions only (no base map); text outside WinAnsi prints as `?`.
 
+pub mod html;
+
 use std::io::Cursor;
 use std::path::Path;
 
@@ -31,7 +33,7 @@ use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 
 /// The embedded font (DejaVu Sans Mono 2.37).
-const FONT_TTF: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
+const FONT_TTF: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
 /// Advance width of every glyph, 1/1000 em (1233/2048).
 const GLYPH_WIDTH: f32 = 602.0;
 /// JPEG quality of the embedded image (visually lossless for photographs).
@@ -507,7 +509,7 @@ pub fn sheet_pdf(input: &SheetInput<'_>) -> Result<Vec<u8>, SheetError> {
 pub enum SheetFormat {
     /// PDF ([`sheet_pdf`]).
     Pdf,
-    /// One self-contained HTML file ([`super::sheet_html::sheet_html`]).
+    /// One self-contained HTML file ([`html::sheet_html`]).
     Html,
 }
 
@@ -576,7 +578,7 @@ pub fn sheet_for_view_as(
     };
     match format {
         SheetFormat::Pdf => sheet_pdf(&input),
-        SheetFormat::Html => super::sheet_html::sheet_html(&input).map(String::into_bytes),
+        SheetFormat::Html => html::sheet_html(&input).map(String::into_bytes),
     }
 }
 
@@ -593,5 +595,4 @@ pub fn write_sheet(path: &Path, bytes: &[u8]) -> Result<(), SheetError> {
 }
 
 #[cfg(test)]
-#[path = "sheet_tests.rs"]
 mod tests;

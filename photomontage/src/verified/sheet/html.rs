@@ -1,5 +1,5 @@
 //! The verified-view sheet as one self-contained HTML file (the "Also HTML"): the same
-//! content as the PDF ([`super::sheet_content`]: view geometry table, methodology, residuals; the
+//! content as the PDF ([`crate::verified::sheet_content`]: view geometry table, methodology, residuals; the
 //! AVR level and TGN Type) with the view embedded as a JPEG data URI and sized in CSS millimetres
 //! at the report's printed width, so that printing the page at 100 % on the report's paper gives
 //! the stated viewing distance (`@page` sets the paper, landscape).
@@ -13,8 +13,8 @@ use std::io::Cursor;
 
 use image::RgbImage;
 
-use super::sheet::{JPEG_QUALITY, SheetError, SheetInput};
-use super::sheet_content::{geometry_rows, residual_lines};
+use super::{JPEG_QUALITY, SheetError, SheetInput};
+use crate::verified::sheet_content::{geometry_rows, residual_lines};
 
 const BASE64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 

@@ -35,9 +35,9 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::differential::{DifferentialTracer, SURFACE_OFFSET_M};
-use super::illumination::{Rgb, add, mul};
 use super::specular::reflect_above;
+use super::{DifferentialTracer, SURFACE_OFFSET_M};
+use crate::render::illumination::{Rgb, add, mul};
 use crate::scene::ObjectKind;
 use crate::scene::material::Glass;
 

@@ -40,12 +40,14 @@ use super::least_squares::{
 use super::projection::{
     apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
 };
-use super::ransac::{normalised_error_sq, ransac};
+mod ransac;
+
 use super::{
     ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, validate_control,
     validate_intrinsics, validate_observations,
 };
 use crate::camera::{Camera, Intrinsics};
+use ransac::{normalised_error_sq, ransac};
 
 /// Tunables of [`resect`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -706,5 +708,4 @@ fn set(free: &mut SelfCalibration, name: &str, value: bool) {
 }
 
 #[cfg(test)]
-#[path = "resection_tests.rs"]
 mod tests;

@@ -6,8 +6,8 @@
 //!   the horizon colour L∞ if it points above the horizon.
 //! - **Case C** ([`DifferentialTracer::case_c_artificial_hit`]): an artificial object → eq. 6 with
 //!   the natural lights (sun, ambient, sky facets, visibility by any-hit against the whole scene)
-//!   and the artificial lights (points or luminaires), the GGX lobe ([`super::specular`]), mirror
-//!   and thin-glass reflection and transmission recursively ([`super::glass`]), water-wave
+//!   and the artificial lights (points or luminaires), the GGX lobe ([`specular`]), mirror
+//!   and thin-glass reflection and transmission recursively ([`glass`]), water-wave
 //!   shading normals ([`super::water`]), then the atmosphere (eq. 2).
 //! - **Case D** ([`DifferentialTracer::case_d_natural_hit`]): a natural object → its apparent
 //!   colour from the photo, its true colour L₀ by the atmosphere's second inversion (eq. 8), its
@@ -18,7 +18,7 @@
 //!
 //! A natural light counts as blocked by artificial objects when an any-hit against the artificial
 //! geometry succeeds and one against the natural geometry fails (separate BVHs); glass panes take
-//! only the fraction they do not transmit ([`super::glass`]). Shadow rays to
+//! only the fraction they do not transmit ([`glass`]). Shadow rays to
 //! the artificial BVH are first culled by its bounding box, so the cost of proving that a pixel is
 //! unchanged is one closest hit plus a slab test per light.
 //!
@@ -43,7 +43,7 @@
 //! Secondary rays that hit natural objects take their apparent colour from the current photo only
 //! (not from the polygon's image attribute photo), when the point is visible in it; otherwise the
 //! library material is shaded by eq. 6. Glass is a thin pane (no refraction through solids;
-//! shadow rays pass it attenuated but straight); the glossy lobe is sampled with few rays (see [`super::specular`]).
+//! shadow rays pass it attenuated but straight); the glossy lobe is sampled with few rays (see [`specular`]).
 //! The gather is one bounce on a fixed facet set (deterministic, so it has
 //! quantisation error rather than noise); the artificial radiance a natural point gathers takes sky
 //! facets as visible and gets its own photo bounce only from the coarser nested dome; natural surfaces blocked from the photo's view
@@ -57,14 +57,15 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use image::Rgb32FImage;
 use nalgebra::{Point2, Point3, Vector3};
 
-use super::glass::PhotoBehind;
+pub mod glass;
+pub mod specular;
+
 use super::illumination::{
     Daylight, DistantLight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour,
     mul, natural_irradiance_rgb, natural_irradiance_weighted_rgb, scale,
 };
 use super::irradiance_cache::{GatherKind, IrradianceCacheSettings, MeanDistance, cached_gather};
 use super::luminaire_light::ArtificialLight;
-use super::specular::{SurfaceFrame, reflect_above};
 use super::water::shading_normal;
 use crate::atmosphere::schachter::SchachterAtmosphere;
 use crate::bvh::BuildQuality;
@@ -72,6 +73,8 @@ use crate::camera::Camera;
 use crate::colour::Colour;
 use crate::scene::material::GradientNoise;
 use crate::scene::{ImportedModel, Material, ObjectKind, Scene, SceneError, SceneHit, SceneTracer};
+use glass::PhotoBehind;
+use specular::{SurfaceFrame, reflect_above};
 
 /// Shadow and reflection rays start this far off the surface, along its normal, so they do not
 /// re-hit it: 1 mm, far above the `f32` spacing (≤ 0.5 mm) of the local tracing frame within
@@ -144,7 +147,7 @@ pub struct DifferentialTracer<'a> {
     natural: Option<SceneTracer>,
     artificial: SceneTracer,
     /// The glass panes among the artificial triangles and the rest, when there are panes:
-    /// shadow rays pass panes attenuated ([`super::glass`]) and stop at the rest.
+    /// shadow rays pass panes attenuated ([`glass`]) and stop at the rest.
     pub(super) artificial_split: Option<GlassSplit>,
     artificial_bounds_in_world_m: [Point3<f64>; 2],
     lighting: &'a Lighting,

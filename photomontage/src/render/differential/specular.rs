@@ -27,8 +27,8 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::differential::DifferentialTracer;
-use super::illumination::{DistantLight, Rgb, add, scale};
+use super::DifferentialTracer;
+use crate::render::illumination::{DistantLight, Rgb, add, scale};
 use crate::scene::material::Specular;
 
 /// Glossy secondary rays traced per primary hit of a specular surface.

@@ -1,5 +1,5 @@
 //! Robust start of the resection: RANSAC (Fischler & Bolles 1981) over minimal P3P samples
-//! ([`super::p3p`]) with the MSAC score (Torr & Zisserman 2000) and a local least-squares
+//! ([`crate::photogrammetry::p3p`]) with the MSAC score (Torr & Zisserman 2000) and a local least-squares
 //! optimisation of the best candidates (LO-RANSAC, Chum, Matas & Kittler 2003). Small point
 //! sets are enumerated exhaustively, larger ones sampled with a seeded `ChaCha8Rng`.
 //!
@@ -11,11 +11,11 @@ use nalgebra::{Unit, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::SelfCalibration;
-use super::least_squares::levenberg_marquardt;
-use super::p3p;
-use super::resection::{MIN_POINTS, Obs, Problem, ResectionOptions};
+use super::{MIN_POINTS, Obs, Problem, ResectionOptions};
 use crate::camera::{Camera, Intrinsics, Pose};
+use crate::photogrammetry::SelfCalibration;
+use crate::photogrammetry::least_squares::levenberg_marquardt;
+use crate::photogrammetry::p3p;
 
 /// Samples drawn even when the adaptive stop says fewer suffice: with every point an inlier the
 /// adaptive count is 0, and a few extra samples guard against a lucky first consensus.
@@ -27,7 +27,7 @@ const LOCAL_OPTIMISATION_CANDIDATES: usize = 5;
 const EXHAUSTIVE_MAX_TRIPLES: usize = 56;
 /// Up to this many points the best candidates get the local optimisation; with more points
 /// the best MSAC pose is reliably in the right basin and the refinement that follows
-/// ([`super::resection`]) does the same job.
+/// ([`super`]) does the same job.
 const FEW_POINTS: usize = 8;
 
 /// Squared normalised reprojection error of `o` for a camera, using σ_px and the control σ
