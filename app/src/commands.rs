@@ -544,8 +544,8 @@ mod tests {
         let model = CadModel {
             id: "box".into(),
             file: "box.obj".into(),
-            units: "m".into(),
-            up_axis: "z".into(),
+            units: photomontage::site::ModelUnits::Metre,
+            up_axis: photomontage::site::ModelUpAxis::Z,
             placement: Placement::default(),
             visible: true,
         };

@@ -31,7 +31,7 @@
 use eframe::egui::{self, Color32};
 use photomontage::scene::{LengthUnit, UpAxis};
 use photomontage::site::render::{SiteWarning, site_camera, site_scene};
-use photomontage::site::{CadModel, Placement, SiteDocument};
+use photomontage::site::{CadModel, ModelUnits, ModelUpAxis, Placement, SiteDocument};
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
@@ -116,7 +116,7 @@ pub struct ModelsPanel {
 type CacheKey = (String, String, String);
 
 fn cache_key(m: &CadModel) -> CacheKey {
-    (m.file.clone(), m.units.clone(), m.up_axis.clone())
+    (m.file.clone(), m.units.to_string(), m.up_axis.to_string())
 }
 
 /// World position of a model-frame point under `placement` (scale, rotation about Z,
@@ -139,11 +139,11 @@ pub fn model_entry_as(
     up_axis: Option<&str>,
 ) -> CadModel {
     let mut m = model_entry(doc, path);
-    if let Some(u) = units {
-        m.units = u.to_owned();
+    if let Some(u) = units.and_then(|u| u.parse().ok()) {
+        m.units = u;
     }
-    if let Some(a) = up_axis {
-        m.up_axis = a.to_owned();
+    if let Some(a) = up_axis.and_then(|a| a.parse().ok()) {
+        m.up_axis = a;
     }
     m
 }
@@ -201,8 +201,8 @@ pub fn model_entry(doc: &SiteDocument, path: &Path) -> CadModel {
     CadModel {
         id,
         file: file.to_string_lossy().into_owned(),
-        units: "m".into(),
-        up_axis: if gltf { "y" } else { "z" }.into(),
+        units: ModelUnits::Metre,
+        up_axis: if gltf { ModelUpAxis::Y } else { ModelUpAxis::Z },
         placement: Placement {
             translation: centroid,
             ..Placement::default()
@@ -345,8 +345,8 @@ impl crate::Studio {
                      centroid; move it in the Models tab)",
                     model.id,
                     path.display(),
-                    unit_label(&model.units),
-                    axis_label(&model.up_axis)
+                    unit_label(model.units.as_str()),
+                    axis_label(model.up_axis.as_str())
                 );
                 let warnings = edges.warnings.clone();
                 self.models
@@ -444,21 +444,25 @@ impl crate::Studio {
             ui.horizontal(|ui| {
                 let mut changed = m.clone();
                 let names: Vec<&str> = UNITS.iter().map(|(u, _)| *u).collect();
+                let mut units = m.units.to_string();
                 let a = choice_ui(
                     ui,
                     &format!("{} units", m.id),
-                    &mut changed.units,
+                    &mut units,
                     &names,
                     unit_label,
                 );
                 let axes: Vec<&str> = UP_AXES.iter().map(|(a, _)| *a).collect();
+                let mut axis = m.up_axis.to_string();
                 let b = choice_ui(
                     ui,
                     &format!("{} up axis", m.id),
-                    &mut changed.up_axis,
+                    &mut axis,
                     &axes,
                     axis_label,
                 );
+                changed.units = units.parse().unwrap_or(m.units);
+                changed.up_axis = axis.parse().unwrap_or(m.up_axis);
                 if a || b {
                     commands.push((
                         Command::PutModel {

@@ -101,22 +101,22 @@ fn units_and_up_axis_change_the_wireframe_exactly_and_undo() {
     assert_wireframe(&before, &project(corners(t0, |p| p)));
 
     choose(&mut h, "box units", "ft (0.3048 m)");
-    assert_eq!(model(&h, "box").units, "ft");
+    assert_eq!(model(&h, "box").units.as_str(), "ft");
     let feet = h.state_mut().model_wireframe_px("P1", "box").unwrap();
     assert_wireframe(&feet, &project(corners(t0, |p| p.map(|c| c * 0.3048))));
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(model(&h, "box").units, "m");
+    assert_eq!(model(&h, "box").units.as_str(), "m");
     let undone = h.state_mut().model_wireframe_px("P1", "box").unwrap();
     assert_wireframe(&undone, &project(corners(t0, |p| p)));
 
     choose(&mut h, "box up axis", "Y up (glTF)");
-    assert_eq!(model(&h, "box").up_axis, "y");
+    assert_eq!(model(&h, "box").up_axis.as_str(), "y");
     let y_up = h.state_mut().model_wireframe_px("P1", "box").unwrap();
     assert_wireframe(&y_up, &project(corners(t0, |[x, y, z]| [x, -z, y])));
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(model(&h, "box").up_axis, "z");
+    assert_eq!(model(&h, "box").up_axis.as_str(), "z");
 }
 
 #[test]
@@ -146,7 +146,7 @@ fn the_importers_scale_warning_follows_the_chosen_unit() {
 
     // Added as metres: 20 km across, the importer's warning in the messages and the panel.
     add(&mut h);
-    assert_eq!(model(&h, "big").units, "m");
+    assert_eq!(model(&h, "big").units.as_str(), "m");
     let last = h.state().messages().last().unwrap().clone();
     assert!(
         last.is_error && last.text.contains("20000.0000 m across"),
@@ -160,16 +160,16 @@ fn the_importers_scale_warning_follows_the_chosen_unit() {
     // Added in millimetres (chosen before adding): 20 m, no warning.
     choose(&mut h, "new model units", "mm (0.001 m)");
     add(&mut h);
-    assert_eq!(model(&h, "big").units, "mm");
+    assert_eq!(model(&h, "big").units.as_str(), "mm");
     assert!(!scale_warning_shown(&h, "big"));
     assert!(!h.state().messages().last().unwrap().is_error);
 
     // Switched to metres afterwards: the warning is back; undo removes it again.
     choose(&mut h, "big units", "m (1 m)");
-    assert_eq!(model(&h, "big").units, "m");
+    assert_eq!(model(&h, "big").units.as_str(), "m");
     assert!(scale_warning_shown(&h, "big"));
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(model(&h, "big").units, "mm");
+    assert_eq!(model(&h, "big").units.as_str(), "mm");
     assert!(!scale_warning_shown(&h, "big"));
 }

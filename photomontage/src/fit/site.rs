@@ -46,7 +46,7 @@ use super::sun_check::{DEFAULT_TOLERANCE_DEG, check_sun};
 use crate::atmosphere::{AtmosphereError, schachter::true_radiance};
 use crate::photo::PhotoImage;
 use crate::scene::{Material, MaterialLibrary, Scene, SceneTracer};
-use crate::site::render::{parse_sky_model, site_material_library, site_sun_dir};
+use crate::site::render::{site_material_library, site_sky_model, site_sun_dir};
 use crate::site::{SamplePurpose, Site, SiteDocument, stored_camera};
 use crate::sky_dome::durisch_facets::durisch_dome;
 use crate::sun::SpaParams;
@@ -618,7 +618,7 @@ fn run_fits(
                 material: s.material.clone(),
             });
         }
-        let model = parse_sky_model(&site.lighting.sky_model)
+        let model = site_sky_model(site.lighting.sky_model)
             .map_err(|e| SiteFitError::Sun(e.to_string()))?;
         let sun_dir = site_sun_dir(doc, &day_samples[0].photo)
             .map(|d| (d.z > 0.0).then_some(d))

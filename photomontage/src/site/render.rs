@@ -26,7 +26,7 @@
 use image::Rgb32FImage;
 use nalgebra::Vector3;
 
-use super::SiteDocument;
+use super::{SiteDocument, SkyModelName};
 use crate::atmosphere::schachter::SchachterAtmosphere;
 use crate::camera::Camera;
 use crate::colour::Colour;
@@ -108,24 +108,18 @@ pub fn site_camera(doc: &SiteDocument, photo_id: &str) -> Result<Camera, SiteRen
     })
 }
 
-/// The sky model named by `lighting.sky_model`.
+/// The sky model of `lighting.sky_model`.
 ///
 /// # Errors
-/// [`SiteRenderError::Sky`] for an unknown name.
-pub fn parse_sky_model(name: &str) -> Result<SkyModel, SiteRenderError> {
-    let bad = || SiteRenderError::Sky {
-        reason: format!("`{name}` is not `uniform`, `cie_overcast` or `cie_general:N` (N = 1–15)"),
-    };
+/// [`SiteRenderError::Sky`] for a CIE general sky type outside 1–15 (only possible for a value
+/// built in code; the site file's reader refuses it).
+pub fn site_sky_model(name: SkyModelName) -> Result<SkyModel, SiteRenderError> {
     match name {
-        "uniform" => Ok(SkyModel::Uniform),
-        "cie_overcast" => Ok(SkyModel::CieOvercast),
-        other => {
-            let n: u8 = other
-                .strip_prefix("cie_general:")
-                .and_then(|n| n.parse().ok())
-                .ok_or_else(bad)?;
-            SkyModel::cie_general(n).map_err(|_| bad())
-        }
+        SkyModelName::Uniform => Ok(SkyModel::Uniform),
+        SkyModelName::CieOvercast => Ok(SkyModel::CieOvercast),
+        SkyModelName::CieGeneral(n) => SkyModel::cie_general(n).map_err(|e| SiteRenderError::Sky {
+            reason: format!("`{name}`: {e}"),
+        }),
     }
 }
 
@@ -291,7 +285,7 @@ pub fn site_lighting(
     options: &SiteLightingOptions,
 ) -> Result<(Lighting, Option<Vector3<f64>>), SiteRenderError> {
     let l = &doc.site.lighting;
-    let model = parse_sky_model(&l.sky_model)?;
+    let model = site_sky_model(l.sky_model)?;
     let sun_dir = if sun_needed(doc, &model) {
         Some(site_sun_dir(doc, photo_id)?)
     } else {

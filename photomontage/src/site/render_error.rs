@@ -36,13 +36,6 @@ pub enum SiteRenderError {
         path: String,
         source: SceneError,
     },
-    #[error("model `{model}`: {field} `{value}` is not one of {allowed}")]
-    ModelSetting {
-        model: String,
-        field: &'static str,
-        value: String,
-        allowed: &'static str,
-    },
     #[error(
         "no visible model in the site: nothing to render (add a [[models]] entry or make one visible)"
     )]

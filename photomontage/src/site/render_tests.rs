@@ -5,6 +5,7 @@ use crate::scene::ObjectKind;
 use crate::site::{
     Atmosphere, ControlPoint, Exterior, Interior, Location, Photo, Polygon, Site, SunManual,
 };
+use crate::site::{ModelUnits, ModelUpAxis};
 use std::path::Path;
 
 /// Σ L_i Δω_i cos Z_i is normalised to k_h by construction; only rounding remains.
@@ -88,15 +89,15 @@ fn fixture(dir: &Path) -> SiteDocument {
         models: vec![crate::site::CadModel {
             id: "box".into(),
             file: "box.obj".into(),
-            units: "m".into(),
-            up_axis: "z".into(),
+            units: ModelUnits::Metre,
+            up_axis: ModelUpAxis::Z,
             placement: crate::site::Placement::default(),
             visible: true,
         }],
         ..Site::default()
     };
     site.lighting.material_library = Some("materials.toml".into());
-    site.lighting.sky_model = "uniform".into();
+    site.lighting.sky_model = SkyModelName::Uniform;
     site.lighting.sun_manual = Some(SunManual {
         azimuth_deg: 135.0,
         elevation_deg: 40.0,
@@ -320,12 +321,6 @@ fn bad_models_are_errors_or_warnings() {
         assert_eq!(scale_warnings, usize::from(warn), "scale {scale}");
     }
     doc.site.models[0].placement.scale = 1.0;
-    doc.site.models[0].units = "furlong".into();
-    assert!(matches!(
-        site_scene(&doc).unwrap_err(),
-        SiteRenderError::ModelSetting { .. }
-    ));
-    doc.site.models[0].units = "m".into();
     doc.site.polygons[0].vertices[0] = "zz".into();
     let err = site_scene(&doc).unwrap_err();
     assert!(err.to_string().contains("`zz`"), "{err}");

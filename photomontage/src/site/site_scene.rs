@@ -14,8 +14,7 @@ use serde::Serialize;
 use super::render_error::{SiteRenderError, SiteWarning};
 use super::{CadModel, SiteDocument};
 use crate::scene::{
-    ImportOptions, LengthUnit, Material, MaterialLibrary, ObjectKind, Placement, Scene,
-    SceneObject, UpAxis,
+    ImportOptions, Material, MaterialLibrary, ObjectKind, Placement, Scene, SceneObject,
 };
 
 /// Diffuse reflectance of a polygon whose material is not in the library (or when the site has
@@ -76,29 +75,10 @@ fn point_table(doc: &SiteDocument) -> HashMap<&str, [f64; 3]> {
     points
 }
 
-fn import_options(model: &CadModel) -> Result<ImportOptions, SiteRenderError> {
-    let setting = |field, value: &str, allowed| SiteRenderError::ModelSetting {
-        model: model.id.clone(),
-        field,
-        value: value.to_owned(),
-        allowed,
-    };
-    let unit = match model.units.as_str() {
-        "m" => LengthUnit::Metre,
-        "cm" => LengthUnit::Centimetre,
-        "mm" => LengthUnit::Millimetre,
-        "in" => LengthUnit::Inch,
-        "ft" => LengthUnit::Foot,
-        other => return Err(setting("units", other, "m, cm, mm, in, ft")),
-    };
-    let up = match model.up_axis.as_str() {
-        "z" | "Z" => UpAxis::Z,
-        "y" | "Y" => UpAxis::Y,
-        other => return Err(setting("up_axis", other, "z, y")),
-    };
-    Ok(ImportOptions {
-        unit: Some(unit),
-        up_axis: Some(up),
+fn import_options(model: &CadModel) -> ImportOptions {
+    ImportOptions {
+        unit: Some(model.units.length_unit()),
+        up_axis: Some(model.up_axis.up_axis()),
         placement: Placement {
             translation_in_world_m: model.placement.translation,
             rotation_about_z_deg: model.placement.rotation_z_deg,
@@ -108,7 +88,7 @@ fn import_options(model: &CadModel) -> Result<ImportOptions, SiteRenderError> {
         // unit is certainly wrong and it is an error.
         min_extent_m: 0.0,
         ..ImportOptions::default()
-    })
+    }
 }
 
 /// The material library of the site, if it names one.
@@ -187,7 +167,7 @@ pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
             .map(|(material, polygons)| SiteWarning::MissingMaterial { material, polygons }),
     );
     for model in doc.site.models.iter().filter(|m| m.visible) {
-        let options = import_options(model)?;
+        let options = import_options(model);
         let path = doc.resolve(&model.file);
         let imported =
             crate::scene::load_model(&path, &options).map_err(|source| SiteRenderError::Model {

@@ -127,6 +127,54 @@ fn type_error_names_line_and_field() {
     assert!(msg.contains(&format!("test.toml:{expected}:")), "{msg}");
 }
 
+/// The closed sets of the schema (model units and up axis, sky model) are read as enums: a value
+/// outside them is refused at its line, naming the allowed values; every member round-trips.
+#[test]
+fn closed_sets_are_refused_at_their_line_and_round_trip() {
+    let model =
+        "\n[[models]]\nid = \"m\"\nfile = \"m.obj\"\nunits = \"UNITS\"\nup_axis = \"AXIS\"\n";
+    let with = |units: &str, axis: &str, sky: &str| {
+        let text = format!(
+            "{EXAMPLE}{}\n[lighting]\nsky_model = \"{sky}\"\n",
+            model.replace("UNITS", units).replace("AXIS", axis)
+        );
+        let line_of = |needle: &str| text.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
+        (
+            parse(&text),
+            line_of("units"),
+            line_of("up_axis"),
+            line_of("sky_model"),
+        )
+    };
+    for units in ModelUnits::ALL {
+        for (axis, expected) in [("z", ModelUpAxis::Z), ("Y", ModelUpAxis::Y)] {
+            let (site, ..) = with(units.as_str(), axis, "cie_general:7");
+            let site = site.unwrap();
+            assert_eq!(site.models[0].units, units);
+            assert_eq!(site.models[0].up_axis, expected);
+            assert_eq!(site.lighting.sky_model, SkyModelName::CieGeneral(7));
+            let again = parse(&site.to_toml().unwrap()).unwrap();
+            assert_eq!(again, site);
+        }
+    }
+    let (err, units_line, axis_line, sky_line) = with("furlong", "z", "uniform");
+    let msg = err.unwrap_err().to_string();
+    assert!(msg.contains(&format!("test.toml:{units_line}:")), "{msg}");
+    assert!(msg.contains("furlong") && msg.contains("`ft`"), "{msg}");
+    let (err, ..) = with("m", "x", "uniform");
+    let msg = err.unwrap_err().to_string();
+    assert!(msg.contains(&format!("test.toml:{axis_line}:")), "{msg}");
+    let (err, ..) = with("m", "z", "cie_general:16");
+    let msg = err.unwrap_err().to_string();
+    assert!(msg.contains(&format!("test.toml:{sky_line}:")), "{msg}");
+    assert!(msg.contains("cie_general:N"), "{msg}");
+    for name in ["uniform", "cie_overcast", "cie_general:1", "cie_general:15"] {
+        assert_eq!(name.parse::<SkyModelName>().unwrap().to_string(), name);
+    }
+    assert!("cie_general:0".parse::<SkyModelName>().is_err());
+    assert!("perez".parse::<SkyModelName>().is_err());
+}
+
 #[test]
 fn unknown_field_is_refused() {
     let text = EXAMPLE.replace("enabled = false", "enabld = false");
@@ -251,8 +299,8 @@ fn save_as_elsewhere_keeps_every_referenced_file_reachable() {
     site.models.push(CadModel {
         id: "M".into(),
         file: "model.obj".into(),
-        units: "m".into(),
-        up_axis: "z".into(),
+        units: ModelUnits::Metre,
+        up_axis: ModelUpAxis::Z,
         placement: Placement::default(),
         visible: true,
     });

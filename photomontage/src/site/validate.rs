@@ -266,18 +266,6 @@ impl Site {
                     format!("duplicate model id `{}`", model.id),
                 ));
             }
-            if !["m", "cm", "mm", "in", "ft"].contains(&model.units.as_str()) {
-                issues.push(issue(
-                    format!("{field}.units"),
-                    format!("`{}` is not one of m, cm, mm, in, ft", model.units),
-                ));
-            }
-            if !["z", "y"].contains(&model.up_axis.as_str()) {
-                issues.push(issue(
-                    format!("{field}.up_axis"),
-                    format!("`{}` is not `z` or `y`", model.up_axis),
-                ));
-            }
             let p = &model.placement;
             check_finite(
                 &mut issues,
@@ -302,15 +290,6 @@ impl Site {
         self.validate_fit_inputs(&mut issues, &photo_ids, &point_ids, &observed);
 
         let lighting = &self.lighting;
-        if !valid_sky_model(&lighting.sky_model) {
-            issues.push(issue(
-                "lighting.sky_model".into(),
-                format!(
-                    "`{}` is not `uniform`, `cie_overcast` or `cie_general:N` (N = 1–15)",
-                    lighting.sky_model
-                ),
-            ));
-        }
         if let Some(t) = &lighting.time
             && chrono::DateTime::parse_from_rfc3339(t).is_err()
         {
@@ -489,16 +468,6 @@ impl Site {
                 ));
             }
         }
-    }
-}
-
-fn valid_sky_model(name: &str) -> bool {
-    match name {
-        "uniform" | "cie_overcast" => true,
-        other => other
-            .strip_prefix("cie_general:")
-            .and_then(|n| n.parse::<u8>().ok())
-            .is_some_and(|n| (1..=15).contains(&n)),
     }
 }
 

@@ -115,7 +115,7 @@ pub(crate) fn base_site() -> Site {
         ..Site::default()
     };
     site.lighting.time = Some("2024-06-21T10:30:00+02:00".into());
-    site.lighting.sky_model = "cie_general:12".into();
+    site.lighting.sky_model = crate::site::SkyModelName::CieGeneral(12);
     site.lighting.material_library = Some("materials.toml".into());
     // The photos hold eq. 9's colours without interreflection (the rest of the image is the
     // horizon colour, not a rendering of the surroundings): eq. 9 as in the paper.
@@ -195,7 +195,7 @@ fn synthetic_site(seed: u64, corrupt_every: Option<usize>) -> Synthetic {
     let sun = site_sun_dir(&doc0, "P1").unwrap();
     let sky = normalised_sky_facets(
         &durisch_dome(SiteFitOptions::default().sky_m_h).unwrap(),
-        &parse_sky_model("cie_general:12").unwrap(),
+        &crate::site::render::site_sky_model(crate::site::SkyModelName::CieGeneral(12)).unwrap(),
         &sun,
     )
     .unwrap();
@@ -653,7 +653,7 @@ fn weights_rendered_by_the_renderer_are_recovered() {
     // The fit starts from the site's defaults, not from the truth.
     site.lighting = crate::site::Lighting {
         time: site.lighting.time.clone(),
-        sky_model: site.lighting.sky_model.clone(),
+        sky_model: site.lighting.sky_model,
         material_library: site.lighting.material_library.clone(),
         ..crate::site::Lighting::default()
     };
