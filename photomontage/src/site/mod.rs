@@ -22,6 +22,7 @@ pub mod render_photo;
 mod schema;
 pub mod site_scene;
 pub mod solve;
+pub mod toml_merge;
 mod validate;
 
 pub use schema::*;
@@ -144,7 +145,8 @@ impl SiteDocument {
                 rebase(lib);
             }
         }
-        site.save(path)?;
+        let template = std::fs::read_to_string(&self.path).ok();
+        site.save_over(path, template.as_deref())?;
         self.site = site;
         self.path = path.to_path_buf();
         Ok(())
@@ -208,12 +210,43 @@ impl Site {
     }
 
     /// Saves atomically: writes a temporary file beside `path`, flushes it to disk, then renames it
-    /// over `path`, so a crash leaves either the old or the new file, never a torn one.
+    /// over `path`, so a crash leaves either the old or the new file, never a torn one. When
+    /// `path` already holds a site, its comments, blank lines and key order are kept
+    /// ([`toml_merge`]).
     ///
     /// # Errors
     /// [`SiteError::Write`] or [`SiteError::Serialise`].
     pub fn save(&self, path: &Path) -> Result<(), SiteError> {
-        let text = self.to_toml()?;
+        let template = std::fs::read_to_string(path).ok();
+        self.save_over(path, template.as_deref())
+    }
+
+    /// The site as TOML laid into `template`'s comments and order ([`toml_merge`]) when that
+    /// reads back to this very site, else the plain serialisation.
+    ///
+    /// # Errors
+    /// [`SiteError::Serialise`].
+    pub fn to_toml_over(&self, template: Option<&str>) -> Result<String, SiteError> {
+        let fresh = self.to_toml()?;
+        let merged = template
+            .and_then(|t| {
+                toml_merge::merge_into_template(t, &fresh, |candidate| {
+                    Self::from_toml(candidate, Path::new("merged"))
+                        .ok()?
+                        .to_toml()
+                        .ok()
+                })
+            })
+            .filter(|m| Self::from_toml(m, Path::new("merged")).is_ok_and(|back| back == *self));
+        Ok(merged.unwrap_or(fresh))
+    }
+
+    /// [`Self::save`] with the previous text given (e.g. the file a document was loaded from).
+    ///
+    /// # Errors
+    /// [`SiteError::Write`] or [`SiteError::Serialise`].
+    pub fn save_over(&self, path: &Path, template: Option<&str>) -> Result<(), SiteError> {
+        let text = self.to_toml_over(template)?;
         write_atomically(path, text.as_bytes()).map_err(|source| SiteError::Write {
             path: path.to_path_buf(),
             source,

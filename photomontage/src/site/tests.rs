@@ -270,6 +270,43 @@ fn atomic_save_replaces_and_leaves_no_temporary() {
     assert_eq!(names.len(), 1, "left behind: {names:?}");
 }
 
+/// Saving a document keeps the comments and key order of the file it came from (toml_edit
+/// merge), with the changed value in place; `save_as` carries them to the new file.
+#[test]
+fn saving_keeps_the_users_comments_and_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("site.toml");
+    let commented = format!("# Survey of 3 May, total station TS16\n{EXAMPLE}").replace(
+        "x_px = 1234.5",
+        "x_px = 1234.5   # clicked twice, centre of the target",
+    );
+    std::fs::write(&path, &commented).unwrap();
+    let mut doc = SiteDocument::load(&path).unwrap();
+    doc.site.name = "renamed".into();
+    doc.save().unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.starts_with("# Survey of 3 May, total station TS16\n"),
+        "{text}"
+    );
+    assert!(
+        text.contains("x_px = 1234.5   # clicked twice, centre of the target"),
+        "{text}"
+    );
+    assert!(text.contains("\"renamed\""), "{text}");
+    assert_eq!(SiteDocument::load(&path).unwrap().site, doc.site);
+    // Unchanged content: the file is written back exactly as the user left it.
+    doc.site.name = parse(&commented).unwrap().name;
+    doc.save().unwrap();
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), commented);
+    std::fs::create_dir(dir.path().join("copy")).unwrap();
+    let copy = dir.path().join("copy/site.toml");
+    doc.save_as(&copy).unwrap();
+    let text = std::fs::read_to_string(&copy).unwrap();
+    assert!(text.contains("# clicked twice"), "{text}");
+    assert_eq!(SiteDocument::load(&copy).unwrap().site, doc.site);
+}
+
 #[test]
 fn failed_save_cleans_up_and_reports() {
     let dir = tempfile::tempdir().unwrap();
