@@ -404,3 +404,31 @@ fn spp_out_of_range_is_refused_before_work() {
     std::fs::write(&site, text.replacen("spp_min = 4", "spp_min = 0", 1)).unwrap();
     assert_refused(&render(&site), &["render.spp_max", "spp_min = 0"]);
 }
+
+/// A site in a folder whose name is not UTF-8, saved elsewhere by `solve --out`: its relative
+/// photo paths would have to become absolute non-UTF-8 paths, which a TOML site cannot hold; the
+/// save is refused naming the path instead of rewriting it with U+FFFD, and nothing is written.
+#[test]
+fn non_utf8_source_folder_is_refused_not_rewritten() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let source = dir.path().join(std::ffi::OsStr::from_bytes(b"caf\xe9"));
+    std::fs::create_dir(&source).unwrap();
+    let courtyard = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sample_sites/courtyard");
+    std::fs::copy(courtyard.join("site.toml"), source.join("site.toml")).unwrap();
+    std::fs::create_dir(source.join("photos")).unwrap();
+    for entry in std::fs::read_dir(courtyard.join("photos")).unwrap() {
+        let entry = entry.unwrap();
+        std::fs::copy(entry.path(), source.join("photos").join(entry.file_name())).unwrap();
+    }
+    let out = dir.path().join("out.toml");
+    let outcome = run(&[
+        os("solve"),
+        source.join("site.toml").as_os_str(),
+        os("--out"),
+        out.as_os_str(),
+    ]);
+    assert_refused(&outcome, &["is not valid UTF-8", "photos"]);
+    assert!(!outcome.stderr.contains('\u{fffd}') || outcome.stderr.contains("caf"));
+    assert!(!out.exists(), "a site was written");
+}

@@ -66,6 +66,12 @@ pub enum SiteError {
     },
     #[error("cannot serialise site: {0}")]
     Serialise(String),
+    #[error(
+        "the path {} is not valid UTF-8 and a site file (TOML text) cannot hold it; rename \
+         the folder or file, or save the site beside the original so its paths stay relative",
+        path.display()
+    )]
+    NonUtf8Path { path: PathBuf },
     #[error("cannot write site file {path}: {source}")]
     Write {
         path: PathBuf,
@@ -131,18 +137,30 @@ impl SiteDocument {
         };
         let mut site = self.site.clone();
         if !same_dir {
-            let rebase = |p: &mut String| {
+            let rebase = |p: &mut String| -> Result<(), SiteError> {
                 if Path::new(p.as_str()).is_relative() {
                     let joined = self.resolve(p);
                     let abs = std::fs::canonicalize(&joined).unwrap_or(joined);
-                    *p = abs.to_string_lossy().into_owned();
+                    // A TOML site holds text: a path that is not UTF-8 cannot be written
+                    // without changing it, so it is refused rather than rewritten.
+                    *p = abs
+                        .to_str()
+                        .ok_or_else(|| SiteError::NonUtf8Path { path: abs.clone() })?
+                        .to_owned();
                 }
+                Ok(())
             };
-            site.photos.iter_mut().for_each(|ph| rebase(&mut ph.file));
-            site.models.iter_mut().for_each(|m| rebase(&mut m.file));
-            site.luminaires.iter_mut().for_each(|l| rebase(&mut l.file));
+            for ph in &mut site.photos {
+                rebase(&mut ph.file)?;
+            }
+            for m in &mut site.models {
+                rebase(&mut m.file)?;
+            }
+            for l in &mut site.luminaires {
+                rebase(&mut l.file)?;
+            }
             if let Some(lib) = site.lighting.material_library.as_mut() {
-                rebase(lib);
+                rebase(lib)?;
             }
         }
         let template = std::fs::read_to_string(&self.path).ok();

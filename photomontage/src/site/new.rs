@@ -47,6 +47,12 @@ pub enum NewSiteError {
     NoSiteFolder { path: PathBuf },
     #[error("photo {path} is chosen twice")]
     DuplicatePhoto { path: PathBuf },
+    #[error(
+        "the path of photo {} is not valid UTF-8 and a site file (TOML text) cannot hold it; \
+         rename the file or folder",
+        path.display()
+    )]
+    NonUtf8Path { path: PathBuf },
     #[error(transparent)]
     Photo(#[from] PhotoError),
     #[error(transparent)]
@@ -259,8 +265,11 @@ pub fn site_from_photos(
         site.photos.push(Photo {
             id,
             file: relative_path(&folder, &absolute)
-                .to_string_lossy()
-                .into_owned(),
+                .to_str()
+                .ok_or_else(|| NewSiteError::NonUtf8Path {
+                    path: absolute.clone(),
+                })?
+                .to_owned(),
             taken_at,
             interior: Some(Interior {
                 focal_px,
