@@ -35,6 +35,7 @@ pub mod solve;
 pub mod state;
 pub mod viewport;
 pub mod window;
+pub mod worker;
 
 use eframe::egui::{self, Color32, Key, Pos2};
 use photomontage::site::{Observation, SiteDocument, SiteSolution};
