@@ -16,6 +16,8 @@ use photomontage::site::{
     SelfCalibrationFlags, Site, TiePoint,
 };
 
+use crate::fit_commands::{self, FitCommand, FitCommandError};
+
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CommandError {
@@ -35,6 +37,14 @@ pub enum CommandError {
     NothingToRedo,
     #[error("no sample `{id}`")]
     NoSuchSample { id: String },
+}
+
+impl From<FitCommandError> for CommandError {
+    fn from(e: FitCommandError) -> Self {
+        match e {
+            FitCommandError::NoSuchSample { id } => Self::NoSuchSample { id },
+        }
+    }
 }
 
 /// One edit of a site.
@@ -80,8 +90,8 @@ pub enum Command {
     },
     /// Several commands applied in order, undone as one.
     Batch(Vec<Command>),
-    /// An edit of the lighting fit's data ([`crate::fit_commands`]).
-    Fit(crate::fit_commands::FitCommand),
+    /// An edit of the lighting fit's data ([`fit_commands`]).
+    Fit(FitCommand),
 }
 
 impl Command {
@@ -297,7 +307,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
             inverses.reverse();
             Command::Batch(inverses)
         }
-        Command::Fit(c) => crate::fit_commands::apply(site, c)?,
+        Command::Fit(c) => Command::Fit(fit_commands::apply(site, c)?),
     })
 }
 
@@ -462,6 +472,99 @@ pub fn parse_script_line(site: &Site, line: &str) -> Result<Option<Command>, Str
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn fit_sample(id: &str) -> photomontage::site::Sample {
+        use photomontage::site::{Sample, SamplePurpose};
+        Sample {
+            id: id.into(),
+            photo: "P1".into(),
+            material: "paving".into(),
+            purpose: SamplePurpose::Daylight,
+            point: None,
+            x_px: Some(10.0),
+            y_px: Some(20.0),
+            window_px: 5,
+            enabled: true,
+        }
+    }
+
+    #[test]
+    fn sample_edits_undo_to_the_exact_site() {
+        let mut s = Site {
+            samples: vec![fit_sample("S1"), fit_sample("S2"), fit_sample("S3")],
+            ..Site::default()
+        };
+        let original = s.clone();
+        let mut h = History::default();
+        h.apply(
+            &mut s,
+            Command::Fit(FitCommand::RemoveSample { id: "S2".into() }),
+        )
+        .expect("remove");
+        let mut off = fit_sample("S1");
+        off.enabled = false;
+        off.purpose = photomontage::site::SamplePurpose::Atmosphere;
+        h.apply(
+            &mut s,
+            Command::Fit(FitCommand::PutSample {
+                sample: off,
+                at: None,
+            }),
+        )
+        .expect("edit");
+        h.apply(
+            &mut s,
+            Command::Fit(FitCommand::PutHorizonSample {
+                sample: photomontage::site::HorizonSample {
+                    id: "H1".into(),
+                    photo: "P1".into(),
+                    origin_px: [1, 2],
+                    size_px: [30, 10],
+                    enabled: true,
+                },
+                at: None,
+            }),
+        )
+        .expect("horizon");
+        h.apply(
+            &mut s,
+            Command::Fit(FitCommand::SetFitSettings(
+                photomontage::site::FitSettings {
+                    interreflection: false,
+                    ambient: false,
+                },
+            )),
+        )
+        .expect("settings");
+        let mut lit = s.lighting.clone();
+        lit.sun_weight = [2.0, 3.0, 4.0];
+        h.apply(
+            &mut s,
+            Command::Fit(FitCommand::SetLighting {
+                lighting: Box::new(lit),
+                record: None,
+            }),
+        )
+        .expect("lighting");
+        let edited = s.clone();
+        assert_eq!(s.samples.len(), 2);
+        assert!(!s.samples[0].enabled);
+        for _ in 0..5 {
+            h.undo(&mut s).expect("undo");
+        }
+        assert_eq!(s, original, "order and values restored");
+        for _ in 0..5 {
+            h.redo(&mut s).expect("redo");
+        }
+        assert_eq!(s, edited);
+        assert_eq!(
+            h.apply(
+                &mut s,
+                Command::Fit(FitCommand::RemoveSample { id: "nope".into() })
+            ),
+            Err(CommandError::NoSuchSample { id: "nope".into() })
+        );
+    }
 
     fn site() -> Site {
         let mut s = Site::default();

@@ -15,7 +15,8 @@
 use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, channel};
+
+use crate::worker::{Poll, Worker};
 
 /// What a dialog is for (decides its title, filters and what happens with the answer).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -155,11 +156,12 @@ impl FilePicker for NativePicker {
     }
 }
 
-/// Runs one dialog at a time on a worker thread and hands its answer back.
+/// Runs one dialog at a time on the studio's [`Worker`] and hands its answer back.
 pub struct DialogWorker {
     picker: Arc<dyn FilePicker>,
-    /// The open dialog: its purpose and where its answer (empty: cancelled) arrives.
-    running: Option<(DialogPurpose, Receiver<Vec<PathBuf>>)>,
+    /// The open dialog's purpose; its answer (empty: cancelled) comes from `worker`.
+    purpose: Option<DialogPurpose>,
+    worker: Worker<Vec<PathBuf>>,
 }
 
 impl Default for DialogWorker {
@@ -174,57 +176,44 @@ impl DialogWorker {
     pub fn new(picker: Arc<dyn FilePicker>) -> Self {
         Self {
             picker,
-            running: None,
+            purpose: None,
+            worker: Worker::new("file-dialog"),
         }
     }
 
     /// Whether a dialog is open.
     #[must_use]
     pub fn busy(&self) -> bool {
-        self.running.is_some()
+        self.worker.busy()
     }
 
     /// Opens a dialog on a worker thread; `false` when one is already open.
     pub fn start(&mut self, request: DialogRequest, ctx: &egui::Context) -> bool {
-        if self.running.is_some() {
-            return false;
-        }
-        let (tx, rx) = channel();
         let picker = Arc::clone(&self.picker);
-        let ctx = ctx.clone();
         let purpose = request.purpose;
-        let spawned = std::thread::Builder::new()
-            .name("file-dialog".into())
-            .spawn(move || {
-                let answer = if request.purpose.is_multi() {
-                    picker.pick_many(&request).unwrap_or_default()
-                } else {
-                    picker.pick(&request).into_iter().collect()
-                };
-                // A closed channel means the studio is gone; nothing to report to.
-                let _ = tx.send(answer);
-                ctx.request_repaint();
-            });
-        if spawned.is_err() {
-            return false;
+        let started = self.worker.spawn(ctx, move |_| {
+            if request.purpose.is_multi() {
+                picker.pick_many(&request).unwrap_or_default()
+            } else {
+                picker.pick(&request).into_iter().collect()
+            }
+        });
+        if started {
+            self.purpose = Some(purpose);
         }
-        self.running = Some((purpose, rx));
-        true
+        started
     }
 
-    /// The answer of the open dialog once it is closed: (purpose, chosen paths; empty when
-    /// cancelled).
-    pub fn poll(&mut self) -> Option<(DialogPurpose, Vec<PathBuf>)> {
-        let (purpose, rx) = self.running.as_ref()?;
-        let purpose = *purpose;
-        let answer = match rx.try_recv() {
-            Ok(a) => a,
-            Err(std::sync::mpsc::TryRecvError::Empty) => return None,
-            // The worker died without answering: treat as cancelled.
-            Err(std::sync::mpsc::TryRecvError::Disconnected) => Vec::new(),
+    /// The answer of the open dialog once it is closed: (purpose, chosen paths — empty when
+    /// cancelled — or the message of a dialog that failed, e.g. panicked).
+    pub fn poll(&mut self) -> Option<(DialogPurpose, Result<Vec<PathBuf>, String>)> {
+        let answer = match self.worker.poll() {
+            Poll::Idle | Poll::Running(_) => return None,
+            Poll::Done(a) => Ok(a),
+            Poll::Cancelled => Ok(Vec::new()),
+            Poll::Failed(e) => Err(e),
         };
-        self.running = None;
-        Some((purpose, answer))
+        Some((self.purpose.take()?, answer))
     }
 }
 
@@ -291,6 +280,13 @@ impl crate::Studio {
         }
         let Some((purpose, answer)) = self.dialogs.poll() else {
             return;
+        };
+        let answer = match answer {
+            Ok(a) => a,
+            Err(e) => {
+                self.say(format!("the {} dialog failed: {e}", purpose.title()), true);
+                return;
+            }
         };
         if purpose == DialogPurpose::NewSitePhotos {
             self.new_site.add_photos(answer);
@@ -461,7 +457,10 @@ mod tests {
         };
         assert_eq!(
             answer,
-            (DialogPurpose::OpenSite, vec![PathBuf::from("/x/site.toml")])
+            (
+                DialogPurpose::OpenSite,
+                Ok(vec![PathBuf::from("/x/site.toml")])
+            )
         );
         assert!(!w.busy());
         assert!(w.poll().is_none());
@@ -490,7 +489,7 @@ mod tests {
             answer,
             (
                 DialogPurpose::NewSitePhotos,
-                vec![PathBuf::from("/x/p1.jpg")]
+                Ok(vec![PathBuf::from("/x/p1.jpg")])
             )
         );
     }

@@ -5,9 +5,9 @@
 //!   window, on/off, delete, and the `[fit_settings]` toggles; every change is a
 //!   [`crate::fit_commands::FitCommand`] through the one command path (undo/redo, autosave).
 //!   Samples are picked on the photo ([`crate::fit_pick`]).
-//! - **Run fit** calls `photomontage::fit::site::fit_site` (the CLI's call, default options) on a
-//!   snapshot of the site on a named worker thread; the solver iterations come back through a
-//!   `FitObserver` and are shown as progress, and the same observer carries **Cancel fit**. The results panel shows the report's numbers
+//! - **Run fit** runs `photomontage::fit::site::fit_site` on the studio's worker
+//!   ([`crate::fit_worker`]); the solver iterations are shown as progress and **Cancel fit**
+//!   stops it at its next step. The results panel shows the report's numbers
 //!   formatted as the CLI prints them (5 decimals): τₐ over 1 km, L∞, k_s, k_u, k_h with σ,
 //!   absolute/relative weights, the sun cross-checks, the warnings and the residual table (flagged
 //!   rows in red). Errors (`SiteFitError`) are shown as their messages.
@@ -23,17 +23,14 @@
 
 use eframe::egui::{self, Color32};
 use egui_extras::{Column, TableBuilder};
-use photomontage::fit::site::{SiteFitOptions, SiteFitReport, apply_fit, fit_site};
-use photomontage::fit::{FitIteration, FitObserver, FitStage};
-use photomontage::site::{FitSettings, SamplePurpose, Site, SiteDocument};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use photomontage::fit::site::{SiteFitReport, apply_fit};
+use photomontage::site::{FitSettings, SamplePurpose, Site};
 
 use crate::commands::Command;
 use crate::fit_commands::FitCommand;
+use crate::fit_worker::FitWorker;
 use crate::points::name_widget;
+use crate::worker::Poll;
 
 /// Colour of flagged rows and errors.
 pub const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
@@ -94,139 +91,6 @@ pub fn rfc3339_utc(secs: u64) -> String {
     )
 }
 
-/// The latest solver iteration and the cancel request, shared with the worker.
-struct Progress {
-    latest: Mutex<Option<FitIteration>>,
-    cancel: AtomicBool,
-    ctx: egui::Context,
-}
-
-impl FitObserver for Progress {
-    fn on_iteration(&self, event: &FitIteration) {
-        if let Ok(mut l) = self.latest.lock() {
-            *l = Some(*event);
-        }
-        self.ctx.request_repaint();
-    }
-
-    fn cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
-    }
-}
-
-/// A fit running on the worker thread.
-#[derive(Default)]
-pub struct FitWorker {
-    rx: Option<mpsc::Receiver<Result<SiteFitReport, String>>>,
-    progress: Option<Arc<Progress>>,
-    started: Option<Instant>,
-}
-
-impl FitWorker {
-    /// Starts `fit_site` on a snapshot of the site. False when a fit is already running.
-    pub fn start(&mut self, doc: SiteDocument, ctx: egui::Context) -> bool {
-        if self.rx.is_some() {
-            return false;
-        }
-        let (tx, rx) = mpsc::channel();
-        let progress = Arc::new(Progress {
-            latest: Mutex::new(None),
-            cancel: AtomicBool::new(false),
-            ctx: ctx.clone(),
-        });
-        let observer: Arc<dyn FitObserver> = progress.clone();
-        let spawned = std::thread::Builder::new()
-            .name("lighting fit".into())
-            .spawn(move || {
-                // The observer only stores the latest iteration (a Mutex): a panic leaves
-                // nothing half-updated that the UI could misread.
-                let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
-                    fit_site(&doc, &SiteFitOptions::default(), Some(observer))
-                        .map_err(|e| e.to_string())
-                }))
-                .unwrap_or_else(|_| Err("the fit crashed; the site is unchanged".into()));
-                let _ = tx.send(result);
-                ctx.request_repaint();
-            });
-        if spawned.is_err() {
-            return false;
-        }
-        self.rx = Some(rx);
-        self.progress = Some(progress);
-        self.started = Some(Instant::now());
-        true
-    }
-
-    /// Whether a fit is running.
-    #[must_use]
-    pub fn busy(&self) -> bool {
-        self.rx.is_some()
-    }
-
-    /// Asks the running fit to stop at its next step (the library polls
-    /// `FitObserver::cancelled` before each sample and each daylight pass); it then reports
-    /// `the fit was cancelled`.
-    pub fn cancel(&self) {
-        if let Some(p) = &self.progress {
-            p.cancel.store(true, Ordering::Relaxed);
-        }
-    }
-
-    /// Whether a cancel was requested for the running fit.
-    #[must_use]
-    pub fn cancelling(&self) -> bool {
-        self.progress
-            .as_ref()
-            .is_some_and(|p| p.cancel.load(Ordering::Relaxed))
-    }
-
-    /// The outcome once the worker has finished.
-    pub fn poll(&mut self) -> Option<Result<SiteFitReport, String>> {
-        let rx = self.rx.as_ref()?;
-        let out = match rx.try_recv() {
-            Ok(r) => r,
-            Err(mpsc::TryRecvError::Empty) => return None,
-            Err(mpsc::TryRecvError::Disconnected) => {
-                Err("the fit worker stopped without an answer".into())
-            }
-        };
-        self.rx = None;
-        self.progress = None;
-        self.started = None;
-        Some(out)
-    }
-
-    /// A line describing the progress: elapsed time and the latest solver iteration.
-    #[must_use]
-    pub fn progress_text(&self) -> Option<String> {
-        let started = self.started?;
-        let secs = started.elapsed().as_secs_f64();
-        let latest = self
-            .progress
-            .as_ref()
-            .and_then(|p| p.latest.lock().ok().and_then(|l| *l));
-        if self.cancelling() {
-            return Some(format!(
-                "cancelling… {secs:.1} s (stops at the fit's next step)"
-            ));
-        }
-        Some(match latest {
-            None => format!("fitting… {secs:.1} s (locating and reading samples)"),
-            Some(e) => {
-                let stage = match e.stage {
-                    FitStage::Atmosphere => "atmosphere (eq. 7)",
-                    FitStage::Daylight => "daylight (eq. 9)",
-                };
-                let channel = ["red", "green", "blue"].get(e.channel).unwrap_or(&"?");
-                format!(
-                    "fitting… {secs:.1} s: {stage} {channel} iteration {} |r| = {:.3e}",
-                    e.iteration, e.cost
-                )
-            }
-        })
-    }
-}
-
 /// State of the Fit tab.
 pub struct FitPanel {
     /// Purpose of samples picked on the photo.
@@ -280,7 +144,7 @@ impl crate::Studio {
         let Some(doc) = self.doc.clone() else {
             return;
         };
-        if self.fit.worker.start(doc, ctx.clone()) {
+        if self.fit.worker.start(doc, ctx) {
             self.fit.error = None;
             self.say("fitting the lighting…", false);
         } else {
@@ -310,7 +174,7 @@ impl crate::Studio {
 
     pub(crate) fn poll_fit(&mut self, ctx: &egui::Context) {
         match self.fit.worker.poll() {
-            Some(Ok(report)) => {
+            Poll::Done(Ok(report)) => {
                 let flagged = report.residuals.iter().filter(|r| r.flagged).count();
                 self.say(
                     format!(
@@ -323,11 +187,15 @@ impl crate::Studio {
                 self.fit.report = Some(report);
                 self.fit.error = None;
             }
-            Some(Err(e)) => {
+            Poll::Done(Err(e)) | Poll::Failed(e) => {
                 self.say(format!("fit failed: {e}"), true);
                 self.fit.error = Some(e);
             }
-            None => {}
+            Poll::Cancelled => {
+                self.say("fit cancelled; the site is unchanged", false);
+                self.fit.error = Some("the fit was cancelled".into());
+            }
+            Poll::Idle | Poll::Running(_) => {}
         }
         if self.fit.worker.busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));

@@ -22,11 +22,14 @@ pub mod files;
 pub mod fit_commands;
 pub mod fit_panel;
 pub mod fit_pick;
+pub mod fit_worker;
 pub mod models_panel;
 pub mod new_site;
 pub mod photo_settings;
 mod photo_view;
 pub mod points;
+pub mod render_display;
+pub mod render_job;
 pub mod render_panel;
 pub mod render_sheet;
 pub mod scene_panel;
@@ -68,6 +71,15 @@ enum PhotoView {
     Loading,
     Ready(Box<DecodedPhoto>),
     Failed(String),
+}
+
+/// A job of the studio that runs on a [`worker::Worker`] (for [`Studio::inject_panic_for_tests`]).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WorkerJob {
+    Solve,
+    Fit,
+    Render,
 }
 
 /// A line for the message area.
@@ -147,7 +159,7 @@ impl Studio {
             last_transform: None,
             selected_point: None,
             dragging: None,
-            solver: solve::SolveWorker::default(),
+            solver: solve::solve_worker(),
             solution: None,
             messages: Vec::new(),
             tab: SideTab::Points,
@@ -373,7 +385,7 @@ impl Studio {
         let Some(doc) = self.doc.clone() else {
             return;
         };
-        if self.solver.start(doc, ctx.clone()) {
+        if solve::start_solve(&mut self.solver, doc, ctx) {
             self.say("solving…", false);
         } else {
             self.say("a solve is already running", true);
@@ -388,9 +400,9 @@ impl Studio {
         }
     }
 
-    fn finish_solve(&mut self, result: Result<SiteSolution, String>) {
-        match result {
-            Ok(solution) => {
+    fn poll_solve(&mut self) {
+        match self.solver.poll() {
+            worker::Poll::Done(solution) => {
                 for f in &solution.failures {
                     self.say(format!("photo {} not solved: {}", f.id, f.error), true);
                 }
@@ -425,7 +437,9 @@ impl Studio {
                 self.solution = Some(solution);
                 self.tab = SideTab::Solve;
             }
-            Err(e) => self.say(e, true),
+            worker::Poll::Failed(e) => self.say(format!("{e}; the site is unchanged"), true),
+            worker::Poll::Cancelled => self.say("solve cancelled; the site is unchanged", true),
+            worker::Poll::Idle | worker::Poll::Running(_) => {}
         }
     }
 
@@ -440,9 +454,7 @@ impl Studio {
             };
             self.photos.insert(d.photo_id, view);
         }
-        if let Some(r) = self.solver.poll() {
-            self.finish_solve(r);
-        }
+        self.poll_solve();
         self.poll_render(ctx);
         self.poll_dialogs(ctx);
         self.poll_fit(ctx);
@@ -453,7 +465,7 @@ impl Studio {
         {
             let path = doc.resolve(&p.file);
             self.photos.insert(id.clone(), PhotoView::Loading);
-            self.loader.request(id, path, ctx.clone());
+            self.loader.request(id, path, ctx);
         }
         if self.loader.busy() || self.solver.busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(50));
@@ -809,6 +821,19 @@ impl Studio {
                 solve::photo_solution_ui(ui, p);
             }
         });
+    }
+
+    /// Test hook: the next job of `job` panics on its worker thread
+    /// ([`worker::Worker::inject_panic_for_tests`]); the kittests use it to check that a crashed
+    /// solve, fit or render ends as a message and leaves the studio usable. Not reachable from
+    /// the UI, the command line or any file.
+    #[doc(hidden)]
+    pub fn inject_panic_for_tests(&mut self, job: WorkerJob) {
+        match job {
+            WorkerJob::Solve => self.solver.inject_panic_for_tests(),
+            WorkerJob::Fit => self.fit.worker.inject_panic_for_tests(),
+            WorkerJob::Render => self.render.inject_panic_for_tests(),
+        }
     }
 
     /// Writes the UI state (call on exit).

@@ -1,4 +1,5 @@
-//! `photomontage-studio [SITE] [--screenshot FILE --frames N] [--script FILE] [--headless] [--solve]`
+//! `photomontage-studio [SITE] [--screenshot FILE [--frames N]] [--script FILE] [--headless] [--solve]`
+//! (arguments parsed by clap; `--help` lists them)
 //!
 //! Opens SITE (default: the bundled courtyard sample) in the studio window.
 //! `--screenshot FILE --frames N`: run at least N frames (and until the photo is shown), save
@@ -9,66 +10,37 @@
 //! until killed — the crash-safety test uses it. `--solve`: start a solve on the first frame.
 
 use anyhow::{Context as _, bail};
+use clap::Parser as _;
 use eframe::egui;
 use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state, window};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
+/// The photomontage studio: opens SITE in the studio window.
+#[derive(Debug, clap::Parser)]
+#[command(name = "photomontage-studio", version, about)]
 struct Args {
-    site: PathBuf,
+    /// Site file to open (default: the bundled courtyard sample).
+    site: Option<PathBuf>,
+    /// Run at least --frames frames (and until the photo is shown), save egui's screenshot of
+    /// the window as PNG to FILE, exit.
+    #[arg(long, value_name = "FILE")]
     screenshot: Option<PathBuf>,
+    /// Frames to run before the screenshot.
+    #[arg(long, value_name = "N", default_value_t = 10, requires = "screenshot")]
     frames: u32,
+    /// Apply the edit commands in FILE through the studio's command path at start (one per
+    /// line: `place PHOTO POINT X Y`, `remove PHOTO POINT`, `control ID X Y Z`,
+    /// `enable|disable PHOTO POINT`).
+    #[arg(long, value_name = "FILE")]
     script: Option<PathBuf>,
+    /// Run the studio's frames without a window (no display needed; autosave and workers run
+    /// as usual) until killed.
+    #[arg(long, conflicts_with = "screenshot")]
     headless: bool,
+    /// Start a solve on the first frame.
+    #[arg(long)]
     solve: bool,
-}
-
-const USAGE: &str = "usage: photomontage-studio [SITE] [--screenshot FILE --frames N] [--script FILE] [--headless] [--solve]";
-
-fn parse_args() -> anyhow::Result<Args> {
-    let mut args = Args {
-        site: default_site_path(),
-        screenshot: None,
-        frames: 10,
-        script: None,
-        headless: false,
-        solve: false,
-    };
-    let mut it = std::env::args_os().skip(1);
-    let mut site = None;
-    while let Some(a) = it.next() {
-        match a.to_str() {
-            Some("--screenshot") => {
-                args.screenshot = Some(it.next().context("--screenshot needs a file")?.into());
-            }
-            Some("--frames") => {
-                let n = it.next().context("--frames needs a number")?;
-                args.frames = n
-                    .to_str()
-                    .and_then(|s| s.parse().ok())
-                    .context("--frames needs a whole number")?;
-            }
-            Some("--script") => {
-                args.script = Some(it.next().context("--script needs a file")?.into());
-            }
-            Some("--headless") => args.headless = true,
-            Some("--solve") => args.solve = true,
-            Some("-h" | "--help") => {
-                println!("{USAGE}");
-                std::process::exit(0);
-            }
-            Some(s) if s.starts_with("--") => bail!("unknown option {s}\n{USAGE}"),
-            _ => {
-                if site.replace(PathBuf::from(a)).is_some() {
-                    bail!("only one SITE may be given\n{USAGE}");
-                }
-            }
-        }
-    }
-    if let Some(s) = site {
-        args.site = s;
-    }
-    Ok(args)
 }
 
 fn apply_script(studio: &mut Studio, script: &PathBuf) -> anyhow::Result<()> {
@@ -166,9 +138,10 @@ fn run_headless(mut studio: Studio) -> anyhow::Result<()> {
 }
 
 fn main() -> anyhow::Result<()> {
-    let args = parse_args()?;
+    let args = Args::parse();
+    let site = args.site.clone().unwrap_or_else(default_site_path);
     let options = StudioOptions {
-        site_path: args.site.clone(),
+        site_path: site,
         state_path: if args.headless || args.screenshot.is_some() {
             None
         } else {

@@ -1,6 +1,6 @@
 //! Solving in the studio: [`photomontage::site::solve_site`] (resection of every photo, then the
-//! bundle adjustment; Durisch 1992 §4.1) on a named worker thread, its result sent back over a
-//! channel; the residual table, the residual vectors drawn on the photo with a scale bar, and the
+//! bundle adjustment; Durisch 1992 §4.1) on the studio's [`crate::worker::Worker`] (a panic in the
+//! solver becomes a message); the residual table, the residual vectors drawn on the photo with a scale bar, and the
 //! warnings and failures as readable messages.
 //!
 //! The table shows the numbers exactly as `photomontage solve` prints them (same rounding), so
@@ -13,61 +13,22 @@
 use eframe::egui::{self, Color32, Pos2, Stroke};
 use egui_extras::{Column, TableBuilder};
 use photomontage::site::{SiteDocument, SiteSolution, solve::PhotoSolution};
-use std::sync::mpsc;
 
 use crate::viewport::ViewTransform;
+use crate::worker::Worker;
 
-/// A solve running on the worker, or its outcome.
-#[derive(Default)]
-pub struct SolveWorker {
-    rx: Option<mpsc::Receiver<Result<SiteSolution, String>>>,
+/// The solve's worker: [`photomontage::site::solve_site`] on a snapshot of the site.
+pub type SolveWorker = Worker<SiteSolution>;
+
+/// A worker for solves, named `solve`.
+#[must_use]
+pub fn solve_worker() -> SolveWorker {
+    Worker::new("solve")
 }
 
-impl SolveWorker {
-    /// Starts solving a snapshot of the site. Returns false when a solve is already running.
-    pub fn start(&mut self, doc: SiteDocument, ctx: egui::Context) -> bool {
-        if self.rx.is_some() {
-            return false;
-        }
-        let (tx, rx) = mpsc::channel();
-        let spawned = std::thread::Builder::new()
-            .name("solve".into())
-            .spawn(move || {
-                let result = std::panic::catch_unwind(|| photomontage::site::solve_site(&doc))
-                    .map_err(|_| "the solver crashed; the site is unchanged".to_string());
-                let _ = tx.send(result);
-                ctx.request_repaint();
-            });
-        match spawned {
-            Ok(_) => {
-                self.rx = Some(rx);
-                true
-            }
-            Err(_) => false,
-        }
-    }
-
-    /// Whether a solve is running.
-    #[must_use]
-    pub fn busy(&self) -> bool {
-        self.rx.is_some()
-    }
-
-    /// The outcome, once the worker has finished.
-    pub fn poll(&mut self) -> Option<Result<SiteSolution, String>> {
-        let rx = self.rx.as_ref()?;
-        match rx.try_recv() {
-            Ok(r) => {
-                self.rx = None;
-                Some(r)
-            }
-            Err(mpsc::TryRecvError::Empty) => None,
-            Err(mpsc::TryRecvError::Disconnected) => {
-                self.rx = None;
-                Some(Err("the solve worker stopped without an answer".into()))
-            }
-        }
-    }
+/// Starts solving a snapshot of the site. Returns false when a solve is already running.
+pub fn start_solve(worker: &mut SolveWorker, doc: SiteDocument, ctx: &egui::Context) -> bool {
+    worker.spawn(ctx, move |_| photomontage::site::solve_site(&doc))
 }
 
 /// `|v|` and `|v|/σ` of a residual row, as the CLI computes them.

@@ -61,10 +61,20 @@ struct Shared {
     ctx: egui::Context,
 }
 
-/// The job's handle: report progress, stream values to the UI, check for cancellation.
+/// The job's handle: report progress, stream values to the UI, check for cancellation. Cloned
+/// into library observers that want an owned handle (the fit's `FitObserver`).
 pub struct Progress<U = ()> {
     shared: Arc<Shared>,
     tx: Sender<U>,
+}
+
+impl<U> Clone for Progress<U> {
+    fn clone(&self) -> Self {
+        Self {
+            shared: Arc::clone(&self.shared),
+            tx: self.tx.clone(),
+        }
+    }
 }
 
 impl<U> Progress<U> {
@@ -113,7 +123,12 @@ struct Running<T, U> {
 pub struct Worker<T, U = ()> {
     name: String,
     running: Option<Running<T, U>>,
+    /// Test hook: the next job panics instead of running ([`Worker::inject_panic_for_tests`]).
+    panic_next: bool,
 }
+
+/// The panic message of the test hook ([`Worker::inject_panic_for_tests`]).
+pub const INJECTED_PANIC: &str = "injected fault (test hook)";
 
 impl<T, U> Worker<T, U> {
     /// An idle worker whose thread and messages are called `name` ("render", "solve", …).
@@ -122,6 +137,7 @@ impl<T, U> Worker<T, U> {
         Self {
             name: name.into(),
             running: None,
+            panic_next: false,
         }
     }
 }
@@ -167,13 +183,17 @@ impl<T: Send + 'static, U: Send + 'static> Worker<T, U> {
             tx: update_tx,
         };
         let name = self.name.clone();
+        let panic = self.panic_next;
         let spawned = std::thread::Builder::new()
             .name(self.name.clone())
             .spawn(move || {
                 // The job owns everything it touches; a panic leaves nothing shared with the UI
                 // half-updated except the progress fields, which are plain values.
-                let result = std::panic::catch_unwind(AssertUnwindSafe(|| job(&progress)))
-                    .map_err(|payload| format!("{name} panicked: {}", panic_text(&*payload)));
+                let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                    assert!(!panic, "{INJECTED_PANIC}");
+                    job(&progress)
+                }))
+                .map_err(|payload| format!("{name} panicked: {}", panic_text(&*payload)));
                 let ctx = progress.shared.ctx.clone();
                 drop(progress);
                 // A closed channel means the worker was dropped; nothing to report to.
@@ -183,6 +203,7 @@ impl<T: Send + 'static, U: Send + 'static> Worker<T, U> {
         if spawned.is_err() {
             return false;
         }
+        self.panic_next = false;
         self.running = Some(Running {
             shared,
             updates,
@@ -190,6 +211,15 @@ impl<T: Send + 'static, U: Send + 'static> Worker<T, U> {
             started: Instant::now(),
         });
         true
+    }
+
+    /// Test hook: the next job started on this worker panics on its thread with
+    /// [`INJECTED_PANIC`] instead of running (the kittests that check a crashed job leaves a
+    /// usable studio use it, through `Studio::inject_panic_for_tests`). Nothing in the studio's
+    /// UI, command line, settings or files calls it, so it cannot be triggered by accident.
+    #[doc(hidden)]
+    pub fn inject_panic_for_tests(&mut self) {
+        self.panic_next = true;
     }
 
     /// Whether a job is running (its outcome not yet returned by [`Worker::poll`]).
@@ -369,6 +399,17 @@ mod tests {
         );
         assert!(!w.busy());
         // The worker is usable again.
+        w.spawn(&egui::Context::default(), |_| ());
+        assert_eq!(wait(&mut w, drop), Poll::Done(()));
+        // The test hook: the next job panics instead of running, the one after runs.
+        w.inject_panic_for_tests();
+        w.spawn(&egui::Context::default(), |_| {
+            unreachable!("the hook panics first")
+        });
+        assert_eq!(
+            wait(&mut w, drop),
+            Poll::Failed(format!("render panicked: {INJECTED_PANIC}"))
+        );
         w.spawn(&egui::Context::default(), |_| ());
         assert_eq!(wait(&mut w, drop), Poll::Done(()));
         // A formatted (String) payload too.
