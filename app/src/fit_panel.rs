@@ -29,13 +29,14 @@ use photomontage::site::{FitSettings, SamplePurpose, Site};
 use crate::commands::Command;
 use crate::fit_commands::FitCommand;
 use crate::fit_worker::FitWorker;
-use crate::points::name_widget;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 use crate::worker::Poll;
 
 /// Colour of flagged rows and errors.
 pub const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
 /// Colour of warnings.
-pub const WARNING: Color32 = Color32::from_rgb(230, 160, 40);
+pub const WARNING: Color32 = crate::widgets::WARNING;
 
 /// An RGB triple as `photomontage fit` prints it.
 #[must_use]
@@ -201,28 +202,30 @@ impl crate::Studio {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
     }
+}
 
-    pub(crate) fn fit_tab_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(doc) = self.doc.as_ref() else {
-            return;
+impl Panel for FitPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let Some(doc) = ctx.doc else {
+            return Vec::new();
         };
-        let site = doc.site.clone();
+        let site = &doc.site;
         let mut commands: Vec<(Command, Option<String>)> = Vec::new();
         let (mut run, mut cancel, mut apply) = (false, false, false);
         ui.horizontal(|ui| {
-            let busy = self.fit.worker.busy();
+            let busy = self.worker.busy();
             run = ui
                 .add_enabled(!busy, egui::Button::new("Run fit"))
                 .clicked();
             cancel = ui
                 .add_enabled(
-                    busy && !self.fit.worker.cancelling(),
+                    busy && !self.worker.cancelling(),
                     egui::Button::new("Cancel fit"),
                 )
                 .clicked();
             apply = ui
                 .add_enabled(
-                    !busy && self.fit.report.is_some(),
+                    !busy && self.report.is_some(),
                     egui::Button::new("Apply fit"),
                 )
                 .on_hover_text("write the fitted lighting into the site (undoable)")
@@ -231,23 +234,23 @@ impl crate::Studio {
                 ui.spinner();
             }
         });
-        if let Some(p) = self.fit.worker.progress_text() {
+        if let Some(p) = self.worker.progress_text() {
             ui.label(p);
         }
         settings_ui(ui, site.fit_settings, &mut commands);
         ui.horizontal(|ui| {
             ui.label("new samples:");
             for p in [SamplePurpose::Daylight, SamplePurpose::Atmosphere] {
-                let r = ui.radio_value(&mut self.fit.purpose, p, purpose_name(p));
+                let r = ui.radio_value(&mut self.purpose, p, purpose_name(p));
                 name_widget(ui, &r, &format!("pick purpose {}", purpose_name(p)));
             }
             let r = ui.add(
-                egui::DragValue::new(&mut self.fit.window_px)
+                egui::DragValue::new(&mut self.window_px)
                     .range(1..=101)
                     .suffix(" px"),
             );
             name_widget(ui, &r, "pick window");
-            self.fit.window_px |= 1;
+            self.window_px |= 1;
         });
         ui.label(
             "click the photo to add a sample on the polygon under the cursor; Shift-drag draws a \
@@ -257,30 +260,36 @@ impl crate::Studio {
             .auto_shrink([false, false])
             .show(ui, |ui| {
                 ui.strong(format!("Samples ({})", site.samples.len()));
-                samples_table_ui(ui, &site, &mut commands);
+                samples_table_ui(ui, site, &mut commands);
                 ui.strong(format!("Horizon samples ({})", site.horizon_samples.len()));
-                horizons_table_ui(ui, &site, &mut commands);
+                horizons_table_ui(ui, site, &mut commands);
                 ui.separator();
-                if let Some(e) = &self.fit.error {
+                if let Some(e) = &self.error {
                     ui.colored_label(FLAGGED, format!("fit failed: {e}"));
                 }
-                if let Some(r) = &self.fit.report {
+                if let Some(r) = &self.report {
                     report_ui(ui, r, site.solve.outlier_threshold_sigma);
-                } else if self.fit.error.is_none() {
+                } else if self.error.is_none() {
                     ui.label("not fitted yet: press Run fit");
                 }
             });
-        self.pending.extend(commands);
-        if run {
-            let ctx = ui.ctx().clone();
-            self.start_fit(&ctx);
+        let mut actions: Vec<Action> = commands
+            .into_iter()
+            .map(|(command, merge_key)| Action::Edit {
+                command: Box::new(command),
+                merge_key,
+            })
+            .collect();
+        for (asked, action) in [
+            (run, Action::StartFit),
+            (cancel, Action::CancelFit),
+            (apply, Action::ApplyFit),
+        ] {
+            if asked {
+                actions.push(action);
+            }
         }
-        if cancel {
-            self.fit.worker.cancel();
-        }
-        if apply {
-            self.apply_fit_report();
-        }
+        actions
     }
 }
 

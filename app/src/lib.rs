@@ -25,6 +25,7 @@ pub mod fit_pick;
 pub mod fit_worker;
 pub mod models_panel;
 pub mod new_site;
+pub mod panel;
 pub mod photo_settings;
 mod photo_view;
 pub mod points;
@@ -37,6 +38,7 @@ pub mod scene_pick;
 pub mod solve;
 pub mod state;
 pub mod viewport;
+pub mod widgets;
 pub mod window;
 pub mod worker;
 
@@ -47,6 +49,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use commands::{Command, History};
+use panel::{Action, Panel, PanelContext};
 use viewport::{DecodedPhoto, PhotoLoader, ViewTransform, Viewport};
 
 /// How the studio starts.
@@ -123,6 +126,8 @@ pub struct Studio {
     open_path: String,
     new_point_id: String,
     pending: Vec<(Command, Option<String>)>,
+    /// What the panels asked for this frame ([`panel::Panel`]), done after the layout.
+    actions: Vec<Action>,
     render: render_panel::RenderPanel,
     models: models_panel::ModelsPanel,
     scene: scene_panel::ScenePanel,
@@ -167,6 +172,7 @@ impl Studio {
             open_path: String::new(),
             new_point_id: String::new(),
             pending: Vec::new(),
+            actions: Vec::new(),
             render: render_panel::RenderPanel::default(),
             models: models_panel::ModelsPanel::default(),
             scene: scene_panel::ScenePanel::default(),
@@ -563,6 +569,9 @@ impl Studio {
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
         }
+        for action in std::mem::take(&mut self.actions) {
+            self.run_action(action, &ctx);
+        }
         if std::mem::take(&mut self.close_polygon) {
             self.create_polygon();
         }
@@ -617,7 +626,7 @@ impl Studio {
                     .hint_text("site file path")
                     .desired_width(220.0),
             );
-            points::name_widget(ui, &r, "site path");
+            widgets::name_widget(ui, &r, "site path");
             if ui.button("Open").clicked() && !self.open_path.trim().is_empty() {
                 let p = PathBuf::from(self.open_path.trim());
                 self.open(&p);
@@ -632,7 +641,7 @@ impl Studio {
             .show(ui, |ui| {
                 for m in &self.messages {
                     if m.is_error {
-                        ui.colored_label(Color32::from_rgb(255, 90, 90), &m.text);
+                        ui.colored_label(crate::widgets::ERROR, &m.text);
                     } else {
                         ui.label(&m.text);
                     }
@@ -660,7 +669,7 @@ impl Studio {
             let text = format!("{}\n{n} obs · {solved}", p.id);
             let sel = self.current_photo.as_deref() == Some(p.id.as_str());
             let r = ui.selectable_label(sel, text);
-            points::name_widget(ui, &r, &format!("photo {}", p.id));
+            widgets::name_widget(ui, &r, &format!("photo {}", p.id));
             if r.clicked() {
                 chosen = Some(p.id.clone());
             }
@@ -683,16 +692,42 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
             ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
             let r = ui.selectable_value(&mut self.tab, SideTab::Fit, "Fit");
-            points::name_widget(ui, &r, "Fit tab");
+            widgets::name_widget(ui, &r, "Fit tab");
         });
         ui.separator();
         match self.tab {
             SideTab::Points => self.points_tab_ui(ui),
             SideTab::Solve => self.solve_tab_ui(ui),
-            SideTab::Render => self.render_tab_ui(ui),
             SideTab::Models => self.models_tab_ui(ui),
             SideTab::Scene => self.scene_tab_ui(ui),
-            SideTab::Fit => self.fit_tab_ui(ui),
+            SideTab::Render | SideTab::Fit => {
+                let ctx = PanelContext {
+                    doc: self.doc.as_ref(),
+                    current_photo: self.current_photo.as_deref(),
+                };
+                let panel: &mut dyn Panel = if self.tab == SideTab::Render {
+                    &mut self.render
+                } else {
+                    &mut self.fit
+                };
+                let actions = panel.ui(ui, &ctx);
+                self.actions.extend(actions);
+            }
+        }
+    }
+
+    /// Does what a panel asked for (after the frame's layout).
+    fn run_action(&mut self, action: Action, ctx: &egui::Context) {
+        match action {
+            Action::Edit { command, merge_key } => self.apply(*command, merge_key),
+            Action::StartRender => self.start_render(ctx),
+            Action::CancelRender => self.render.cancel(),
+            Action::ExportRender => self.export_render(),
+            Action::ExportSheet => self.export_sheet(),
+            Action::MakeReport => self.make_report(),
+            Action::StartFit => self.start_fit(ctx),
+            Action::CancelFit => self.fit.worker.cancel(),
+            Action::ApplyFit => self.apply_fit_report(),
         }
     }
 
@@ -703,7 +738,7 @@ impl Studio {
                     .hint_text(points::IMPORT_HINT)
                     .desired_width(330.0),
             );
-            points::name_widget(ui, &r, "import path");
+            widgets::name_widget(ui, &r, "import path");
             if ui.button("Import").clicked() {
                 self.import();
             }
@@ -714,7 +749,7 @@ impl Studio {
                     .hint_text("tie point id (no survey)")
                     .desired_width(160.0),
             );
-            points::name_widget(ui, &r, "point id");
+            widgets::name_widget(ui, &r, "point id");
             let id = self.new_point_id.trim();
             if ui.button("Pick id").clicked() && !id.is_empty() {
                 self.selected_point = Some(id.to_owned());
@@ -733,7 +768,7 @@ impl Studio {
                 for t in ties {
                     let sel = self.selected_point.as_deref() == Some(t);
                     let r = ui.selectable_label(sel, t);
-                    points::name_widget(ui, &r, &format!("tie {t}"));
+                    widgets::name_widget(ui, &r, &format!("tie {t}"));
                     if r.clicked() {
                         self.selected_point = Some(t.to_owned());
                     }
@@ -787,13 +822,13 @@ impl Studio {
     fn solve_tab_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             let r = ui.checkbox(&mut self.ui_state.show_residuals, "residual vectors");
-            points::name_widget(ui, &r, "residual vectors");
+            widgets::name_widget(ui, &r, "residual vectors");
             let r = ui.add(
                 egui::Slider::new(&mut self.ui_state.residual_exaggeration, 1.0..=5000.0)
                     .logarithmic(true)
                     .text("×"),
             );
-            points::name_widget(ui, &r, "residual exaggeration");
+            widgets::name_widget(ui, &r, "residual exaggeration");
         });
         let Some(solution) = self.solution.as_ref() else {
             ui.label("not solved yet: press Solve");
@@ -803,13 +838,10 @@ impl Studio {
             ui.strong(format!("bundle adjustment RMS {r:.3} px"));
         }
         for f in &solution.failures {
-            ui.colored_label(
-                Color32::from_rgb(255, 90, 90),
-                format!("{}: {}", f.id, f.error),
-            );
+            ui.colored_label(crate::widgets::ERROR, format!("{}: {}", f.id, f.error));
         }
         for w in &solution.warnings {
-            ui.colored_label(Color32::from_rgb(230, 160, 40), format!("warning: {w}"));
+            ui.colored_label(crate::widgets::WARNING, format!("warning: {w}"));
         }
         egui::ScrollArea::vertical().show(ui, |ui| {
             // The current photo first, then the others.

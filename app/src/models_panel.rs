@@ -80,7 +80,7 @@ fn choice_ui(
                 ui.selectable_value(value, (*o).to_owned(), label(o));
             }
         });
-    crate::points::name_widget(ui, &r.response, name);
+    crate::widgets::name_widget(ui, &r.response, name);
     *value != before
 }
 
@@ -251,7 +251,7 @@ impl crate::Studio {
 
     pub(crate) fn models_tab_ui(&mut self, ui: &mut egui::Ui) {
         let r = ui.checkbox(&mut self.models.show_wireframe, "wireframe overlay");
-        crate::points::name_widget(ui, &r, "wireframe overlay");
+        crate::widgets::name_widget(ui, &r, "wireframe overlay");
         let mut add = false;
         ui.horizontal(|ui| {
             let r = ui.add(
@@ -259,7 +259,7 @@ impl crate::Studio {
                     .hint_text("model file (.obj, .gltf, .glb, .dxf)")
                     .desired_width(260.0),
             );
-            crate::points::name_widget(ui, &r, "model path");
+            crate::widgets::name_widget(ui, &r, "model path");
             add = ui.button("Add model").clicked();
         });
         ui.horizontal(|ui| {
@@ -299,7 +299,7 @@ impl crate::Studio {
         }
         let photo = self.current_photo.clone().unwrap_or_default();
         let mut commands = Vec::new();
-        let warn = Color32::from_rgb(230, 160, 40);
+        let warn = crate::widgets::WARNING;
         for m in &doc.site.models {
             ui.separator();
             ui.strong(format!("{} ({})", m.id, m.file));
@@ -352,14 +352,14 @@ impl crate::Studio {
                 for (k, axis) in ["E", "N", "H"].iter().enumerate() {
                     ui.label(*axis);
                     let r = ui.add(egui::DragValue::new(&mut p.translation[k]).speed(0.05));
-                    crate::points::name_widget(ui, &r, &format!("{} {axis}", m.id));
+                    crate::widgets::name_widget(ui, &r, &format!("{} {axis}", m.id));
                     changed |= r.changed();
                 }
             });
             ui.horizontal(|ui| {
                 ui.label("rotation Z °");
                 let r = ui.add(egui::DragValue::new(&mut p.rotation_z_deg).speed(0.1));
-                crate::points::name_widget(ui, &r, &format!("{} rotation", m.id));
+                crate::widgets::name_widget(ui, &r, &format!("{} rotation", m.id));
                 changed |= r.changed();
                 ui.label("scale");
                 let r = ui.add(
@@ -367,7 +367,7 @@ impl crate::Studio {
                         .speed(0.001)
                         .range(1e-6..=1e6),
                 );
-                crate::points::name_widget(ui, &r, &format!("{} scale", m.id));
+                crate::widgets::name_widget(ui, &r, &format!("{} scale", m.id));
                 changed |= r.changed();
             });
             if changed {

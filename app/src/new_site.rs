@@ -15,7 +15,7 @@ use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 
 use crate::files::DialogPurpose;
-use crate::points::name_widget;
+use crate::widgets::name_widget;
 
 /// State of the New site window.
 #[derive(Debug, Default)]
@@ -159,7 +159,7 @@ impl crate::Studio {
                     }
                 });
                 if let Some(e) = &d.error {
-                    ui.colored_label(Color32::from_rgb(255, 90, 90), e);
+                    ui.colored_label(crate::widgets::ERROR, e);
                 }
                 let ready = !d.photos.is_empty() && !d.site_path.trim().is_empty();
                 if ui

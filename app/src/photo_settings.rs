@@ -17,7 +17,7 @@ use eframe::egui;
 use photomontage::site::{Interior, Photo, SelfCalibrationFlags};
 
 use crate::commands::Command;
-use crate::points::name_widget;
+use crate::widgets::name_widget;
 
 /// Which photo's camera settings are shown.
 #[derive(Debug, Default)]

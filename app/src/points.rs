@@ -20,6 +20,7 @@ use photomontage::site::{ControlPoint, Observation, Site};
 use std::path::Path;
 
 use crate::commands::Command;
+use crate::widgets::name_widget;
 
 /// σ given to imported control points that carry none (1 cm per axis, the site default).
 pub const DEFAULT_SIGMA_M: [f64; 3] = [0.01; 3];
@@ -129,13 +130,6 @@ pub fn import_file(
             }),
     );
     Ok(Command::Batch(batch))
-}
-
-/// Gives a widget an accessible name (for screen readers and the kittest tests).
-pub fn name_widget(ui: &egui::Ui, response: &egui::Response, name: &str) {
-    ui.ctx().accesskit_node_builder(response.id, |node| {
-        node.set_label(name.to_owned());
-    });
 }
 
 /// The table. `selected` is the selected point id; edits come back as commands.

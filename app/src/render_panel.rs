@@ -30,6 +30,7 @@ use photomontage::site::SiteDocument;
 use photomontage::verified::AvrLevel;
 use std::path::Path;
 
+use crate::panel::{Action, Panel, PanelContext};
 pub use crate::render_display::{
     MAX_DISPLAY_SIDE_PX, Preview, display_image, display_photo, display_rgb, display_step,
 };
@@ -38,6 +39,7 @@ pub use crate::render_job::{
     trace_photo,
 };
 use crate::viewport::ViewTransform;
+use crate::widgets::name_widget;
 use crate::worker::{Poll, Progress, Worker};
 
 /// What the render job streams to the panel before its outcome.
@@ -388,42 +390,40 @@ impl crate::Studio {
             ctx.request_repaint_after(std::time::Duration::from_millis(50));
         }
     }
+}
 
-    pub(crate) fn render_tab_ui(&mut self, ui: &mut egui::Ui) {
-        let id = self.current_photo.clone().unwrap_or_default();
-        let solved = self.doc.as_ref().is_some_and(|d| {
-            d.site
-                .photos
-                .iter()
-                .any(|p| p.id == id && p.exterior.is_some())
-        });
+impl Panel for RenderPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut actions = Vec::new();
+        let id = ctx.current_photo.unwrap_or_default();
+        let solved = ctx.current_photo_solved();
         ui.label(format!("view: photo {id}"));
         if !solved {
             ui.colored_label(
-                Color32::from_rgb(230, 160, 40),
+                crate::widgets::WARNING,
                 "this photo is not solved yet: press Solve first",
             );
         }
-        let q = &mut self.render.quality;
+        let q = &mut self.quality;
         ui.horizontal(|ui| {
             let r = ui.add(
                 egui::DragValue::new(&mut q.spp_min)
                     .range(4..=1024)
                     .speed(0.2),
             );
-            crate::points::name_widget(ui, &r, "spp min");
+            name_widget(ui, &r, "spp min");
             ui.label("–");
             let r = ui.add(
                 egui::DragValue::new(&mut q.spp_max)
                     .range(4..=1024)
                     .speed(0.2),
             );
-            crate::points::name_widget(ui, &r, "spp max");
+            name_widget(ui, &r, "spp max");
             ui.label("rays per pixel (multiples of 4)");
         });
         ui.horizontal(|ui| {
             let r = ui.add(egui::DragValue::new(&mut q.seed));
-            crate::points::name_widget(ui, &r, "seed");
+            name_widget(ui, &r, "seed");
             ui.label("seed");
         });
         ui.horizontal(|ui| {
@@ -442,18 +442,17 @@ impl crate::Studio {
                     }
                 })
                 .response;
-            crate::points::name_widget(ui, &r, "AVR level");
+            name_widget(ui, &r, "AVR level");
         });
         ui.horizontal(|ui| {
-            let busy = self.render.busy();
+            let busy = self.busy();
             if ui.add_enabled(!busy, egui::Button::new("Start")).clicked() {
-                let ctx = ui.ctx().clone();
-                self.start_render(&ctx);
+                actions.push(Action::StartRender);
             }
             if ui.add_enabled(busy, egui::Button::new("Cancel")).clicked() {
-                self.render.cancel();
+                actions.push(Action::CancelRender);
             }
-            let (done, total) = self.render.progress();
+            let (done, total) = self.progress();
             if busy {
                 ui.spinner();
                 let f = if total == 0 {
@@ -464,33 +463,37 @@ impl crate::Studio {
                 ui.add(egui::ProgressBar::new(f).text(format!("{done}/{total} tiles")));
             }
         });
-        let r = ui.add(egui::Slider::new(&mut self.render.ab_split, 0.0..=1.0).text("A/B"));
-        crate::points::name_widget(ui, &r, "A/B split");
+        let r = ui.add(egui::Slider::new(&mut self.ab_split, 0.0..=1.0).text("A/B"));
+        name_widget(ui, &r, "A/B split");
         ui.label("photo left of the split, montage right");
         ui.horizontal(|ui| {
             let r = ui.add(
-                egui::TextEdit::singleline(&mut self.render.export_path)
+                egui::TextEdit::singleline(&mut self.export_path)
                     .hint_text("montage.exr / .png / .jpg / .tif")
                     .desired_width(260.0),
             );
-            crate::points::name_widget(ui, &r, "export path");
-            let has = self.render.montage().is_some_and(|m| m.photo_id == id);
+            name_widget(ui, &r, "export path");
+            let has = self.montage().is_some_and(|m| m.photo_id == id);
             if ui.add_enabled(has, egui::Button::new("Export")).clicked() {
-                self.export_render();
+                actions.push(Action::ExportRender);
             }
         });
         ui.horizontal(|ui| {
             let r = ui.add(
-                egui::TextEdit::singleline(&mut self.render.sheet_path)
+                egui::TextEdit::singleline(&mut self.sheet_path)
                     .hint_text("sheet.pdf")
                     .desired_width(260.0),
             );
-            crate::points::name_widget(ui, &r, "sheet path");
-            let has = self.render.montage().is_some_and(|m| m.photo_id == id);
+            name_widget(ui, &r, "sheet path");
+            let has = self.montage().is_some_and(|m| m.photo_id == id);
             if ui.add_enabled(has, egui::Button::new("Sheet")).clicked() {
-                self.export_sheet();
+                actions.push(Action::ExportSheet);
             }
         });
-        self.report_ui(ui);
+        if ui.button("Report").clicked() {
+            actions.push(Action::MakeReport);
+        }
+        self.report_ui(ui, id);
+        actions
     }
 }

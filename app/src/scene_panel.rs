@@ -184,7 +184,7 @@ impl crate::Studio {
         ui.horizontal_wrapped(|ui| {
             for t in &ties {
                 let r = ui.button(t);
-                crate::points::name_widget(ui, &r, &format!("intersect {t}"));
+                crate::widgets::name_widget(ui, &r, &format!("intersect {t}"));
                 if r.clicked() {
                     intersect_id = Some(t.clone());
                 }
@@ -199,7 +199,7 @@ impl crate::Studio {
                     .hint_text("polygon id")
                     .desired_width(120.0),
             );
-            crate::points::name_widget(ui, &r, "polygon id");
+            crate::widgets::name_widget(ui, &r, "polygon id");
             let selected = if self.scene.material.is_empty() {
                 "material".to_owned()
             } else {
@@ -216,7 +216,7 @@ impl crate::Studio {
         ui.horizontal_wrapped(|ui| {
             for p in &points {
                 let r = ui.small_button(p);
-                crate::points::name_widget(ui, &r, &format!("vertex {p}"));
+                crate::widgets::name_widget(ui, &r, &format!("vertex {p}"));
                 if r.clicked() {
                     self.scene.vertices.push(p.clone());
                 }

@@ -66,7 +66,7 @@ pub fn photo_solution_ui(ui: &mut egui::Ui, s: &PhotoSolution) {
         c.x, c.y, c.z, s.sigma_center_m[0], s.sigma_center_m[1], s.sigma_center_m[2]
     ));
     for w in &s.warnings {
-        ui.colored_label(Color32::from_rgb(230, 160, 40), format!("warning: {w}"));
+        ui.colored_label(crate::widgets::WARNING, format!("warning: {w}"));
     }
     TableBuilder::new(ui)
         .id_salt(("residuals", &s.id))

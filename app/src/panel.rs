@@ -1,0 +1,72 @@
+//! Panels as types: a side-tab panel owns its own state, draws itself from a read-only
+//! [`PanelContext`] (the open site, the current photo) and returns the [`Action`]s its widgets
+//! asked for; the [`crate::Studio`] applies them after the frame. Edits of the user's data are
+//! [`Action::Edit`]s, which go through the one command path (`commands.rs`: undo/redo,
+//! autosave); everything else (start or cancel a worker job, export) is a named action, so a
+//! panel never reaches into the studio (egui's demo `View` trait, rerun's `ViewerContext` and
+//! `SystemCommand`).
+//!
+//! # Known limitations
+//! The Render and Fit tabs are panels; the Points, Results, Models and Scene tabs and the photo
+//! view are still drawn by `impl Studio` methods.
+
+use eframe::egui;
+use photomontage::site::SiteDocument;
+
+use crate::commands::Command;
+
+/// What a panel may read while it draws.
+#[derive(Clone, Copy)]
+pub struct PanelContext<'a> {
+    /// The open site.
+    pub doc: Option<&'a SiteDocument>,
+    /// The photo shown.
+    pub current_photo: Option<&'a str>,
+}
+
+impl PanelContext<'_> {
+    /// Whether the current photo has a solved exterior orientation.
+    #[must_use]
+    pub fn current_photo_solved(&self) -> bool {
+        let (Some(doc), Some(id)) = (self.doc, self.current_photo) else {
+            return false;
+        };
+        doc.site
+            .photos
+            .iter()
+            .any(|p| p.id == id && p.exterior.is_some())
+    }
+}
+
+/// What a panel asks the studio to do after the frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// An undoable edit of the site; consecutive edits with the same `merge_key` are one undo
+    /// step.
+    Edit {
+        command: Box<Command>,
+        merge_key: Option<String>,
+    },
+    /// Render the current photo (Render tab, Start).
+    StartRender,
+    /// Stop the running render at its next tile.
+    CancelRender,
+    /// Export the montage to the Render tab's export path.
+    ExportRender,
+    /// Write the verified-view sheet to the Render tab's sheet path.
+    ExportSheet,
+    /// Compute the view geometry report of the current photo.
+    MakeReport,
+    /// Start the lighting fit on the site as it is now.
+    StartFit,
+    /// Stop the running fit at its next step.
+    CancelFit,
+    /// Write the last fit's report into the site (one undoable edit).
+    ApplyFit,
+}
+
+/// A side-tab panel.
+pub trait Panel {
+    /// Draws the panel into `ui` from `ctx`; returns what its widgets asked for.
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action>;
+}
