@@ -122,9 +122,8 @@ pub struct Studio {
     solution: Option<SiteSolution>,
     messages: Vec<Message>,
     tab: SideTab,
-    import_path: String,
+    points: points::PointsPanel,
     open_path: String,
-    new_point_id: String,
     pending: Vec<(Command, Option<String>)>,
     /// What the panels asked for this frame ([`panel::Panel`]), done after the layout.
     actions: Vec<Action>,
@@ -168,9 +167,8 @@ impl Studio {
             solution: None,
             messages: Vec::new(),
             tab: SideTab::Points,
-            import_path: String::new(),
+            points: points::PointsPanel::default(),
             open_path: String::new(),
-            new_point_id: String::new(),
             pending: Vec::new(),
             actions: Vec::new(),
             render: render_panel::RenderPanel::default(),
@@ -696,19 +694,19 @@ impl Studio {
         });
         ui.separator();
         match self.tab {
-            SideTab::Points => self.points_tab_ui(ui),
             SideTab::Solve => self.solve_tab_ui(ui),
-            SideTab::Models => self.models_tab_ui(ui),
             SideTab::Scene => self.scene_tab_ui(ui),
-            SideTab::Render | SideTab::Fit => {
+            SideTab::Points | SideTab::Render | SideTab::Fit | SideTab::Models => {
                 let ctx = PanelContext {
                     doc: self.doc.as_ref(),
                     current_photo: self.current_photo.as_deref(),
+                    selected_point: self.selected_point.as_deref(),
                 };
-                let panel: &mut dyn Panel = if self.tab == SideTab::Render {
-                    &mut self.render
-                } else {
-                    &mut self.fit
+                let panel: &mut dyn Panel = match self.tab {
+                    SideTab::Points => &mut self.points,
+                    SideTab::Render => &mut self.render,
+                    SideTab::Models => &mut self.models,
+                    _ => &mut self.fit,
                 };
                 let actions = panel.ui(ui, &ctx);
                 self.actions.extend(actions);
@@ -720,6 +718,9 @@ impl Studio {
     fn run_action(&mut self, action: Action, ctx: &egui::Context) {
         match action {
             Action::Edit { command, merge_key } => self.apply(*command, merge_key),
+            Action::ImportPoints => self.import(),
+            Action::SelectPoint(id) => self.selected_point = Some(id),
+            Action::ImportModel(path) => self.import_model(&path),
             Action::StartRender => self.start_render(ctx),
             Action::CancelRender => self.render.cancel(),
             Action::ExportRender => self.export_render(),
@@ -731,76 +732,12 @@ impl Studio {
         }
     }
 
-    fn points_tab_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            let r = ui.add(
-                egui::TextEdit::singleline(&mut self.import_path)
-                    .hint_text(points::IMPORT_HINT)
-                    .desired_width(330.0),
-            );
-            widgets::name_widget(ui, &r, "import path");
-            if ui.button("Import").clicked() {
-                self.import();
-            }
-        });
-        ui.horizontal(|ui| {
-            let r = ui.add(
-                egui::TextEdit::singleline(&mut self.new_point_id)
-                    .hint_text("tie point id (no survey)")
-                    .desired_width(160.0),
-            );
-            widgets::name_widget(ui, &r, "point id");
-            let id = self.new_point_id.trim();
-            if ui.button("Pick id").clicked() && !id.is_empty() {
-                self.selected_point = Some(id.to_owned());
-            }
-            // Points observed but not surveyed (tie points) are listed for picking too.
-            if let Some(doc) = self.doc.as_ref() {
-                let mut ties: Vec<&str> = doc
-                    .site
-                    .observations
-                    .iter()
-                    .map(|o| o.point.as_str())
-                    .filter(|p| !doc.site.control_points.iter().any(|c| c.id == *p))
-                    .collect();
-                ties.sort_unstable();
-                ties.dedup();
-                for t in ties {
-                    let sel = self.selected_point.as_deref() == Some(t);
-                    let r = ui.selectable_label(sel, t);
-                    widgets::name_widget(ui, &r, &format!("tie {t}"));
-                    if r.clicked() {
-                        self.selected_point = Some(t.to_owned());
-                    }
-                }
-            }
-        });
-        let sel = self.selected_point.clone().unwrap_or_else(|| "none".into());
-        ui.label(format!(
-            "selected: {sel} — click the photo to place it, drag a mark to move, Delete removes"
-        ));
-        let Some(doc) = self.doc.as_ref() else {
-            return;
-        };
-        let mut commands = Vec::new();
-        egui::ScrollArea::horizontal().show(ui, |ui| {
-            points::table_ui(
-                ui,
-                &doc.site,
-                self.current_photo.as_deref(),
-                &mut self.selected_point,
-                &mut commands,
-            );
-        });
-        self.pending.extend(commands);
-    }
-
     /// Imports control points (and observations) from the file named in the import field.
     pub fn import(&mut self) {
         let Some(doc) = self.doc.as_ref() else {
             return;
         };
-        let path = PathBuf::from(self.import_path.trim());
+        let path = PathBuf::from(self.points.import_path.trim());
         match points::import_file(&doc.site, &path, self.current_photo.as_deref()) {
             Ok(Command::Batch(b)) if b.is_empty() => {
                 self.say(format!("{}: nothing to import", path.display()), true);
@@ -816,7 +753,7 @@ impl Studio {
 
     /// Sets the import field (what a user types).
     pub fn set_import_path(&mut self, path: &str) {
-        path.clone_into(&mut self.import_path);
+        path.clone_into(&mut self.points.import_path);
     }
 
     fn solve_tab_ui(&mut self, ui: &mut egui::Ui) {

@@ -34,6 +34,8 @@ use photomontage::site::{CadModel, SiteDocument};
 use std::collections::HashMap;
 
 use crate::commands::Command;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 
 /// The length units the importer reads (`photomontage::scene::LengthUnit`), with the site file
 /// spelling of `[[models]] units`.
@@ -80,7 +82,7 @@ fn choice_ui(
                 ui.selectable_value(value, (*o).to_owned(), label(o));
             }
         });
-    crate::widgets::name_widget(ui, &r.response, name);
+    name_widget(ui, &r.response, name);
     *value != before
 }
 
@@ -248,32 +250,31 @@ impl crate::Studio {
             }
         }
     }
+}
 
-    pub(crate) fn models_tab_ui(&mut self, ui: &mut egui::Ui) {
-        let r = ui.checkbox(&mut self.models.show_wireframe, "wireframe overlay");
-        crate::widgets::name_widget(ui, &r, "wireframe overlay");
+impl Panel for ModelsPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut actions = Vec::new();
+        let r = ui.checkbox(&mut self.show_wireframe, "wireframe overlay");
+        name_widget(ui, &r, "wireframe overlay");
         let mut add = false;
         ui.horizontal(|ui| {
             let r = ui.add(
-                egui::TextEdit::singleline(&mut self.models.model_path)
+                egui::TextEdit::singleline(&mut self.model_path)
                     .hint_text("model file (.obj, .gltf, .glb, .dxf)")
                     .desired_width(260.0),
             );
-            crate::widgets::name_widget(ui, &r, "model path");
+            name_widget(ui, &r, "model path");
             add = ui.button("Add model").clicked();
         });
         ui.horizontal(|ui| {
             ui.label("added in");
-            let mut units = self.models.new_units.clone().unwrap_or_else(|| "m".into());
+            let mut units = self.new_units.clone().unwrap_or_else(|| "m".into());
             let names: Vec<&str> = UNITS.iter().map(|(u, _)| *u).collect();
             if choice_ui(ui, "new model units", &mut units, &names, unit_label) {
-                self.models.new_units = Some(units);
+                self.new_units = Some(units);
             }
-            let mut axis = self
-                .models
-                .new_up_axis
-                .clone()
-                .unwrap_or_else(|| "auto".into());
+            let mut axis = self.new_up_axis.clone().unwrap_or_else(|| "auto".into());
             let axes = ["auto", "z", "y"];
             let label = |a: &str| {
                 if a == "auto" {
@@ -283,21 +284,21 @@ impl crate::Studio {
                 }
             };
             if choice_ui(ui, "new model up axis", &mut axis, &axes, label) {
-                self.models.new_up_axis = (axis != "auto").then_some(axis);
+                self.new_up_axis = (axis != "auto").then_some(axis);
             }
         });
-        if add && !self.models.model_path.trim().is_empty() {
-            let path = std::path::PathBuf::from(self.models.model_path.trim());
-            self.import_model(&path);
+        if add && !self.model_path.trim().is_empty() {
+            let path = std::path::PathBuf::from(self.model_path.trim());
+            actions.push(Action::ImportModel(path));
         }
-        let Some(doc) = self.doc.as_ref() else {
-            return;
+        let Some(doc) = ctx.doc else {
+            return actions;
         };
         if doc.site.models.is_empty() {
             ui.label("the site has no [[models]]");
-            return;
+            return actions;
         }
-        let photo = self.current_photo.clone().unwrap_or_default();
+        let photo = ctx.current_photo.unwrap_or_default();
         let mut commands = Vec::new();
         let warn = crate::widgets::WARNING;
         for m in &doc.site.models {
@@ -331,7 +332,7 @@ impl crate::Studio {
                     ));
                 }
             });
-            match self.models.model_warnings(doc, &m.id) {
+            match self.model_warnings(doc, &m.id) {
                 Ok(warnings) => {
                     for w in warnings {
                         ui.colored_label(warn, format!("importer: {w}"));
@@ -341,8 +342,8 @@ impl crate::Studio {
                     ui.colored_label(warn, e);
                 }
             }
-            if let Err(e) = self.models.wireframe_px(doc, &photo, &m.id)
-                && self.models.show_wireframe
+            if let Err(e) = self.wireframe_px(doc, photo, &m.id)
+                && self.show_wireframe
             {
                 ui.colored_label(warn, e);
             }
@@ -352,14 +353,14 @@ impl crate::Studio {
                 for (k, axis) in ["E", "N", "H"].iter().enumerate() {
                     ui.label(*axis);
                     let r = ui.add(egui::DragValue::new(&mut p.translation[k]).speed(0.05));
-                    crate::widgets::name_widget(ui, &r, &format!("{} {axis}", m.id));
+                    name_widget(ui, &r, &format!("{} {axis}", m.id));
                     changed |= r.changed();
                 }
             });
             ui.horizontal(|ui| {
                 ui.label("rotation Z °");
                 let r = ui.add(egui::DragValue::new(&mut p.rotation_z_deg).speed(0.1));
-                crate::widgets::name_widget(ui, &r, &format!("{} rotation", m.id));
+                name_widget(ui, &r, &format!("{} rotation", m.id));
                 changed |= r.changed();
                 ui.label("scale");
                 let r = ui.add(
@@ -367,7 +368,7 @@ impl crate::Studio {
                         .speed(0.001)
                         .range(1e-6..=1e6),
                 );
-                crate::widgets::name_widget(ui, &r, &format!("{} scale", m.id));
+                name_widget(ui, &r, &format!("{} scale", m.id));
                 changed |= r.changed();
             });
             if changed {
@@ -380,6 +381,14 @@ impl crate::Studio {
                 ));
             }
         }
-        self.pending.extend(commands);
+        actions.extend(
+            commands
+                .into_iter()
+                .map(|(command, merge_key)| Action::Edit {
+                    command: Box::new(command),
+                    merge_key,
+                }),
+        );
+        actions
     }
 }

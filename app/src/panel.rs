@@ -7,8 +7,8 @@
 //! `SystemCommand`).
 //!
 //! # Known limitations
-//! The Render and Fit tabs are panels; the Points, Results, Models and Scene tabs and the photo
-//! view are still drawn by `impl Studio` methods.
+//! The Points, Render, Fit and Models tabs are panels; the Results and Scene tabs, the toolbar,
+//! the photo strip, the dialogs and the photo view are still drawn by `impl Studio` methods.
 
 use eframe::egui;
 use photomontage::site::SiteDocument;
@@ -22,6 +22,8 @@ pub struct PanelContext<'a> {
     pub doc: Option<&'a SiteDocument>,
     /// The photo shown.
     pub current_photo: Option<&'a str>,
+    /// The point selected for placing on the photo.
+    pub selected_point: Option<&'a str>,
 }
 
 impl PanelContext<'_> {
@@ -47,6 +49,12 @@ pub enum Action {
         command: Box<Command>,
         merge_key: Option<String>,
     },
+    /// Import control points from the Points tab's import path.
+    ImportPoints,
+    /// Select a point for placing on the photo.
+    SelectPoint(String),
+    /// Import a CAD model file into the site (checked, then one undoable edit).
+    ImportModel(std::path::PathBuf),
     /// Render the current photo (Render tab, Start).
     StartRender,
     /// Stop the running render at its next tile.
