@@ -123,6 +123,7 @@ pub struct Studio {
     messages: Vec<Message>,
     tab: SideTab,
     points: points::PointsPanel,
+    results: solve::ResultsPanel,
     open_path: String,
     pending: Vec<(Command, Option<String>)>,
     /// What the panels asked for this frame ([`panel::Panel`]), done after the layout.
@@ -168,6 +169,7 @@ impl Studio {
             messages: Vec::new(),
             tab: SideTab::Points,
             points: points::PointsPanel::default(),
+            results: solve::ResultsPanel,
             open_path: String::new(),
             pending: Vec::new(),
             actions: Vec::new(),
@@ -693,25 +695,26 @@ impl Studio {
             widgets::name_widget(ui, &r, "Fit tab");
         });
         ui.separator();
-        match self.tab {
-            SideTab::Solve => self.solve_tab_ui(ui),
-            SideTab::Scene => self.scene_tab_ui(ui),
-            SideTab::Points | SideTab::Render | SideTab::Fit | SideTab::Models => {
-                let ctx = PanelContext {
-                    doc: self.doc.as_ref(),
-                    current_photo: self.current_photo.as_deref(),
-                    selected_point: self.selected_point.as_deref(),
-                };
-                let panel: &mut dyn Panel = match self.tab {
-                    SideTab::Points => &mut self.points,
-                    SideTab::Render => &mut self.render,
-                    SideTab::Models => &mut self.models,
-                    _ => &mut self.fit,
-                };
-                let actions = panel.ui(ui, &ctx);
-                self.actions.extend(actions);
-            }
-        }
+        let ctx = PanelContext {
+            doc: self.doc.as_ref(),
+            current_photo: self.current_photo.as_deref(),
+            selected_point: self.selected_point.as_deref(),
+            solution: self.solution.as_ref(),
+            residuals: panel::ResidualDisplay {
+                show: self.ui_state.show_residuals,
+                exaggeration: self.ui_state.residual_exaggeration,
+            },
+        };
+        let panel: &mut dyn Panel = match self.tab {
+            SideTab::Points => &mut self.points,
+            SideTab::Solve => &mut self.results,
+            SideTab::Render => &mut self.render,
+            SideTab::Models => &mut self.models,
+            SideTab::Scene => &mut self.scene,
+            SideTab::Fit => &mut self.fit,
+        };
+        let actions = panel.ui(ui, &ctx);
+        self.actions.extend(actions);
     }
 
     /// Does what a panel asked for (after the frame's layout).
@@ -719,8 +722,14 @@ impl Studio {
         match action {
             Action::Edit { command, merge_key } => self.apply(*command, merge_key),
             Action::ImportPoints => self.import(),
+            Action::SetResiduals(r) => {
+                self.ui_state.show_residuals = r.show;
+                self.ui_state.residual_exaggeration = r.exaggeration;
+            }
             Action::SelectPoint(id) => self.selected_point = Some(id),
             Action::ImportModel(path) => self.import_model(&path),
+            Action::IntersectTiePoint(id) => self.intersect_tie_point(&id),
+            Action::CreatePolygon => self.create_polygon(),
             Action::StartRender => self.start_render(ctx),
             Action::CancelRender => self.render.cancel(),
             Action::ExportRender => self.export_render(),
@@ -754,42 +763,6 @@ impl Studio {
     /// Sets the import field (what a user types).
     pub fn set_import_path(&mut self, path: &str) {
         path.clone_into(&mut self.points.import_path);
-    }
-
-    fn solve_tab_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            let r = ui.checkbox(&mut self.ui_state.show_residuals, "residual vectors");
-            widgets::name_widget(ui, &r, "residual vectors");
-            let r = ui.add(
-                egui::Slider::new(&mut self.ui_state.residual_exaggeration, 1.0..=5000.0)
-                    .logarithmic(true)
-                    .text("×"),
-            );
-            widgets::name_widget(ui, &r, "residual exaggeration");
-        });
-        let Some(solution) = self.solution.as_ref() else {
-            ui.label("not solved yet: press Solve");
-            return;
-        };
-        if let Some(r) = solution.bundle_rms_px {
-            ui.strong(format!("bundle adjustment RMS {r:.3} px"));
-        }
-        for f in &solution.failures {
-            ui.colored_label(crate::widgets::ERROR, format!("{}: {}", f.id, f.error));
-        }
-        for w in &solution.warnings {
-            ui.colored_label(crate::widgets::WARNING, format!("warning: {w}"));
-        }
-        egui::ScrollArea::vertical().show(ui, |ui| {
-            // The current photo first, then the others.
-            let current = self.current_photo.as_deref();
-            let mut order: Vec<_> = solution.photos.iter().collect();
-            order.sort_by_key(|p| Some(p.id.as_str()) != current);
-            for p in order {
-                ui.separator();
-                solve::photo_solution_ui(ui, p);
-            }
-        });
     }
 
     /// Test hook: the next job of `job` panics on its worker thread

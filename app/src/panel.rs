@@ -7,11 +7,11 @@
 //! `SystemCommand`).
 //!
 //! # Known limitations
-//! The Points, Render, Fit and Models tabs are panels; the Results and Scene tabs, the toolbar,
-//! the photo strip, the dialogs and the photo view are still drawn by `impl Studio` methods.
+//! All six side tabs are panels; the toolbar, the photo strip, the message area, the New site
+//! and Camera settings windows and the photo view are still drawn by `impl Studio` methods.
 
 use eframe::egui;
-use photomontage::site::SiteDocument;
+use photomontage::site::{SiteDocument, SiteSolution};
 
 use crate::commands::Command;
 
@@ -24,6 +24,19 @@ pub struct PanelContext<'a> {
     pub current_photo: Option<&'a str>,
     /// The point selected for placing on the photo.
     pub selected_point: Option<&'a str>,
+    /// The last solve's result.
+    pub solution: Option<&'a SiteSolution>,
+    /// How residual vectors are drawn on the photo (persisted UI state).
+    pub residuals: ResidualDisplay,
+}
+
+/// How the residual vectors of the last solve are drawn on the photo.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResidualDisplay {
+    /// Draw them.
+    pub show: bool,
+    /// Screen length per pixel of residual.
+    pub exaggeration: f64,
 }
 
 impl PanelContext<'_> {
@@ -49,10 +62,16 @@ pub enum Action {
         command: Box<Command>,
         merge_key: Option<String>,
     },
+    /// Change how residual vectors are drawn (Results tab).
+    SetResiduals(ResidualDisplay),
     /// Import control points from the Points tab's import path.
     ImportPoints,
     /// Select a point for placing on the photo.
     SelectPoint(String),
+    /// Intersect a tie point from its observations (Scene tab).
+    IntersectTiePoint(String),
+    /// Close the polygon under construction as one undoable edit (Scene tab).
+    CreatePolygon,
     /// Import a CAD model file into the site (checked, then one undoable edit).
     ImportModel(std::path::PathBuf),
     /// Render the current photo (Render tab, Start).

@@ -14,7 +14,9 @@ use eframe::egui::{self, Color32, Pos2, Stroke};
 use egui_extras::{Column, TableBuilder};
 use photomontage::site::{SiteDocument, SiteSolution, solve::PhotoSolution};
 
+use crate::panel::{Action, Panel, PanelContext};
 use crate::viewport::ViewTransform;
+use crate::widgets::{ERROR, WARNING, name_widget};
 use crate::worker::Worker;
 
 /// The solve's worker: [`photomontage::site::solve_site`] on a snapshot of the site.
@@ -186,5 +188,53 @@ mod tests {
         assert!((scale_bar_px(3.0, 120.0) - 20.0).abs() < 1e-12);
         assert!((scale_bar_px(120.0, 120.0) - 1.0).abs() < 1e-12);
         assert!((scale_bar_px(500.0, 120.0) - 0.2).abs() < 1e-12);
+    }
+}
+
+/// The Results tab: residual-vector display, the solve's summary, failures, warnings and each
+/// photo's residual table (the current photo first).
+#[derive(Debug, Default)]
+pub struct ResultsPanel;
+
+impl Panel for ResultsPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut residuals = ctx.residuals;
+        ui.horizontal(|ui| {
+            let r = ui.checkbox(&mut residuals.show, "residual vectors");
+            name_widget(ui, &r, "residual vectors");
+            let r = ui.add(
+                egui::Slider::new(&mut residuals.exaggeration, 1.0..=5000.0)
+                    .logarithmic(true)
+                    .text("×"),
+            );
+            name_widget(ui, &r, "residual exaggeration");
+        });
+        let actions: Vec<Action> = (residuals != ctx.residuals)
+            .then_some(Action::SetResiduals(residuals))
+            .into_iter()
+            .collect();
+        let Some(solution) = ctx.solution else {
+            ui.label("not solved yet: press Solve");
+            return actions;
+        };
+        if let Some(r) = solution.bundle_rms_px {
+            ui.strong(format!("bundle adjustment RMS {r:.3} px"));
+        }
+        for f in &solution.failures {
+            ui.colored_label(ERROR, format!("{}: {}", f.id, f.error));
+        }
+        for w in &solution.warnings {
+            ui.colored_label(WARNING, format!("warning: {w}"));
+        }
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            // The current photo first, then the others.
+            let mut order: Vec<_> = solution.photos.iter().collect();
+            order.sort_by_key(|p| Some(p.id.as_str()) != ctx.current_photo);
+            for p in order {
+                ui.separator();
+                photo_solution_ui(ui, p);
+            }
+        });
+        actions
     }
 }
