@@ -22,6 +22,7 @@ pub mod files;
 pub mod fit_commands;
 pub mod fit_panel;
 pub mod fit_pick;
+pub mod fit_tables;
 pub mod fit_worker;
 pub mod models_panel;
 pub mod new_site;
