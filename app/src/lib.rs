@@ -17,6 +17,7 @@
 //! headless tests, which use the typed-path fields and a substituted [`files::FilePicker`].
 
 pub mod autosave;
+pub mod chrome;
 pub mod commands;
 pub mod files;
 pub mod fit_commands;
@@ -52,6 +53,26 @@ use std::time::Instant;
 use commands::{Command, History};
 use panel::{Action, Panel, PanelContext};
 use viewport::{DecodedPhoto, PhotoLoader, ViewTransform, Viewport};
+
+/// The read-only view of the studio that panels draw from (a macro, not a method, so that the
+/// borrows are of single fields and a panel field can be borrowed mutably beside it).
+macro_rules! panel_context {
+    ($s:ident) => {
+        PanelContext {
+            doc: $s.doc.as_ref(),
+            current_photo: $s.current_photo.as_deref(),
+            selected_point: $s.selected_point.as_deref(),
+            solution: $s.solution.as_ref(),
+            residuals: panel::ResidualDisplay {
+                show: $s.ui_state.show_residuals,
+                exaggeration: $s.ui_state.residual_exaggeration,
+            },
+            can_undo: $s.history.can_undo(),
+            can_redo: $s.history.can_redo(),
+            solving: $s.solver.busy(),
+        }
+    };
+}
 
 /// How the studio starts.
 #[derive(Debug, Clone)]
@@ -125,7 +146,8 @@ pub struct Studio {
     tab: SideTab,
     points: points::PointsPanel,
     results: solve::ResultsPanel,
-    open_path: String,
+    toolbar: chrome::Toolbar,
+    photo_strip: chrome::PhotoStrip,
     pending: Vec<(Command, Option<String>)>,
     /// What the panels asked for this frame ([`panel::Panel`]), done after the layout.
     actions: Vec<Action>,
@@ -171,7 +193,8 @@ impl Studio {
             tab: SideTab::Points,
             points: points::PointsPanel::default(),
             results: solve::ResultsPanel,
-            open_path: String::new(),
+            toolbar: chrome::Toolbar::default(),
+            photo_strip: chrome::PhotoStrip,
             pending: Vec::new(),
             actions: Vec::new(),
             render: render_panel::RenderPanel::default(),
@@ -550,11 +573,15 @@ impl Studio {
             .frame(side_frame)
             .resizable(true)
             .default_size(70.0)
-            .show(ui, |ui| self.messages_ui(ui));
+            .show(ui, |ui| chrome::messages_ui(ui, &self.messages));
         egui::Panel::left("photos")
             .frame(side_frame)
             .default_size(150.0)
-            .show(ui, |ui| self.photo_strip_ui(ui));
+            .show(ui, |ui| {
+                let ctx = panel_context!(self);
+                let actions = self.photo_strip.ui(ui, &ctx);
+                self.actions.extend(actions);
+            });
         egui::Panel::right("side")
             .frame(side_frame)
             .default_size(560.0)
@@ -581,108 +608,11 @@ impl Studio {
 
     fn toolbar_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            let name = self
-                .doc
-                .as_ref()
-                .map_or_else(|| "no site".into(), |d| d.site.name.clone());
             self.file_menu_ui(ui);
-            ui.strong(name);
-            ui.separator();
-            if ui.button("Save").clicked() {
-                self.save();
-            }
-            if ui
-                .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
-                .clicked()
-            {
-                self.undo();
-            }
-            if ui
-                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
-                .clicked()
-            {
-                self.redo();
-            }
-            let solving = self.solver.busy();
-            if ui
-                .add_enabled(!solving, egui::Button::new("Solve"))
-                .clicked()
-            {
-                let ctx = ui.ctx().clone();
-                self.start_solve(&ctx);
-            }
-            if solving {
-                ui.spinner();
-            }
-            if ui
-                .button("Fit view")
-                .on_hover_text("fit the whole photo into the view")
-                .clicked()
-            {
-                self.viewport.fitted = true;
-            }
-            ui.separator();
-            let r = ui.add(
-                egui::TextEdit::singleline(&mut self.open_path)
-                    .hint_text("site file path")
-                    .desired_width(220.0),
-            );
-            widgets::name_widget(ui, &r, "site path");
-            if ui.button("Open").clicked() && !self.open_path.trim().is_empty() {
-                let p = PathBuf::from(self.open_path.trim());
-                self.open(&p);
-            }
+            let ctx = panel_context!(self);
+            let actions = self.toolbar.ui(ui, &ctx);
+            self.actions.extend(actions);
         });
-    }
-
-    fn messages_ui(&mut self, ui: &mut egui::Ui) {
-        egui::ScrollArea::vertical()
-            .stick_to_bottom(true)
-            .auto_shrink([false, false])
-            .show(ui, |ui| {
-                for m in &self.messages {
-                    if m.is_error {
-                        ui.colored_label(crate::widgets::ERROR, &m.text);
-                    } else {
-                        ui.label(&m.text);
-                    }
-                }
-            });
-    }
-
-    fn photo_strip_ui(&mut self, ui: &mut egui::Ui) {
-        ui.strong("Photos");
-        let Some(doc) = self.doc.as_ref() else {
-            return;
-        };
-        let mut chosen = None;
-        for p in &doc.site.photos {
-            let solved = p.exterior.as_ref().map_or_else(
-                || "not solved".to_string(),
-                |e| format!("RMS {:.2} px", e.rms_px),
-            );
-            let n = doc
-                .site
-                .observations
-                .iter()
-                .filter(|o| o.photo == p.id)
-                .count();
-            let text = format!("{}\n{n} obs · {solved}", p.id);
-            let sel = self.current_photo.as_deref() == Some(p.id.as_str());
-            let r = ui.selectable_label(sel, text);
-            widgets::name_widget(ui, &r, &format!("photo {}", p.id));
-            if r.clicked() {
-                chosen = Some(p.id.clone());
-            }
-        }
-        if let Some(id) = chosen {
-            self.select_photo(&id);
-        }
-        if let Some(id) = self.current_photo.clone()
-            && ui.button("Camera settings").clicked()
-        {
-            self.open_photo_settings(&id);
-        }
     }
 
     fn side_ui(&mut self, ui: &mut egui::Ui) {
@@ -696,16 +626,7 @@ impl Studio {
             widgets::name_widget(ui, &r, "Fit tab");
         });
         ui.separator();
-        let ctx = PanelContext {
-            doc: self.doc.as_ref(),
-            current_photo: self.current_photo.as_deref(),
-            selected_point: self.selected_point.as_deref(),
-            solution: self.solution.as_ref(),
-            residuals: panel::ResidualDisplay {
-                show: self.ui_state.show_residuals,
-                exaggeration: self.ui_state.residual_exaggeration,
-            },
-        };
+        let ctx = panel_context!(self);
         let panel: &mut dyn Panel = match self.tab {
             SideTab::Points => &mut self.points,
             SideTab::Solve => &mut self.results,
@@ -722,6 +643,14 @@ impl Studio {
     fn run_action(&mut self, action: Action, ctx: &egui::Context) {
         match action {
             Action::Edit { command, merge_key } => self.apply(*command, merge_key),
+            Action::Save => self.save(),
+            Action::Undo => self.undo(),
+            Action::Redo => self.redo(),
+            Action::StartSolve => self.start_solve(ctx),
+            Action::FitView => self.viewport.fitted = true,
+            Action::OpenSite(path) => self.open(&path),
+            Action::SelectPhoto(id) => self.select_photo(&id),
+            Action::OpenPhotoSettings(id) => self.open_photo_settings(&id),
             Action::ImportPoints => self.import(),
             Action::SetResiduals(r) => {
                 self.ui_state.show_residuals = r.show;

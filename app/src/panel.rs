@@ -7,8 +7,9 @@
 //! `SystemCommand`).
 //!
 //! # Known limitations
-//! All six side tabs are panels; the toolbar, the photo strip, the message area, the New site
-//! and Camera settings windows and the photo view are still drawn by `impl Studio` methods.
+//! The six side tabs, the toolbar and the photo strip ([`crate::chrome`]) are panels; the File
+//! menu, the New site and Camera settings windows and the photo view are still drawn by
+//! `impl Studio` methods.
 
 use eframe::egui;
 use photomontage::site::{SiteDocument, SiteSolution};
@@ -28,6 +29,12 @@ pub struct PanelContext<'a> {
     pub solution: Option<&'a SiteSolution>,
     /// How residual vectors are drawn on the photo (persisted UI state).
     pub residuals: ResidualDisplay,
+    /// Whether there is an edit to undo.
+    pub can_undo: bool,
+    /// Whether there is an undone edit to redo.
+    pub can_redo: bool,
+    /// Whether a solve is running.
+    pub solving: bool,
 }
 
 /// How the residual vectors of the last solve are drawn on the photo.
@@ -62,6 +69,22 @@ pub enum Action {
         command: Box<Command>,
         merge_key: Option<String>,
     },
+    /// Save the site (toolbar).
+    Save,
+    /// Undo the last edit.
+    Undo,
+    /// Redo the last undone edit.
+    Redo,
+    /// Solve the site as it is now (toolbar).
+    StartSolve,
+    /// Fit the whole photo into the view.
+    FitView,
+    /// Open a site file.
+    OpenSite(std::path::PathBuf),
+    /// Show a photo (photo strip).
+    SelectPhoto(String),
+    /// Open a photo's camera settings window.
+    OpenPhotoSettings(String),
     /// Change how residual vectors are drawn (Results tab).
     SetResiduals(ResidualDisplay),
     /// Import control points from the Points tab's import path.
