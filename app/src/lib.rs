@@ -1,7 +1,7 @@
 //! The photomontage studio: view state and wiring over the `photomontage` library (which does
 //! all computation). [`Studio`] is the whole app, testable headless with egui_kittest: it
 //! opens a site (restoring an autosave sidecar newer than it), shows a photo strip, the photo
-//! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
+//! view with zoom/pan/loupe, the control-point table, solves on a worker ([`solve`]), renders a
 //! montage preview progressively ([`render_panel`]), places CAD models with a wireframe overlay
 //! ([`models_panel`]) and builds scene geometry ([`scene_panel`], vertices picked on the photo
 //! with [`scene_pick`]), picks lighting-fit samples on the photo and runs, shows and applies the
@@ -9,11 +9,23 @@
 //! recent sites ([`files`]) and creates a site from photos ([`new_site`]); each photo's interior
 //! orientation is edited in its camera settings ([`photo_settings`]).
 //!
-//! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
-//! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
+//! Structure:
+//! - **One worker type** ([`worker::Worker`]): solve, fit, render, file dialogs and photo
+//!   decoding run on it, with progress, cancellation and panic capture (a crashed job is a
+//!   message, never a panel busy forever); [`jobs`] starts and polls them.
+//! - **Panels as types** ([`panel::Panel`]): the six side tabs, the toolbar and the photo strip
+//!   ([`chrome`]) draw from a read-only [`panel::PanelContext`] and return [`panel::Action`]s,
+//!   which [`Studio`] applies after the frame's layout; shared widgets are in [`widgets`].
+//! - **One command path**: every edit goes through [`Studio::apply`] (→ [`commands::History`]),
+//!   so undo/redo and the autosave see all of them (rerun's `SystemCommand`).
+//! - Computation lives in the library: model placement and wireframe edges
+//!   (`photomontage::site::models`), points projected into a photo
+//!   (`photomontage::site::photo_points`), solve, fit, render.
 //!
 //! # Known limitations
-//! See each module's own list. Native file dialogs ([`files`]) cannot be driven by the
+//! See each module's own list. The File menu, the New site and Camera settings windows, the
+//! photo view and its pickers are still `impl Studio` methods in their modules rather than
+//! panels. Native file dialogs ([`files`]) cannot be driven by the
 //! headless tests, which use the typed-path fields and a substituted [`files::FilePicker`].
 
 pub mod autosave;
@@ -25,6 +37,7 @@ pub mod fit_panel;
 pub mod fit_pick;
 pub mod fit_tables;
 pub mod fit_worker;
+mod jobs;
 pub mod models_panel;
 pub mod new_site;
 pub mod panel;
@@ -320,22 +333,6 @@ impl Studio {
         self.host_clears_to_panel_fill = clears;
     }
 
-    /// Whether no worker is running and the current photo is fully decoded and uploaded.
-    #[must_use]
-    pub fn is_idle(&self) -> bool {
-        let photo_ready = match self.current_photo.as_ref().and_then(|p| self.photos.get(p)) {
-            Some(PhotoView::Ready(_) | PhotoView::Failed(_)) => true,
-            Some(PhotoView::Loading) => false,
-            None => self.current_photo.is_none(),
-        };
-        photo_ready
-            && !self.solver.busy()
-            && !self.loader.busy()
-            && !self.render.busy()
-            && !self.dialogs.busy()
-            && !self.fit.worker.busy()
-    }
-
     /// Whether edits are not yet in the autosave sidecar.
     #[must_use]
     pub fn autosave_pending(&self) -> bool {
@@ -410,95 +407,11 @@ impl Studio {
         }
     }
 
-    /// Starts a solve of the site as it is now on the worker thread.
-    pub fn start_solve(&mut self, ctx: &egui::Context) {
-        let Some(doc) = self.doc.clone() else {
-            return;
-        };
-        if solve::start_solve(&mut self.solver, doc, ctx) {
-            self.say("solving…", false);
-        } else {
-            self.say("a solve is already running", true);
-        }
-    }
-
     /// Selects the photo shown.
     pub fn select_photo(&mut self, id: &str) {
         if self.current_photo.as_deref() != Some(id) {
             self.current_photo = Some(id.to_owned());
             self.viewport = Viewport::default();
-        }
-    }
-
-    fn poll_solve(&mut self) {
-        match self.solver.poll() {
-            worker::Poll::Done(solution) => {
-                for f in &solution.failures {
-                    self.say(format!("photo {} not solved: {}", f.id, f.error), true);
-                }
-                for w in &solution.warnings {
-                    self.say(format!("warning: {w}"), false);
-                }
-                if let Some(doc) = self.doc.as_ref() {
-                    let mut solved = doc.site.clone();
-                    photomontage::site::apply_solution(&mut solved, &solution);
-                    let mut batch: Vec<Command> = solved
-                        .photos
-                        .iter()
-                        .map(|p| Command::SetOrientation {
-                            photo: p.id.clone(),
-                            interior: p.interior.clone(),
-                            exterior: p.exterior.clone(),
-                        })
-                        .collect();
-                    batch.push(Command::SetTiePoints(solved.tie_points.clone()));
-                    self.apply(Command::Batch(batch), None);
-                }
-                let summary = solution.bundle_rms_px.map_or_else(
-                    || format!("solved {} photo(s)", solution.photos.len()),
-                    |r| {
-                        format!(
-                            "solved {} photo(s), bundle RMS {r:.3} px",
-                            solution.photos.len()
-                        )
-                    },
-                );
-                self.say(summary, false);
-                self.solution = Some(solution);
-                self.tab = SideTab::Solve;
-            }
-            worker::Poll::Failed(e) => self.say(format!("{e}; the site is unchanged"), true),
-            worker::Poll::Cancelled => self.say("solve cancelled; the site is unchanged", true),
-            worker::Poll::Idle | worker::Poll::Running(_) => {}
-        }
-    }
-
-    fn poll_workers(&mut self, ctx: &egui::Context) {
-        for d in self.loader.poll() {
-            let view = match d.result {
-                Ok(p) => PhotoView::Ready(Box::new(p)),
-                Err(e) => {
-                    self.say(e.clone(), true);
-                    PhotoView::Failed(e)
-                }
-            };
-            self.photos.insert(d.photo_id, view);
-        }
-        self.poll_solve();
-        self.poll_render(ctx);
-        self.poll_dialogs(ctx);
-        self.poll_fit(ctx);
-        // Start decoding the current photo.
-        if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
-            && !self.photos.contains_key(&id)
-            && let Some(p) = doc.site.photos.iter().find(|p| p.id == id)
-        {
-            let path = doc.resolve(&p.file);
-            self.photos.insert(id.clone(), PhotoView::Loading);
-            self.loader.request(id, path, ctx);
-        }
-        if self.loader.busy() || self.solver.busy() {
-            ctx.request_repaint_after(std::time::Duration::from_millis(50));
         }
     }
 
@@ -693,19 +606,6 @@ impl Studio {
     /// Sets the import field (what a user types).
     pub fn set_import_path(&mut self, path: &str) {
         path.clone_into(&mut self.points.import_path);
-    }
-
-    /// Test hook: the next job of `job` panics on its worker thread
-    /// ([`worker::Worker::inject_panic_for_tests`]); the kittests use it to check that a crashed
-    /// solve, fit or render ends as a message and leaves the studio usable. Not reachable from
-    /// the UI, the command line or any file.
-    #[doc(hidden)]
-    pub fn inject_panic_for_tests(&mut self, job: WorkerJob) {
-        match job {
-            WorkerJob::Solve => self.solver.inject_panic_for_tests(),
-            WorkerJob::Fit => self.fit.worker.inject_panic_for_tests(),
-            WorkerJob::Render => self.render.inject_panic_for_tests(),
-        }
     }
 
     /// Writes the UI state (call on exit).
