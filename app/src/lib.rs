@@ -83,6 +83,7 @@ macro_rules! panel_context {
             can_undo: $s.history.can_undo(),
             can_redo: $s.history.can_redo(),
             solving: $s.solver.busy(),
+            dialog_open: $s.dialogs.busy(),
         }
     };
 }
@@ -505,7 +506,9 @@ impl Studio {
         egui::CentralPanel::default()
             .frame(frame)
             .show(ui, |ui| self.photo_view_ui(ui));
-        self.new_site_ui(&ctx);
+        let panel_ctx = panel_context!(self);
+        let actions = self.new_site.ui(ui, &panel_ctx);
+        self.actions.extend(actions);
         self.photo_settings_ui(&ctx);
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
@@ -564,6 +567,8 @@ impl Studio {
             Action::OpenSite(path) => self.open(&path),
             Action::SelectPhoto(id) => self.select_photo(&id),
             Action::OpenPhotoSettings(id) => self.open_photo_settings(&id),
+            Action::RequestDialog(purpose) => self.request_dialog(purpose, ctx),
+            Action::CreateNewSite => self.create_new_site(),
             Action::ImportPoints => self.import(),
             Action::SetResiduals(r) => {
                 self.ui_state.show_residuals = r.show;

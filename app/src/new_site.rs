@@ -15,6 +15,7 @@ use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 
 use crate::files::DialogPurpose;
+use crate::panel::{Action, Panel, PanelContext};
 use crate::widgets::name_widget;
 
 /// State of the New site window.
@@ -88,10 +89,13 @@ impl crate::Studio {
             }
         }
     }
+}
 
-    pub(crate) fn new_site_ui(&mut self, ctx: &egui::Context) {
-        if !self.new_site.open {
-            return;
+impl Panel for NewSiteDialog {
+    /// Shows the window (when open) over `ui`'s context.
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        if !self.open {
+            return Vec::new();
         }
         let mut open = true;
         let mut create = false;
@@ -102,9 +106,9 @@ impl crate::Studio {
             .default_width(520.0)
             // Right of the photo strip, below the toolbar.
             .default_pos(egui::pos2(170.0, 60.0))
-            .show(ctx, |ui| {
-                let busy = self.dialogs.busy();
-                let d = &mut self.new_site;
+            .show(ui.ctx(), |ui| {
+                let busy = ctx.dialog_open;
+                let d = &mut *self;
                 ui.label("Photos of the site:");
                 let mut remove = None;
                 for (i, p) in d.photos.iter().enumerate() {
@@ -170,13 +174,12 @@ impl crate::Studio {
                 }
             });
         if !open {
-            self.new_site.open = false;
+            self.open = false;
         }
-        if let Some(purpose) = dialog {
-            self.request_dialog(purpose, ctx);
-        }
+        let mut actions: Vec<Action> = dialog.map(Action::RequestDialog).into_iter().collect();
         if create {
-            self.create_new_site();
+            actions.push(Action::CreateNewSite);
         }
+        actions
     }
 }

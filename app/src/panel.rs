@@ -7,9 +7,9 @@
 //! `SystemCommand`).
 //!
 //! # Known limitations
-//! The six side tabs, the toolbar and the photo strip ([`crate::chrome`]) are panels; the File
-//! menu, the New site and Camera settings windows and the photo view are still drawn by
-//! `impl Studio` methods.
+//! The six side tabs, the toolbar, the photo strip ([`crate::chrome`]) and the New site window
+//! are panels; the File menu, the Camera settings window and the photo view with its pickers
+//! are still drawn by `impl Studio` methods.
 
 use eframe::egui;
 use photomontage::site::{SiteDocument, SiteSolution};
@@ -35,6 +35,8 @@ pub struct PanelContext<'a> {
     pub can_redo: bool,
     /// Whether a solve is running.
     pub solving: bool,
+    /// Whether a file dialog is open (one at a time).
+    pub dialog_open: bool,
 }
 
 /// How the residual vectors of the last solve are drawn on the photo.
@@ -85,6 +87,10 @@ pub enum Action {
     SelectPhoto(String),
     /// Open a photo's camera settings window.
     OpenPhotoSettings(String),
+    /// Open the file dialog for this purpose (on its worker).
+    RequestDialog(crate::files::DialogPurpose),
+    /// Create the site of the New site window and open it.
+    CreateNewSite,
     /// Change how residual vectors are drawn (Results tab).
     SetResiduals(ResidualDisplay),
     /// Import control points from the Points tab's import path.

@@ -50,6 +50,7 @@ fn harness<P: Panel + 'static>(panel: P, can_undo: bool, row: bool) -> Harness<'
                     can_undo: s.can_undo,
                     can_redo: false,
                     solving: false,
+                    dialog_open: false,
                 };
                 let actions = if row {
                     ui.horizontal(|ui| s.panel.ui(ui, &ctx)).inner
