@@ -509,7 +509,16 @@ impl Studio {
         let panel_ctx = panel_context!(self);
         let actions = self.new_site.ui(ui, &panel_ctx);
         self.actions.extend(actions);
-        self.photo_settings_ui(&ctx);
+        self.photo_settings.size_px = self.photo_settings.photo.as_ref().and_then(|id| match self
+            .photos
+            .get(id)
+        {
+            Some(PhotoView::Ready(p)) => Some(p.size_px),
+            _ => None,
+        });
+        let panel_ctx = panel_context!(self);
+        let actions = self.photo_settings.ui(ui, &panel_ctx);
+        self.actions.extend(actions);
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
         }

@@ -7,9 +7,9 @@
 //! `SystemCommand`).
 //!
 //! # Known limitations
-//! The six side tabs, the toolbar, the photo strip ([`crate::chrome`]) and the New site window
-//! are panels; the File menu, the Camera settings window and the photo view with its pickers
-//! are still drawn by `impl Studio` methods.
+//! The six side tabs, the toolbar, the photo strip ([`crate::chrome`]) and the New site and
+//! Camera settings windows are panels; the File menu and the photo view with its pickers
+//! (points, scene vertices, fit samples) are still drawn by `impl Studio` methods.
 
 use eframe::egui;
 use photomontage::site::{SiteDocument, SiteSolution};
