@@ -16,6 +16,7 @@ use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::panel::{Action, Panel, PanelContext};
 use crate::worker::{Poll, Worker};
 
 /// What a dialog is for (decides its title, filters and what happens with the answer).
@@ -337,68 +338,45 @@ impl crate::Studio {
     pub fn recent_sites(&self) -> Vec<RecentEntry> {
         recent_entries(&self.ui_state.recent_sites)
     }
+}
 
-    /// The File menu.
-    pub(crate) fn file_menu_ui(&mut self, ui: &mut egui::Ui) {
-        let mut open_recent = None;
+/// The File menu: New site…, Open site…, Save, Save as…, the imports, Export render… and the
+/// recent sites.
+#[derive(Debug, Default)]
+pub struct FileMenu;
+
+impl Panel for FileMenu {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut actions = Vec::new();
         ui.menu_button("File", |ui| {
-            let ctx = ui.ctx().clone();
-            let busy = self.dialogs.busy();
-            let has_doc = self.doc.is_some();
-            if ui.button("New site…").clicked() {
-                self.new_site.open = true;
-                ui.close();
-            }
-            if ui
-                .add_enabled(!busy, egui::Button::new("Open site…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::OpenSite, &ctx);
-                ui.close();
-            }
-            if ui.add_enabled(has_doc, egui::Button::new("Save")).clicked() {
-                self.save();
-                ui.close();
-            }
-            if ui
-                .add_enabled(has_doc && !busy, egui::Button::new("Save as…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::SaveSiteAs, &ctx);
-                ui.close();
-            }
+            let busy = ctx.dialog_open;
+            let has_doc = ctx.doc.is_some();
+            let mut item = |ui: &mut egui::Ui, enabled: bool, text: &str, action: Action| {
+                if ui.add_enabled(enabled, egui::Button::new(text)).clicked() {
+                    actions.push(action);
+                    ui.close();
+                }
+            };
+            item(ui, true, "New site…", Action::ShowNewSite);
+            let dialog = Action::RequestDialog;
+            item(ui, !busy, "Open site…", dialog(DialogPurpose::OpenSite));
+            item(ui, has_doc, "Save", Action::Save);
+            let enabled = has_doc && !busy;
+            item(ui, enabled, "Save as…", dialog(DialogPurpose::SaveSiteAs));
             ui.separator();
-            if ui
-                .add_enabled(
-                    has_doc && !busy,
-                    egui::Button::new("Import control points…"),
-                )
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::ImportPoints, &ctx);
-                ui.close();
-            }
-            if ui
-                .add_enabled(has_doc && !busy, egui::Button::new("Import model…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::ImportModel, &ctx);
-                ui.close();
-            }
-            let has_montage = self
-                .render
-                .montage()
-                .is_some_and(|m| self.current_photo.as_deref() == Some(m.photo_id.as_str()));
-            if ui
-                .add_enabled(has_montage && !busy, egui::Button::new("Export render…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::ExportRender, &ctx);
-                ui.close();
-            }
+            let import = dialog(DialogPurpose::ImportPoints);
+            item(ui, enabled, "Import control points…", import);
+            item(
+                ui,
+                enabled,
+                "Import model…",
+                dialog(DialogPurpose::ImportModel),
+            );
+            let export = dialog(DialogPurpose::ExportRender);
+            item(ui, ctx.has_montage && !busy, "Export render…", export);
             ui.separator();
             ui.label("Recent sites");
-            let entries = self.recent_sites();
+            let entries = recent_entries(ctx.recent_sites);
             if entries.is_empty() {
                 ui.colored_label(Color32::GRAY, "none yet");
             }
@@ -411,14 +389,12 @@ impl crate::Studio {
                     r.on_disabled_hover_text("file not found (moved or deleted)")
                 };
                 if r.clicked() {
-                    open_recent = Some(e.path);
+                    actions.push(Action::OpenSite(e.path));
                     ui.close();
                 }
             }
         });
-        if let Some(p) = open_recent {
-            self.open(&p);
-        }
+        actions
     }
 }
 

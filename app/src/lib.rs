@@ -84,6 +84,11 @@ macro_rules! panel_context {
             can_redo: $s.history.can_redo(),
             solving: $s.solver.busy(),
             dialog_open: $s.dialogs.busy(),
+            has_montage: $s
+                .render
+                .montage()
+                .is_some_and(|m| $s.current_photo.as_deref() == Some(m.photo_id.as_str())),
+            recent_sites: &$s.ui_state.recent_sites,
         }
     };
 }
@@ -161,6 +166,7 @@ pub struct Studio {
     points: points::PointsPanel,
     results: solve::ResultsPanel,
     toolbar: chrome::Toolbar,
+    file_menu: files::FileMenu,
     photo_strip: chrome::PhotoStrip,
     pending: Vec<(Command, Option<String>)>,
     /// What the panels asked for this frame ([`panel::Panel`]), done after the layout.
@@ -208,6 +214,7 @@ impl Studio {
             points: points::PointsPanel::default(),
             results: solve::ResultsPanel,
             toolbar: chrome::Toolbar::default(),
+            file_menu: files::FileMenu,
             photo_strip: chrome::PhotoStrip,
             pending: Vec::new(),
             actions: Vec::new(),
@@ -533,9 +540,9 @@ impl Studio {
 
     fn toolbar_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            self.file_menu_ui(ui);
             let ctx = panel_context!(self);
-            let actions = self.toolbar.ui(ui, &ctx);
+            let mut actions = self.file_menu.ui(ui, &ctx);
+            actions.extend(self.toolbar.ui(ui, &ctx));
             self.actions.extend(actions);
         });
     }
@@ -578,6 +585,7 @@ impl Studio {
             Action::OpenPhotoSettings(id) => self.open_photo_settings(&id),
             Action::RequestDialog(purpose) => self.request_dialog(purpose, ctx),
             Action::CreateNewSite => self.create_new_site(),
+            Action::ShowNewSite => self.new_site.open = true,
             Action::ImportPoints => self.import(),
             Action::SetResiduals(r) => {
                 self.ui_state.show_residuals = r.show;

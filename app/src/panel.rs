@@ -7,9 +7,9 @@
 //! `SystemCommand`).
 //!
 //! # Known limitations
-//! The six side tabs, the toolbar, the photo strip ([`crate::chrome`]) and the New site and
-//! Camera settings windows are panels; the File menu and the photo view with its pickers
-//! (points, scene vertices, fit samples) are still drawn by `impl Studio` methods.
+//! The six side tabs, the toolbar, the photo strip ([`crate::chrome`]), the File menu and the
+//! New site and Camera settings windows are panels; the photo view with its pickers (points,
+//! scene vertices, fit samples) is still drawn by `impl Studio` methods.
 
 use eframe::egui;
 use photomontage::site::{SiteDocument, SiteSolution};
@@ -37,6 +37,10 @@ pub struct PanelContext<'a> {
     pub solving: bool,
     /// Whether a file dialog is open (one at a time).
     pub dialog_open: bool,
+    /// Whether a finished montage of the current photo exists (Export render…).
+    pub has_montage: bool,
+    /// The recent sites, newest first.
+    pub recent_sites: &'a [std::path::PathBuf],
 }
 
 /// How the residual vectors of the last solve are drawn on the photo.
@@ -89,6 +93,8 @@ pub enum Action {
     OpenPhotoSettings(String),
     /// Open the file dialog for this purpose (on its worker).
     RequestDialog(crate::files::DialogPurpose),
+    /// Show the New site window.
+    ShowNewSite,
     /// Create the site of the New site window and open it.
     CreateNewSite,
     /// Change how residual vectors are drawn (Results tab).

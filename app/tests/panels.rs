@@ -51,6 +51,8 @@ fn harness<P: Panel + 'static>(panel: P, can_undo: bool, row: bool) -> Harness<'
                     can_redo: false,
                     solving: false,
                     dialog_open: false,
+                    has_montage: false,
+                    recent_sites: &[],
                 };
                 let actions = if row {
                     ui.horizontal(|ui| s.panel.ui(ui, &ctx)).inner
