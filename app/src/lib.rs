@@ -14,8 +14,9 @@
 //!   decoding run on it, with progress, cancellation and panic capture (a crashed job is a
 //!   message, never a panel busy forever); [`jobs`] starts and polls them.
 //! - **Panels as types** ([`panel::Panel`]): the six side tabs, the toolbar and the photo strip
-//!   ([`chrome`]) draw from a read-only [`panel::PanelContext`] and return [`panel::Action`]s,
-//!   which [`Studio`] applies after the frame's layout; shared widgets are in [`widgets`].
+//!   ([`chrome`]), the File menu ([`files::FileMenu`]) and the New site and Camera settings
+//!   windows draw from a read-only [`panel::PanelContext`] and return [`panel::Action`]s, which
+//!   [`Studio`] applies after the frame's layout; shared widgets are in [`widgets`].
 //! - **One command path**: every edit goes through [`Studio::apply`] (→ [`commands::History`]),
 //!   so undo/redo and the autosave see all of them (rerun's `SystemCommand`).
 //! - Computation lives in the library: model placement and wireframe edges
@@ -23,14 +24,16 @@
 //!   (`photomontage::site::photo_points`), solve, fit, render.
 //!
 //! # Known limitations
-//! See each module's own list. The File menu, the New site and Camera settings windows, the
-//! photo view and its pickers are still `impl Studio` methods in their modules rather than
-//! panels. Native file dialogs ([`files`]) cannot be driven by the
-//! headless tests, which use the typed-path fields and a substituted [`files::FilePicker`].
+//! See each module's own list. The photo view and its pickers (placing points, scene vertices,
+//! fit samples: [`photo_view`], [`scene_pick`], [`fit_pick`]) are still `impl Studio` methods
+//! rather than panels, and the actions' handlers (`start_render`, `import_model`, …) are
+//! `impl Studio` methods beside their panels. Native file dialogs ([`files`]) cannot be driven by the
+//! headless tests, which use the typed-path fields and a substituted [`dialogs::FilePicker`].
 
 pub mod autosave;
 pub mod chrome;
 pub mod commands;
+pub mod dialogs;
 pub mod files;
 pub mod fit_commands;
 pub mod fit_panel;

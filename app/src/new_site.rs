@@ -1,5 +1,5 @@
 //! File → New site…: a window where the user chooses the photos (the multi-select dialog of
-//! [`crate::files::FilePicker`], or a typed path added one at a time) and where the site file
+//! [`crate::dialogs::FilePicker`], or a typed path added one at a time) and where the site file
 //! goes (a save dialog or a typed path), then creates the site with the library's
 //! [`photomontage::site::new::create_site`] (one photo entry per file, interior orientation from
 //! EXIF or the stated fallback, paths relative to the site file, saved atomically and never over
@@ -14,7 +14,7 @@
 use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 
-use crate::files::DialogPurpose;
+use crate::dialogs::DialogPurpose;
 use crate::panel::{Action, Panel, PanelContext};
 use crate::widgets::name_widget;
 

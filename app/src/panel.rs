@@ -92,7 +92,7 @@ pub enum Action {
     /// Open a photo's camera settings window.
     OpenPhotoSettings(String),
     /// Open the file dialog for this purpose (on its worker).
-    RequestDialog(crate::files::DialogPurpose),
+    RequestDialog(crate::dialogs::DialogPurpose),
     /// Show the New site window.
     ShowNewSite,
     /// Create the site of the New site window and open it.
