@@ -12,7 +12,7 @@
 //! Structure:
 //! - **One worker type** ([`worker::Worker`]): solve, fit, render, file dialogs and photo
 //!   decoding run on it, with progress, cancellation and panic capture (a crashed job is a
-//!   message, never a panel busy forever); [`jobs`] starts and polls them.
+//!   message, never a panel busy forever); the `jobs` module starts and polls them.
 //! - **Panels as types** ([`panel::Panel`]): the six side tabs, the toolbar and the photo strip
 //!   ([`chrome`]), the File menu ([`files::FileMenu`]) and the New site and Camera settings
 //!   windows draw from a read-only [`panel::PanelContext`] and return [`panel::Action`]s, which
@@ -25,7 +25,7 @@
 //!
 //! # Known limitations
 //! See each module's own list. The photo view and its pickers (placing points, scene vertices,
-//! fit samples: [`photo_view`], [`scene_pick`], [`fit_pick`]) are still `impl Studio` methods
+//! fit samples: `photo_view`, [`scene_pick`], [`fit_pick`]) are still `impl Studio` methods
 //! rather than panels, and the actions' handlers (`start_render`, `import_model`, …) are
 //! `impl Studio` methods beside their panels. Native file dialogs ([`files`]) cannot be driven by the
 //! headless tests, which use the typed-path fields and a substituted [`dialogs::FilePicker`].
