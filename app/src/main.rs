@@ -18,7 +18,11 @@ use std::sync::{Arc, Mutex};
 
 /// The photomontage studio: opens SITE in the studio window.
 #[derive(Debug, clap::Parser)]
-#[command(name = "photomontage-studio", version, about)]
+#[command(
+    name = "photomontage-studio",
+    version,
+    about = "The photomontage studio: opens SITE (default: the bundled courtyard sample) in a window"
+)]
 struct Args {
     /// Site file to open (default: the bundled courtyard sample).
     site: Option<PathBuf>,
@@ -171,4 +175,46 @@ fn main() -> anyhow::Result<()> {
         Box::new(move |_cc| Ok(Box::new(shell))),
     )
     .map_err(|e| anyhow::anyhow!("cannot start the studio window: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::*;
+    use clap::CommandFactory as _;
+
+    #[test]
+    fn arguments_parse_as_documented() {
+        Args::command().debug_assert();
+        let a = Args::try_parse_from(["studio"]).unwrap();
+        assert!(a.site.is_none() && a.screenshot.is_none() && !a.headless && !a.solve);
+        assert_eq!(a.frames, 10);
+        let a = Args::try_parse_from([
+            "studio",
+            "s.toml",
+            "--screenshot",
+            "x.png",
+            "--frames",
+            "3",
+            "--solve",
+        ])
+        .unwrap();
+        assert_eq!(a.site, Some(PathBuf::from("s.toml")));
+        assert_eq!(a.screenshot, Some(PathBuf::from("x.png")));
+        assert_eq!(a.frames, 3);
+        assert!(a.solve);
+        let a = Args::try_parse_from(["studio", "--headless", "--script", "e.txt"]).unwrap();
+        assert!(a.headless && a.script == Some(PathBuf::from("e.txt")));
+        // Refused: frames without a screenshot, headless with a screenshot, two sites, a
+        // frame count that is not a whole number.
+        for bad in [
+            &["studio", "--frames", "3"][..],
+            &["studio", "--headless", "--screenshot", "x.png"],
+            &["studio", "a.toml", "b.toml"],
+            &["studio", "--screenshot", "x.png", "--frames", "many"],
+        ] {
+            assert!(Args::try_parse_from(bad).is_err(), "{bad:?} accepted");
+        }
+    }
 }
