@@ -1,4 +1,4 @@
-//! Panels as types: a side-tab panel owns its own state, draws itself from a read-only
+//! Panels as types: a panel (side tab, toolbar, menu, window) owns its own state, draws itself from a read-only
 //! [`PanelContext`] (the open site, the current photo) and returns the [`Action`]s its widgets
 //! asked for; the [`crate::Studio`] applies them after the frame. Edits of the user's data are
 //! [`Action::Edit`]s, which go through the one command path (`commands.rs`: undo/redo,

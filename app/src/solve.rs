@@ -1,7 +1,8 @@
 //! Solving in the studio: [`photomontage::site::solve_site`] (resection of every photo, then the
-//! bundle adjustment; Durisch 1992 §4.1) on the studio's [`crate::worker::Worker`] (a panic in the
-//! solver becomes a message); the residual table, the residual vectors drawn on the photo with a scale bar, and the
-//! warnings and failures as readable messages.
+//! bundle adjustment; Durisch 1992 §4.1) on the studio's [`crate::worker::Worker`] (a panic in
+//! the solver becomes a message); the Results tab ([`ResultsPanel`]) with the residual table,
+//! the residual vectors drawn on the photo with a scale bar, and the warnings and failures as
+//! readable messages.
 //!
 //! The table shows the numbers exactly as `photomontage solve` prints them (same rounding), so
 //! the two can be compared by eye and by the tests.
