@@ -1,9 +1,9 @@
-//! The studio's File menu: native file dialogs (the `rfd` crate; on Linux the XDG desktop
-//! portal over a dlopened libdbus, else zenity) shown on a worker thread so that the UI never
-//! blocks, and the recent-sites list (kept in [`crate::state::UiState`], at most
+//! The studio's File menu ([`FileMenu`], a panel): the native file dialogs of
+//! [`crate::dialogs`] (shown on a worker so that the UI never blocks) and what the studio does
+//! with their answers, and the recent-sites list (kept in [`crate::state::UiState`], at most
 //! [`crate::state::MAX_RECENT`], files that no longer exist greyed out with a tooltip).
 //!
-//! The dialog itself is behind the [`FilePicker`] trait so that tests (egui_kittest cannot drive
+//! The dialog itself is behind the [`crate::dialogs::FilePicker`] trait so that tests (egui_kittest cannot drive
 //! a native dialog) substitute a picker that answers with a fixed path. The typed-path fields of
 //! the toolbar and panels stay as the fallback.
 //!
@@ -15,218 +15,9 @@
 use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, channel};
 
-/// What a dialog is for (decides its title, filters and what happens with the answer).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DialogPurpose {
-    /// Open a site file.
-    OpenSite,
-    /// Save the site under a new name.
-    SaveSiteAs,
-    /// Import control points (CSV or OpenDroneMap gcp_list.txt).
-    ImportPoints,
-    /// Add a CAD model (OBJ, glTF/GLB, DXF) to the site.
-    ImportModel,
-    /// Export the rendered montage (.exr, .png, .jpg, .tif).
-    ExportRender,
-    /// Choose the photos of a new site (several at once).
-    NewSitePhotos,
-    /// Choose where a new site file goes.
-    NewSiteFile,
-}
-
-impl DialogPurpose {
-    /// Title of the dialog window.
-    #[must_use]
-    pub fn title(self) -> &'static str {
-        match self {
-            Self::OpenSite => "Open site",
-            Self::SaveSiteAs => "Save site as",
-            Self::ImportPoints => "Import control points",
-            Self::ImportModel => "Import model",
-            Self::ExportRender => "Export render",
-            Self::NewSitePhotos => "Photos of the new site",
-            Self::NewSiteFile => "New site file",
-        }
-    }
-
-    /// Whether the dialog chooses a file to write.
-    #[must_use]
-    pub fn is_save(self) -> bool {
-        matches!(
-            self,
-            Self::SaveSiteAs | Self::ExportRender | Self::NewSiteFile
-        )
-    }
-
-    /// Whether the dialog lets the user choose several files.
-    #[must_use]
-    pub fn is_multi(self) -> bool {
-        matches!(self, Self::NewSitePhotos)
-    }
-
-    /// File filters offered: (name, extensions without the dot).
-    #[must_use]
-    pub fn filters(self) -> &'static [(&'static str, &'static [&'static str])] {
-        match self {
-            Self::OpenSite | Self::SaveSiteAs | Self::NewSiteFile => &[("Site file", &["toml"])],
-            Self::NewSitePhotos => &[
-                (
-                    "Photos (JPEG, PNG, TIFF, EXR)",
-                    &["jpg", "jpeg", "JPG", "JPEG", "png", "tif", "tiff", "exr"],
-                ),
-                ("All files", &["*"]),
-            ],
-            Self::ImportPoints => &[
-                ("Control points (CSV, gcp_list.txt)", &["csv", "txt"]),
-                ("All files", &["*"]),
-            ],
-            Self::ImportModel => &[
-                ("CAD model (OBJ, glTF, DXF)", &["obj", "gltf", "glb", "dxf"]),
-                ("All files", &["*"]),
-            ],
-            Self::ExportRender => &[
-                ("OpenEXR (linear)", &["exr"]),
-                ("PNG", &["png"]),
-                ("JPEG", &["jpg", "jpeg"]),
-                ("TIFF", &["tif", "tiff"]),
-            ],
-        }
-    }
-}
-
-/// A request for a file dialog.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct DialogRequest {
-    /// What it is for.
-    pub purpose: DialogPurpose,
-    /// Folder to start in.
-    pub start_dir: Option<PathBuf>,
-    /// File name suggested (save dialogs).
-    pub file_name: Option<String>,
-}
-
-/// Shows a file dialog and returns the chosen path (`None`: cancelled). Called on a worker
-/// thread, never on the UI thread.
-pub trait FilePicker: Send + Sync {
-    /// Asks the user for a file.
-    fn pick(&self, request: &DialogRequest) -> Option<PathBuf>;
-
-    /// Asks the user for several files ([`DialogPurpose::is_multi`]); `None`: cancelled. By
-    /// default the single-file dialog.
-    fn pick_many(&self, request: &DialogRequest) -> Option<Vec<PathBuf>> {
-        self.pick(request).map(|p| vec![p])
-    }
-}
-
-/// The native dialog of the `rfd` crate.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct NativePicker;
-
-impl FilePicker for NativePicker {
-    fn pick(&self, request: &DialogRequest) -> Option<PathBuf> {
-        let mut dialog = rfd::FileDialog::new().set_title(request.purpose.title());
-        for (name, extensions) in request.purpose.filters() {
-            dialog = dialog.add_filter(*name, extensions);
-        }
-        if let Some(dir) = &request.start_dir {
-            dialog = dialog.set_directory(dir);
-        }
-        if let Some(name) = &request.file_name {
-            dialog = dialog.set_file_name(name);
-        }
-        if request.purpose.is_save() {
-            dialog.save_file()
-        } else {
-            dialog.pick_file()
-        }
-    }
-
-    fn pick_many(&self, request: &DialogRequest) -> Option<Vec<PathBuf>> {
-        let mut dialog = rfd::FileDialog::new().set_title(request.purpose.title());
-        for (name, extensions) in request.purpose.filters() {
-            dialog = dialog.add_filter(*name, extensions);
-        }
-        if let Some(dir) = &request.start_dir {
-            dialog = dialog.set_directory(dir);
-        }
-        dialog.pick_files()
-    }
-}
-
-/// Runs one dialog at a time on a worker thread and hands its answer back.
-pub struct DialogWorker {
-    picker: Arc<dyn FilePicker>,
-    /// The open dialog: its purpose and where its answer (empty: cancelled) arrives.
-    running: Option<(DialogPurpose, Receiver<Vec<PathBuf>>)>,
-}
-
-impl Default for DialogWorker {
-    fn default() -> Self {
-        Self::new(Arc::new(NativePicker))
-    }
-}
-
-impl DialogWorker {
-    /// A worker that asks `picker`.
-    #[must_use]
-    pub fn new(picker: Arc<dyn FilePicker>) -> Self {
-        Self {
-            picker,
-            running: None,
-        }
-    }
-
-    /// Whether a dialog is open.
-    #[must_use]
-    pub fn busy(&self) -> bool {
-        self.running.is_some()
-    }
-
-    /// Opens a dialog on a worker thread; `false` when one is already open.
-    pub fn start(&mut self, request: DialogRequest, ctx: &egui::Context) -> bool {
-        if self.running.is_some() {
-            return false;
-        }
-        let (tx, rx) = channel();
-        let picker = Arc::clone(&self.picker);
-        let ctx = ctx.clone();
-        let purpose = request.purpose;
-        let spawned = std::thread::Builder::new()
-            .name("file-dialog".into())
-            .spawn(move || {
-                let answer = if request.purpose.is_multi() {
-                    picker.pick_many(&request).unwrap_or_default()
-                } else {
-                    picker.pick(&request).into_iter().collect()
-                };
-                // A closed channel means the studio is gone; nothing to report to.
-                let _ = tx.send(answer);
-                ctx.request_repaint();
-            });
-        if spawned.is_err() {
-            return false;
-        }
-        self.running = Some((purpose, rx));
-        true
-    }
-
-    /// The answer of the open dialog once it is closed: (purpose, chosen paths; empty when
-    /// cancelled).
-    pub fn poll(&mut self) -> Option<(DialogPurpose, Vec<PathBuf>)> {
-        let (purpose, rx) = self.running.as_ref()?;
-        let purpose = *purpose;
-        let answer = match rx.try_recv() {
-            Ok(a) => a,
-            Err(std::sync::mpsc::TryRecvError::Empty) => return None,
-            // The worker died without answering: treat as cancelled.
-            Err(std::sync::mpsc::TryRecvError::Disconnected) => Vec::new(),
-        };
-        self.running = None;
-        Some((purpose, answer))
-    }
-}
+pub use crate::dialogs::{DialogPurpose, DialogRequest, DialogWorker, FilePicker, NativePicker};
+use crate::panel::{Action, Panel, PanelContext};
 
 /// A recent-sites entry as the menu shows it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -292,6 +83,13 @@ impl crate::Studio {
         let Some((purpose, answer)) = self.dialogs.poll() else {
             return;
         };
+        let answer = match answer {
+            Ok(a) => a,
+            Err(e) => {
+                self.say(format!("the {} dialog failed: {e}", purpose.title()), true);
+                return;
+            }
+        };
         if purpose == DialogPurpose::NewSitePhotos {
             self.new_site.add_photos(answer);
             return;
@@ -341,68 +139,45 @@ impl crate::Studio {
     pub fn recent_sites(&self) -> Vec<RecentEntry> {
         recent_entries(&self.ui_state.recent_sites)
     }
+}
 
-    /// The File menu.
-    pub(crate) fn file_menu_ui(&mut self, ui: &mut egui::Ui) {
-        let mut open_recent = None;
+/// The File menu: New site…, Open site…, Save, Save as…, the imports, Export render… and the
+/// recent sites.
+#[derive(Debug, Default)]
+pub struct FileMenu;
+
+impl Panel for FileMenu {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut actions = Vec::new();
         ui.menu_button("File", |ui| {
-            let ctx = ui.ctx().clone();
-            let busy = self.dialogs.busy();
-            let has_doc = self.doc.is_some();
-            if ui.button("New site…").clicked() {
-                self.new_site.open = true;
-                ui.close();
-            }
-            if ui
-                .add_enabled(!busy, egui::Button::new("Open site…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::OpenSite, &ctx);
-                ui.close();
-            }
-            if ui.add_enabled(has_doc, egui::Button::new("Save")).clicked() {
-                self.save();
-                ui.close();
-            }
-            if ui
-                .add_enabled(has_doc && !busy, egui::Button::new("Save as…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::SaveSiteAs, &ctx);
-                ui.close();
-            }
+            let busy = ctx.dialog_open;
+            let has_doc = ctx.doc.is_some();
+            let mut item = |ui: &mut egui::Ui, enabled: bool, text: &str, action: Action| {
+                if ui.add_enabled(enabled, egui::Button::new(text)).clicked() {
+                    actions.push(action);
+                    ui.close();
+                }
+            };
+            item(ui, true, "New site…", Action::ShowNewSite);
+            let dialog = Action::RequestDialog;
+            item(ui, !busy, "Open site…", dialog(DialogPurpose::OpenSite));
+            item(ui, has_doc, "Save", Action::Save);
+            let enabled = has_doc && !busy;
+            item(ui, enabled, "Save as…", dialog(DialogPurpose::SaveSiteAs));
             ui.separator();
-            if ui
-                .add_enabled(
-                    has_doc && !busy,
-                    egui::Button::new("Import control points…"),
-                )
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::ImportPoints, &ctx);
-                ui.close();
-            }
-            if ui
-                .add_enabled(has_doc && !busy, egui::Button::new("Import model…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::ImportModel, &ctx);
-                ui.close();
-            }
-            let has_montage = self
-                .render
-                .montage()
-                .is_some_and(|m| self.current_photo.as_deref() == Some(m.photo_id.as_str()));
-            if ui
-                .add_enabled(has_montage && !busy, egui::Button::new("Export render…"))
-                .clicked()
-            {
-                self.request_dialog(DialogPurpose::ExportRender, &ctx);
-                ui.close();
-            }
+            let import = dialog(DialogPurpose::ImportPoints);
+            item(ui, enabled, "Import control points…", import);
+            item(
+                ui,
+                enabled,
+                "Import model…",
+                dialog(DialogPurpose::ImportModel),
+            );
+            let export = dialog(DialogPurpose::ExportRender);
+            item(ui, ctx.has_montage && !busy, "Export render…", export);
             ui.separator();
             ui.label("Recent sites");
-            let entries = self.recent_sites();
+            let entries = recent_entries(ctx.recent_sites);
             if entries.is_empty() {
                 ui.colored_label(Color32::GRAY, "none yet");
             }
@@ -415,85 +190,18 @@ impl crate::Studio {
                     r.on_disabled_hover_text("file not found (moved or deleted)")
                 };
                 if r.clicked() {
-                    open_recent = Some(e.path);
+                    actions.push(Action::OpenSite(e.path));
                     ui.close();
                 }
             }
         });
-        if let Some(p) = open_recent {
-            self.open(&p);
-        }
+        actions
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct Fixed(PathBuf);
-    impl FilePicker for Fixed {
-        fn pick(&self, _: &DialogRequest) -> Option<PathBuf> {
-            Some(self.0.clone())
-        }
-    }
-
-    #[test]
-    fn worker_hands_back_the_pickers_answer_once() {
-        let ctx = egui::Context::default();
-        let mut w = DialogWorker::new(Arc::new(Fixed(PathBuf::from("/x/site.toml"))));
-        let req = DialogRequest {
-            purpose: DialogPurpose::OpenSite,
-            start_dir: None,
-            file_name: None,
-        };
-        assert!(w.start(req.clone(), &ctx));
-        assert!(
-            !w.start(req, &ctx),
-            "second dialog refused while one is open"
-        );
-        let start = std::time::Instant::now();
-        let answer = loop {
-            if let Some(a) = w.poll() {
-                break a;
-            }
-            assert!(start.elapsed().as_secs() < 10, "worker never answered");
-            std::thread::sleep(std::time::Duration::from_millis(5));
-        };
-        assert_eq!(
-            answer,
-            (DialogPurpose::OpenSite, vec![PathBuf::from("/x/site.toml")])
-        );
-        assert!(!w.busy());
-        assert!(w.poll().is_none());
-    }
-
-    #[test]
-    fn a_multi_select_dialog_falls_back_to_the_single_pick() {
-        let ctx = egui::Context::default();
-        let mut w = DialogWorker::new(Arc::new(Fixed(PathBuf::from("/x/p1.jpg"))));
-        let req = DialogRequest {
-            purpose: DialogPurpose::NewSitePhotos,
-            start_dir: None,
-            file_name: None,
-        };
-        assert!(req.purpose.is_multi() && !req.purpose.is_save());
-        assert!(w.start(req, &ctx));
-        let start = std::time::Instant::now();
-        let answer = loop {
-            if let Some(a) = w.poll() {
-                break a;
-            }
-            assert!(start.elapsed().as_secs() < 10, "worker never answered");
-            std::thread::sleep(std::time::Duration::from_millis(5));
-        };
-        assert_eq!(
-            answer,
-            (
-                DialogPurpose::NewSitePhotos,
-                vec![PathBuf::from("/x/p1.jpg")]
-            )
-        );
-    }
 
     #[test]
     fn recent_entries_mark_missing_files() {

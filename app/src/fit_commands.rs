@@ -1,6 +1,7 @@
 //! The lighting fit's edits of the site (Durisch 1992 §4.2–4.3: colour samples on scene
 //! polygons, horizon rectangles, the `[fit_settings]`, and the fitted lighting written back):
-//! one [`FitCommand`] carried by [`crate::commands::Command::Fit`] through the one command path,
+//! one [`FitCommand`] carried by the studio's `Command::Fit` through the one command path
+//! (this module does not import `commands`: the dependency runs one way),
 //! each returning its exact inverse (positions restored, so an undone edit leaves the saved file
 //! byte-identical).
 //!
@@ -9,7 +10,14 @@
 
 use photomontage::site::{FitRecord, FitSettings, HorizonSample, Lighting, Sample, Site};
 
-use crate::commands::{Command, CommandError};
+/// What can go wrong applying a fit command (converted into
+/// the command path's `CommandError`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FitCommandError {
+    /// No sample or horizon sample with this id.
+    #[error("no sample `{id}`")]
+    NoSuchSample { id: String },
+}
 
 /// One edit of the fit's data.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,12 +79,12 @@ fn put<T>(
     }
 }
 
-/// Applies `command` to `site` and returns its inverse (as a [`Command`]).
+/// Applies `command` to `site` and returns its inverse.
 ///
 /// # Errors
-/// [`CommandError::NoSuchSample`] when removing a sample the site does not have; the site is
+/// [`FitCommandError::NoSuchSample`] when removing a sample the site does not have; the site is
 /// unchanged then.
-pub fn apply(site: &mut Site, command: FitCommand) -> Result<Command, CommandError> {
+pub fn apply(site: &mut Site, command: FitCommand) -> Result<FitCommand, FitCommandError> {
     let inverse = match command {
         FitCommand::PutSample { sample, at } => put(
             &mut site.samples,
@@ -91,7 +99,7 @@ pub fn apply(site: &mut Site, command: FitCommand) -> Result<Command, CommandErr
                 .samples
                 .iter()
                 .position(|s| s.id == id)
-                .ok_or(CommandError::NoSuchSample { id })?;
+                .ok_or(FitCommandError::NoSuchSample { id })?;
             FitCommand::PutSample {
                 sample: site.samples.remove(i),
                 at: Some(i),
@@ -110,7 +118,7 @@ pub fn apply(site: &mut Site, command: FitCommand) -> Result<Command, CommandErr
                 .horizon_samples
                 .iter()
                 .position(|s| s.id == id)
-                .ok_or(CommandError::NoSuchSample { id })?;
+                .ok_or(FitCommandError::NoSuchSample { id })?;
             FitCommand::PutHorizonSample {
                 sample: site.horizon_samples.remove(i),
                 at: Some(i),
@@ -124,7 +132,7 @@ pub fn apply(site: &mut Site, command: FitCommand) -> Result<Command, CommandErr
             record: std::mem::replace(&mut site.fit, record.map(|r| *r)).map(Box::new),
         },
     };
-    Ok(Command::Fit(inverse))
+    Ok(inverse)
 }
 
 /// The first id `PREFIX1`, `PREFIX2`, … not in `taken`.
@@ -139,97 +147,15 @@ pub fn next_id<'a>(prefix: &str, taken: impl Iterator<Item = &'a str> + Clone) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::commands::History;
-    use photomontage::site::SamplePurpose;
-
-    fn sample(id: &str) -> Sample {
-        Sample {
-            id: id.into(),
-            photo: "P1".into(),
-            material: "paving".into(),
-            purpose: SamplePurpose::Daylight,
-            point: None,
-            x_px: Some(10.0),
-            y_px: Some(20.0),
-            window_px: 5,
-            enabled: true,
-        }
-    }
 
     #[test]
-    fn sample_edits_undo_to_the_exact_site() {
-        let mut s = Site {
-            samples: vec![sample("S1"), sample("S2"), sample("S3")],
-            ..Site::default()
-        };
-        let original = s.clone();
-        let mut h = History::default();
-        h.apply(
-            &mut s,
-            Command::Fit(FitCommand::RemoveSample { id: "S2".into() }),
-        )
-        .expect("remove");
-        let mut off = sample("S1");
-        off.enabled = false;
-        off.purpose = SamplePurpose::Atmosphere;
-        h.apply(
-            &mut s,
-            Command::Fit(FitCommand::PutSample {
-                sample: off,
-                at: None,
-            }),
-        )
-        .expect("edit");
-        h.apply(
-            &mut s,
-            Command::Fit(FitCommand::PutHorizonSample {
-                sample: HorizonSample {
-                    id: "H1".into(),
-                    photo: "P1".into(),
-                    origin_px: [1, 2],
-                    size_px: [30, 10],
-                    enabled: true,
-                },
-                at: None,
-            }),
-        )
-        .expect("horizon");
-        h.apply(
-            &mut s,
-            Command::Fit(FitCommand::SetFitSettings(FitSettings {
-                interreflection: false,
-                ambient: false,
-            })),
-        )
-        .expect("settings");
-        let mut lit = s.lighting.clone();
-        lit.sun_weight = [2.0, 3.0, 4.0];
-        h.apply(
-            &mut s,
-            Command::Fit(FitCommand::SetLighting {
-                lighting: Box::new(lit),
-                record: None,
-            }),
-        )
-        .expect("lighting");
-        let edited = s.clone();
-        assert_eq!(s.samples.len(), 2);
-        assert!(!s.samples[0].enabled);
-        for _ in 0..5 {
-            h.undo(&mut s).expect("undo");
-        }
-        assert_eq!(s, original, "order and values restored");
-        for _ in 0..5 {
-            h.redo(&mut s).expect("redo");
-        }
-        assert_eq!(s, edited);
+    fn removing_a_missing_sample_is_an_error_and_changes_nothing() {
+        let mut s = Site::default();
         assert_eq!(
-            h.apply(
-                &mut s,
-                Command::Fit(FitCommand::RemoveSample { id: "nope".into() })
-            ),
-            Err(CommandError::NoSuchSample { id: "nope".into() })
+            apply(&mut s, FitCommand::RemoveHorizonSample { id: "H9".into() }),
+            Err(FitCommandError::NoSuchSample { id: "H9".into() })
         );
+        assert_eq!(s, Site::default());
     }
 
     #[test]

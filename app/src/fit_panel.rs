@@ -5,9 +5,9 @@
 //!   window, on/off, delete, and the `[fit_settings]` toggles; every change is a
 //!   [`crate::fit_commands::FitCommand`] through the one command path (undo/redo, autosave).
 //!   Samples are picked on the photo ([`crate::fit_pick`]).
-//! - **Run fit** calls `photomontage::fit::site::fit_site` (the CLI's call, default options) on a
-//!   snapshot of the site on a named worker thread; the solver iterations come back through a
-//!   `FitObserver` and are shown as progress, and the same observer carries **Cancel fit**. The results panel shows the report's numbers
+//! - **Run fit** runs `photomontage::fit::site::fit_site` on the studio's worker
+//!   ([`crate::fit_worker`]); the solver iterations are shown as progress and **Cancel fit**
+//!   stops it at its next step. The results panel shows the report's numbers
 //!   formatted as the CLI prints them (5 decimals): τₐ over 1 km, L∞, k_s, k_u, k_h with σ,
 //!   absolute/relative weights, the sun cross-checks, the warnings and the residual table (flagged
 //!   rows in red). Errors (`SiteFitError`) are shown as their messages.
@@ -23,22 +23,21 @@
 
 use eframe::egui::{self, Color32};
 use egui_extras::{Column, TableBuilder};
-use photomontage::fit::site::{SiteFitOptions, SiteFitReport, apply_fit, fit_site};
-use photomontage::fit::{FitIteration, FitObserver, FitStage};
-use photomontage::site::{FitSettings, SamplePurpose, Site, SiteDocument};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use photomontage::fit::site::{SiteFitReport, apply_fit};
+use photomontage::site::SamplePurpose;
 
 use crate::commands::Command;
 use crate::fit_commands::FitCommand;
-use crate::points::name_widget;
+use crate::fit_tables::{horizons_table_ui, purpose_name, samples_table_ui, settings_ui};
+use crate::fit_worker::FitWorker;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
+use crate::worker::Poll;
 
 /// Colour of flagged rows and errors.
 pub const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
 /// Colour of warnings.
-pub const WARNING: Color32 = Color32::from_rgb(230, 160, 40);
+pub const WARNING: Color32 = crate::widgets::WARNING;
 
 /// An RGB triple as `photomontage fit` prints it.
 #[must_use]
@@ -94,139 +93,6 @@ pub fn rfc3339_utc(secs: u64) -> String {
     )
 }
 
-/// The latest solver iteration and the cancel request, shared with the worker.
-struct Progress {
-    latest: Mutex<Option<FitIteration>>,
-    cancel: AtomicBool,
-    ctx: egui::Context,
-}
-
-impl FitObserver for Progress {
-    fn on_iteration(&self, event: &FitIteration) {
-        if let Ok(mut l) = self.latest.lock() {
-            *l = Some(*event);
-        }
-        self.ctx.request_repaint();
-    }
-
-    fn cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
-    }
-}
-
-/// A fit running on the worker thread.
-#[derive(Default)]
-pub struct FitWorker {
-    rx: Option<mpsc::Receiver<Result<SiteFitReport, String>>>,
-    progress: Option<Arc<Progress>>,
-    started: Option<Instant>,
-}
-
-impl FitWorker {
-    /// Starts `fit_site` on a snapshot of the site. False when a fit is already running.
-    pub fn start(&mut self, doc: SiteDocument, ctx: egui::Context) -> bool {
-        if self.rx.is_some() {
-            return false;
-        }
-        let (tx, rx) = mpsc::channel();
-        let progress = Arc::new(Progress {
-            latest: Mutex::new(None),
-            cancel: AtomicBool::new(false),
-            ctx: ctx.clone(),
-        });
-        let observer: Arc<dyn FitObserver> = progress.clone();
-        let spawned = std::thread::Builder::new()
-            .name("lighting fit".into())
-            .spawn(move || {
-                // The observer only stores the latest iteration (a Mutex): a panic leaves
-                // nothing half-updated that the UI could misread.
-                let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
-                    fit_site(&doc, &SiteFitOptions::default(), Some(observer))
-                        .map_err(|e| e.to_string())
-                }))
-                .unwrap_or_else(|_| Err("the fit crashed; the site is unchanged".into()));
-                let _ = tx.send(result);
-                ctx.request_repaint();
-            });
-        if spawned.is_err() {
-            return false;
-        }
-        self.rx = Some(rx);
-        self.progress = Some(progress);
-        self.started = Some(Instant::now());
-        true
-    }
-
-    /// Whether a fit is running.
-    #[must_use]
-    pub fn busy(&self) -> bool {
-        self.rx.is_some()
-    }
-
-    /// Asks the running fit to stop at its next step (the library polls
-    /// `FitObserver::cancelled` before each sample and each daylight pass); it then reports
-    /// `the fit was cancelled`.
-    pub fn cancel(&self) {
-        if let Some(p) = &self.progress {
-            p.cancel.store(true, Ordering::Relaxed);
-        }
-    }
-
-    /// Whether a cancel was requested for the running fit.
-    #[must_use]
-    pub fn cancelling(&self) -> bool {
-        self.progress
-            .as_ref()
-            .is_some_and(|p| p.cancel.load(Ordering::Relaxed))
-    }
-
-    /// The outcome once the worker has finished.
-    pub fn poll(&mut self) -> Option<Result<SiteFitReport, String>> {
-        let rx = self.rx.as_ref()?;
-        let out = match rx.try_recv() {
-            Ok(r) => r,
-            Err(mpsc::TryRecvError::Empty) => return None,
-            Err(mpsc::TryRecvError::Disconnected) => {
-                Err("the fit worker stopped without an answer".into())
-            }
-        };
-        self.rx = None;
-        self.progress = None;
-        self.started = None;
-        Some(out)
-    }
-
-    /// A line describing the progress: elapsed time and the latest solver iteration.
-    #[must_use]
-    pub fn progress_text(&self) -> Option<String> {
-        let started = self.started?;
-        let secs = started.elapsed().as_secs_f64();
-        let latest = self
-            .progress
-            .as_ref()
-            .and_then(|p| p.latest.lock().ok().and_then(|l| *l));
-        if self.cancelling() {
-            return Some(format!(
-                "cancelling… {secs:.1} s (stops at the fit's next step)"
-            ));
-        }
-        Some(match latest {
-            None => format!("fitting… {secs:.1} s (locating and reading samples)"),
-            Some(e) => {
-                let stage = match e.stage {
-                    FitStage::Atmosphere => "atmosphere (eq. 7)",
-                    FitStage::Daylight => "daylight (eq. 9)",
-                };
-                let channel = ["red", "green", "blue"].get(e.channel).unwrap_or(&"?");
-                format!(
-                    "fitting… {secs:.1} s: {stage} {channel} iteration {} |r| = {:.3e}",
-                    e.iteration, e.cost
-                )
-            }
-        })
-    }
-}
-
 /// State of the Fit tab.
 pub struct FitPanel {
     /// Purpose of samples picked on the photo.
@@ -256,13 +122,6 @@ impl Default for FitPanel {
     }
 }
 
-fn purpose_name(p: SamplePurpose) -> &'static str {
-    match p {
-        SamplePurpose::Daylight => "daylight",
-        SamplePurpose::Atmosphere => "atmosphere",
-    }
-}
-
 impl crate::Studio {
     /// The Fit tab's state.
     pub fn fit_panel_mut(&mut self) -> &mut FitPanel {
@@ -280,7 +139,7 @@ impl crate::Studio {
         let Some(doc) = self.doc.clone() else {
             return;
         };
-        if self.fit.worker.start(doc, ctx.clone()) {
+        if self.fit.worker.start(doc, ctx) {
             self.fit.error = None;
             self.say("fitting the lighting…", false);
         } else {
@@ -310,7 +169,7 @@ impl crate::Studio {
 
     pub(crate) fn poll_fit(&mut self, ctx: &egui::Context) {
         match self.fit.worker.poll() {
-            Some(Ok(report)) => {
+            Poll::Done(Ok(report)) => {
                 let flagged = report.residuals.iter().filter(|r| r.flagged).count();
                 self.say(
                     format!(
@@ -323,38 +182,44 @@ impl crate::Studio {
                 self.fit.report = Some(report);
                 self.fit.error = None;
             }
-            Some(Err(e)) => {
+            Poll::Done(Err(e)) | Poll::Failed(e) => {
                 self.say(format!("fit failed: {e}"), true);
                 self.fit.error = Some(e);
             }
-            None => {}
+            Poll::Cancelled => {
+                self.say("fit cancelled; the site is unchanged", false);
+                self.fit.error = Some("the fit was cancelled".into());
+            }
+            Poll::Idle | Poll::Running(_) => {}
         }
         if self.fit.worker.busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
     }
+}
 
-    pub(crate) fn fit_tab_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(doc) = self.doc.as_ref() else {
-            return;
+impl Panel for FitPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let Some(doc) = ctx.doc else {
+            return Vec::new();
         };
-        let site = doc.site.clone();
+        let site = &doc.site;
         let mut commands: Vec<(Command, Option<String>)> = Vec::new();
         let (mut run, mut cancel, mut apply) = (false, false, false);
         ui.horizontal(|ui| {
-            let busy = self.fit.worker.busy();
+            let busy = self.worker.busy();
             run = ui
                 .add_enabled(!busy, egui::Button::new("Run fit"))
                 .clicked();
             cancel = ui
                 .add_enabled(
-                    busy && !self.fit.worker.cancelling(),
+                    busy && !self.worker.cancelling(),
                     egui::Button::new("Cancel fit"),
                 )
                 .clicked();
             apply = ui
                 .add_enabled(
-                    !busy && self.fit.report.is_some(),
+                    !busy && self.report.is_some(),
                     egui::Button::new("Apply fit"),
                 )
                 .on_hover_text("write the fitted lighting into the site (undoable)")
@@ -363,23 +228,23 @@ impl crate::Studio {
                 ui.spinner();
             }
         });
-        if let Some(p) = self.fit.worker.progress_text() {
+        if let Some(p) = self.worker.progress_text() {
             ui.label(p);
         }
         settings_ui(ui, site.fit_settings, &mut commands);
         ui.horizontal(|ui| {
             ui.label("new samples:");
             for p in [SamplePurpose::Daylight, SamplePurpose::Atmosphere] {
-                let r = ui.radio_value(&mut self.fit.purpose, p, purpose_name(p));
+                let r = ui.radio_value(&mut self.purpose, p, purpose_name(p));
                 name_widget(ui, &r, &format!("pick purpose {}", purpose_name(p)));
             }
             let r = ui.add(
-                egui::DragValue::new(&mut self.fit.window_px)
+                egui::DragValue::new(&mut self.window_px)
                     .range(1..=101)
                     .suffix(" px"),
             );
             name_widget(ui, &r, "pick window");
-            self.fit.window_px |= 1;
+            self.window_px |= 1;
         });
         ui.label(
             "click the photo to add a sample on the polygon under the cursor; Shift-drag draws a \
@@ -389,222 +254,37 @@ impl crate::Studio {
             .auto_shrink([false, false])
             .show(ui, |ui| {
                 ui.strong(format!("Samples ({})", site.samples.len()));
-                samples_table_ui(ui, &site, &mut commands);
+                samples_table_ui(ui, site, &mut commands);
                 ui.strong(format!("Horizon samples ({})", site.horizon_samples.len()));
-                horizons_table_ui(ui, &site, &mut commands);
+                horizons_table_ui(ui, site, &mut commands);
                 ui.separator();
-                if let Some(e) = &self.fit.error {
+                if let Some(e) = &self.error {
                     ui.colored_label(FLAGGED, format!("fit failed: {e}"));
                 }
-                if let Some(r) = &self.fit.report {
+                if let Some(r) = &self.report {
                     report_ui(ui, r, site.solve.outlier_threshold_sigma);
-                } else if self.fit.error.is_none() {
+                } else if self.error.is_none() {
                     ui.label("not fitted yet: press Run fit");
                 }
             });
-        self.pending.extend(commands);
-        if run {
-            let ctx = ui.ctx().clone();
-            self.start_fit(&ctx);
+        let mut actions: Vec<Action> = commands
+            .into_iter()
+            .map(|(command, merge_key)| Action::Edit {
+                command: Box::new(command),
+                merge_key,
+            })
+            .collect();
+        for (asked, action) in [
+            (run, Action::StartFit),
+            (cancel, Action::CancelFit),
+            (apply, Action::ApplyFit),
+        ] {
+            if asked {
+                actions.push(action);
+            }
         }
-        if cancel {
-            self.fit.worker.cancel();
-        }
-        if apply {
-            self.apply_fit_report();
-        }
+        actions
     }
-}
-
-fn settings_ui(
-    ui: &mut egui::Ui,
-    settings: FitSettings,
-    commands: &mut Vec<(Command, Option<String>)>,
-) {
-    ui.horizontal(|ui| {
-        let mut s = settings;
-        let r = ui
-            .checkbox(&mut s.interreflection, "interreflection E_r")
-            .on_hover_text("subtract the light the photographed surroundings reflect onto each daylight sample");
-        name_widget(ui, &r, "interreflection");
-        let r2 = ui
-            .checkbox(&mut s.ambient, "fit ambient k_u")
-            .on_hover_text("off: k_u = 0 (the sky model carries all diffuse light)");
-        name_widget(ui, &r2, "fit ambient");
-        if s != settings {
-            commands.push((Command::Fit(FitCommand::SetFitSettings(s)), None));
-        }
-    });
-}
-
-fn samples_table_ui(ui: &mut egui::Ui, site: &Site, commands: &mut Vec<(Command, Option<String>)>) {
-    if site.samples.is_empty() {
-        ui.label("none: click the photo to add one");
-        return;
-    }
-    TableBuilder::new(ui)
-        .id_salt("fit samples")
-        .striped(true)
-        .column(Column::auto().at_least(40.0))
-        .column(Column::auto().at_least(36.0))
-        .column(Column::auto().at_least(90.0))
-        .column(Column::auto().at_least(110.0))
-        .column(Column::auto().at_least(74.0))
-        .column(Column::auto().at_least(56.0))
-        .column(Column::auto().at_least(24.0))
-        .column(Column::remainder().at_least(30.0))
-        .max_scroll_height(220.0)
-        .header(20.0, |mut h| {
-            for t in [
-                "id", "photo", "material", "at", "purpose", "window", "on", "",
-            ] {
-                h.col(|ui| {
-                    ui.strong(t);
-                });
-            }
-        })
-        .body(|mut body| {
-            for s in &site.samples {
-                body.row(22.0, |mut row| {
-                    row.col(|ui| {
-                        ui.label(&s.id);
-                    });
-                    row.col(|ui| {
-                        ui.label(&s.photo);
-                    });
-                    row.col(|ui| {
-                        ui.label(&s.material);
-                    });
-                    row.col(|ui| {
-                        let at = match (s.point, s.x_px, s.y_px) {
-                            (_, Some(x), Some(y)) => format!("{x:.1}, {y:.1} px"),
-                            (Some(_), _, _) => "world point".into(),
-                            _ => "—".into(),
-                        };
-                        ui.label(at);
-                    });
-                    row.col(|ui| {
-                        let r = ui.button(purpose_name(s.purpose));
-                        name_widget(ui, &r, &format!("purpose {}", s.id));
-                        if r.on_hover_text("click to switch").clicked() {
-                            let mut c = s.clone();
-                            c.purpose = match s.purpose {
-                                SamplePurpose::Daylight => SamplePurpose::Atmosphere,
-                                SamplePurpose::Atmosphere => SamplePurpose::Daylight,
-                            };
-                            commands.push((put(c), None));
-                        }
-                    });
-                    row.col(|ui| {
-                        let mut w = s.window_px;
-                        let r = ui.add(egui::DragValue::new(&mut w).range(1..=101).speed(0.2));
-                        name_widget(ui, &r, &format!("window {}", s.id));
-                        let w = w | 1;
-                        if r.changed() && w != s.window_px {
-                            let mut c = s.clone();
-                            c.window_px = w;
-                            commands.push((put(c), Some(format!("sample window {}", s.id))));
-                        }
-                    });
-                    row.col(|ui| {
-                        let mut on = s.enabled;
-                        let r = ui.checkbox(&mut on, "");
-                        name_widget(ui, &r, &format!("use sample {}", s.id));
-                        if r.changed() {
-                            let mut c = s.clone();
-                            c.enabled = on;
-                            commands.push((put(c), None));
-                        }
-                    });
-                    row.col(|ui| {
-                        let r = ui.small_button("del");
-                        name_widget(ui, &r, &format!("delete sample {}", s.id));
-                        if r.clicked() {
-                            commands.push((
-                                Command::Fit(FitCommand::RemoveSample { id: s.id.clone() }),
-                                None,
-                            ));
-                        }
-                    });
-                });
-            }
-        });
-}
-
-fn put(sample: photomontage::site::Sample) -> Command {
-    Command::Fit(FitCommand::PutSample { sample, at: None })
-}
-
-fn horizons_table_ui(
-    ui: &mut egui::Ui,
-    site: &Site,
-    commands: &mut Vec<(Command, Option<String>)>,
-) {
-    if site.horizon_samples.is_empty() {
-        ui.label("none: Shift-drag a rectangle of sky at the horizon on the photo");
-        return;
-    }
-    TableBuilder::new(ui)
-        .id_salt("fit horizon samples")
-        .striped(true)
-        .column(Column::auto().at_least(40.0))
-        .column(Column::auto().at_least(36.0))
-        .column(Column::auto().at_least(90.0))
-        .column(Column::auto().at_least(80.0))
-        .column(Column::auto().at_least(24.0))
-        .column(Column::remainder().at_least(30.0))
-        .max_scroll_height(140.0)
-        .header(20.0, |mut h| {
-            for t in ["id", "photo", "origin px", "size px", "on", ""] {
-                h.col(|ui| {
-                    ui.strong(t);
-                });
-            }
-        })
-        .body(|mut body| {
-            for s in &site.horizon_samples {
-                body.row(22.0, |mut row| {
-                    row.col(|ui| {
-                        ui.label(&s.id);
-                    });
-                    row.col(|ui| {
-                        ui.label(&s.photo);
-                    });
-                    row.col(|ui| {
-                        ui.label(format!("{}, {}", s.origin_px[0], s.origin_px[1]));
-                    });
-                    row.col(|ui| {
-                        ui.label(format!("{} × {}", s.size_px[0], s.size_px[1]));
-                    });
-                    row.col(|ui| {
-                        let mut on = s.enabled;
-                        let r = ui.checkbox(&mut on, "");
-                        name_widget(ui, &r, &format!("use horizon {}", s.id));
-                        if r.changed() {
-                            let mut c = s.clone();
-                            c.enabled = on;
-                            commands.push((
-                                Command::Fit(FitCommand::PutHorizonSample {
-                                    sample: c,
-                                    at: None,
-                                }),
-                                None,
-                            ));
-                        }
-                    });
-                    row.col(|ui| {
-                        let r = ui.small_button("del");
-                        name_widget(ui, &r, &format!("delete horizon {}", s.id));
-                        if r.clicked() {
-                            commands.push((
-                                Command::Fit(FitCommand::RemoveHorizonSample { id: s.id.clone() }),
-                                None,
-                            ));
-                        }
-                    });
-                });
-            }
-        });
 }
 
 /// The report: fitted values with σ, flags, sun checks, warnings and the residual table.

@@ -1,7 +1,7 @@
 //! The photomontage studio: view state and wiring over the `photomontage` library (which does
 //! all computation). [`Studio`] is the whole app, testable headless with egui_kittest: it
 //! opens a site (restoring an autosave sidecar newer than it), shows a photo strip, the photo
-//! view with zoom/pan/loupe, the control-point table, solves on a worker thread, renders a
+//! view with zoom/pan/loupe, the control-point table, solves on a worker ([`solve`]), renders a
 //! montage preview progressively ([`render_panel`]), places CAD models with a wireframe overlay
 //! ([`models_panel`]) and builds scene geometry ([`scene_panel`], vertices picked on the photo
 //! with [`scene_pick`]), picks lighting-fit samples on the photo and runs, shows and applies the
@@ -9,24 +9,46 @@
 //! recent sites ([`files`]) and creates a site from photos ([`new_site`]); each photo's interior
 //! orientation is edited in its camera settings ([`photo_settings`]).
 //!
-//! Every edit goes through [`Studio::apply`] (→ [`commands::History`]), so undo/redo and the
-//! autosave see all of them (the "one command path" of rerun's `SystemCommand`).
+//! Structure:
+//! - **One worker type** ([`worker::Worker`]): solve, fit, render, file dialogs and photo
+//!   decoding run on it, with progress, cancellation and panic capture (a crashed job is a
+//!   message, never a panel busy forever); the `jobs` module starts and polls them.
+//! - **Panels as types** ([`panel::Panel`]): the six side tabs, the toolbar and the photo strip
+//!   ([`chrome`]), the File menu ([`files::FileMenu`]) and the New site and Camera settings
+//!   windows draw from a read-only [`panel::PanelContext`] and return [`panel::Action`]s, which
+//!   [`Studio`] applies after the frame's layout; shared widgets are in [`widgets`].
+//! - **One command path**: every edit goes through [`Studio::apply`] (→ [`commands::History`]),
+//!   so undo/redo and the autosave see all of them (rerun's `SystemCommand`).
+//! - Computation lives in the library: model placement and wireframe edges
+//!   (`photomontage::site::models`), points projected into a photo
+//!   (`photomontage::site::photo_points`), solve, fit, render.
 //!
 //! # Known limitations
-//! See each module's own list. Native file dialogs ([`files`]) cannot be driven by the
-//! headless tests, which use the typed-path fields and a substituted [`files::FilePicker`].
+//! See each module's own list. The photo view and its pickers (placing points, scene vertices,
+//! fit samples: `photo_view`, [`scene_pick`], [`fit_pick`]) are still `impl Studio` methods
+//! rather than panels, and the actions' handlers (`start_render`, `import_model`, …) are
+//! `impl Studio` methods beside their panels. Native file dialogs ([`files`]) cannot be driven by the
+//! headless tests, which use the typed-path fields and a substituted [`dialogs::FilePicker`].
 
 pub mod autosave;
+pub mod chrome;
 pub mod commands;
+pub mod dialogs;
 pub mod files;
 pub mod fit_commands;
 pub mod fit_panel;
 pub mod fit_pick;
+pub mod fit_tables;
+pub mod fit_worker;
+mod jobs;
 pub mod models_panel;
 pub mod new_site;
+pub mod panel;
 pub mod photo_settings;
 mod photo_view;
 pub mod points;
+pub mod render_display;
+pub mod render_job;
 pub mod render_panel;
 pub mod render_sheet;
 pub mod scene_panel;
@@ -34,7 +56,9 @@ pub mod scene_pick;
 pub mod solve;
 pub mod state;
 pub mod viewport;
+pub mod widgets;
 pub mod window;
+pub mod worker;
 
 use eframe::egui::{self, Color32, Key, Pos2};
 use photomontage::site::{Observation, SiteDocument, SiteSolution};
@@ -43,7 +67,34 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use commands::{Command, History};
+use panel::{Action, Panel, PanelContext};
 use viewport::{DecodedPhoto, PhotoLoader, ViewTransform, Viewport};
+
+/// The read-only view of the studio that panels draw from (a macro, not a method, so that the
+/// borrows are of single fields and a panel field can be borrowed mutably beside it).
+macro_rules! panel_context {
+    ($s:ident) => {
+        PanelContext {
+            doc: $s.doc.as_ref(),
+            current_photo: $s.current_photo.as_deref(),
+            selected_point: $s.selected_point.as_deref(),
+            solution: $s.solution.as_ref(),
+            residuals: panel::ResidualDisplay {
+                show: $s.ui_state.show_residuals,
+                exaggeration: $s.ui_state.residual_exaggeration,
+            },
+            can_undo: $s.history.can_undo(),
+            can_redo: $s.history.can_redo(),
+            solving: $s.solver.busy(),
+            dialog_open: $s.dialogs.busy(),
+            has_montage: $s
+                .render
+                .montage()
+                .is_some_and(|m| $s.current_photo.as_deref() == Some(m.photo_id.as_str())),
+            recent_sites: &$s.ui_state.recent_sites,
+        }
+    };
+}
 
 /// How the studio starts.
 #[derive(Debug, Clone)]
@@ -67,6 +118,15 @@ enum PhotoView {
     Loading,
     Ready(Box<DecodedPhoto>),
     Failed(String),
+}
+
+/// A job of the studio that runs on a [`worker::Worker`] (for [`Studio::inject_panic_for_tests`]).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WorkerJob {
+    Solve,
+    Fit,
+    Render,
 }
 
 /// A line for the message area.
@@ -106,10 +166,14 @@ pub struct Studio {
     solution: Option<SiteSolution>,
     messages: Vec<Message>,
     tab: SideTab,
-    import_path: String,
-    open_path: String,
-    new_point_id: String,
+    points: points::PointsPanel,
+    results: solve::ResultsPanel,
+    toolbar: chrome::Toolbar,
+    file_menu: files::FileMenu,
+    photo_strip: chrome::PhotoStrip,
     pending: Vec<(Command, Option<String>)>,
+    /// What the panels asked for this frame ([`panel::Panel`]), done after the layout.
+    actions: Vec<Action>,
     render: render_panel::RenderPanel,
     models: models_panel::ModelsPanel,
     scene: scene_panel::ScenePanel,
@@ -146,14 +210,17 @@ impl Studio {
             last_transform: None,
             selected_point: None,
             dragging: None,
-            solver: solve::SolveWorker::default(),
+            solver: solve::solve_worker(),
             solution: None,
             messages: Vec::new(),
             tab: SideTab::Points,
-            import_path: String::new(),
-            open_path: String::new(),
-            new_point_id: String::new(),
+            points: points::PointsPanel::default(),
+            results: solve::ResultsPanel,
+            toolbar: chrome::Toolbar::default(),
+            file_menu: files::FileMenu,
+            photo_strip: chrome::PhotoStrip,
             pending: Vec::new(),
+            actions: Vec::new(),
             render: render_panel::RenderPanel::default(),
             models: models_panel::ModelsPanel::default(),
             scene: scene_panel::ScenePanel::default(),
@@ -277,22 +344,6 @@ impl Studio {
         self.host_clears_to_panel_fill = clears;
     }
 
-    /// Whether no worker is running and the current photo is fully decoded and uploaded.
-    #[must_use]
-    pub fn is_idle(&self) -> bool {
-        let photo_ready = match self.current_photo.as_ref().and_then(|p| self.photos.get(p)) {
-            Some(PhotoView::Ready(_) | PhotoView::Failed(_)) => true,
-            Some(PhotoView::Loading) => false,
-            None => self.current_photo.is_none(),
-        };
-        photo_ready
-            && !self.solver.busy()
-            && !self.loader.busy()
-            && !self.render.busy()
-            && !self.dialogs.busy()
-            && !self.fit.worker.busy()
-    }
-
     /// Whether edits are not yet in the autosave sidecar.
     #[must_use]
     pub fn autosave_pending(&self) -> bool {
@@ -367,95 +418,11 @@ impl Studio {
         }
     }
 
-    /// Starts a solve of the site as it is now on the worker thread.
-    pub fn start_solve(&mut self, ctx: &egui::Context) {
-        let Some(doc) = self.doc.clone() else {
-            return;
-        };
-        if self.solver.start(doc, ctx.clone()) {
-            self.say("solving…", false);
-        } else {
-            self.say("a solve is already running", true);
-        }
-    }
-
     /// Selects the photo shown.
     pub fn select_photo(&mut self, id: &str) {
         if self.current_photo.as_deref() != Some(id) {
             self.current_photo = Some(id.to_owned());
             self.viewport = Viewport::default();
-        }
-    }
-
-    fn finish_solve(&mut self, result: Result<SiteSolution, String>) {
-        match result {
-            Ok(solution) => {
-                for f in &solution.failures {
-                    self.say(format!("photo {} not solved: {}", f.id, f.error), true);
-                }
-                for w in &solution.warnings {
-                    self.say(format!("warning: {w}"), false);
-                }
-                if let Some(doc) = self.doc.as_ref() {
-                    let mut solved = doc.site.clone();
-                    photomontage::site::apply_solution(&mut solved, &solution);
-                    let mut batch: Vec<Command> = solved
-                        .photos
-                        .iter()
-                        .map(|p| Command::SetOrientation {
-                            photo: p.id.clone(),
-                            interior: p.interior.clone(),
-                            exterior: p.exterior.clone(),
-                        })
-                        .collect();
-                    batch.push(Command::SetTiePoints(solved.tie_points.clone()));
-                    self.apply(Command::Batch(batch), None);
-                }
-                let summary = solution.bundle_rms_px.map_or_else(
-                    || format!("solved {} photo(s)", solution.photos.len()),
-                    |r| {
-                        format!(
-                            "solved {} photo(s), bundle RMS {r:.3} px",
-                            solution.photos.len()
-                        )
-                    },
-                );
-                self.say(summary, false);
-                self.solution = Some(solution);
-                self.tab = SideTab::Solve;
-            }
-            Err(e) => self.say(e, true),
-        }
-    }
-
-    fn poll_workers(&mut self, ctx: &egui::Context) {
-        for d in self.loader.poll() {
-            let view = match d.result {
-                Ok(p) => PhotoView::Ready(Box::new(p)),
-                Err(e) => {
-                    self.say(e.clone(), true);
-                    PhotoView::Failed(e)
-                }
-            };
-            self.photos.insert(d.photo_id, view);
-        }
-        if let Some(r) = self.solver.poll() {
-            self.finish_solve(r);
-        }
-        self.poll_render(ctx);
-        self.poll_dialogs(ctx);
-        self.poll_fit(ctx);
-        // Start decoding the current photo.
-        if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
-            && !self.photos.contains_key(&id)
-            && let Some(p) = doc.site.photos.iter().find(|p| p.id == id)
-        {
-            let path = doc.resolve(&p.file);
-            self.photos.insert(id.clone(), PhotoView::Loading);
-            self.loader.request(id, path, ctx.clone());
-        }
-        if self.loader.busy() || self.solver.busy() {
-            ctx.request_repaint_after(std::time::Duration::from_millis(50));
         }
     }
 
@@ -530,11 +497,15 @@ impl Studio {
             .frame(side_frame)
             .resizable(true)
             .default_size(70.0)
-            .show(ui, |ui| self.messages_ui(ui));
+            .show(ui, |ui| chrome::messages_ui(ui, &self.messages));
         egui::Panel::left("photos")
             .frame(side_frame)
             .default_size(150.0)
-            .show(ui, |ui| self.photo_strip_ui(ui));
+            .show(ui, |ui| {
+                let ctx = panel_context!(self);
+                let actions = self.photo_strip.ui(ui, &ctx);
+                self.actions.extend(actions);
+            });
         egui::Panel::right("side")
             .frame(side_frame)
             .default_size(560.0)
@@ -545,10 +516,24 @@ impl Studio {
         egui::CentralPanel::default()
             .frame(frame)
             .show(ui, |ui| self.photo_view_ui(ui));
-        self.new_site_ui(&ctx);
-        self.photo_settings_ui(&ctx);
+        let panel_ctx = panel_context!(self);
+        let actions = self.new_site.ui(ui, &panel_ctx);
+        self.actions.extend(actions);
+        self.photo_settings.size_px = self.photo_settings.photo.as_ref().and_then(|id| match self
+            .photos
+            .get(id)
+        {
+            Some(PhotoView::Ready(p)) => Some(p.size_px),
+            _ => None,
+        });
+        let panel_ctx = panel_context!(self);
+        let actions = self.photo_settings.ui(ui, &panel_ctx);
+        self.actions.extend(actions);
         for (c, key) in std::mem::take(&mut self.pending) {
             self.apply(c, key);
+        }
+        for action in std::mem::take(&mut self.actions) {
+            self.run_action(action, &ctx);
         }
         if std::mem::take(&mut self.close_polygon) {
             self.create_polygon();
@@ -558,108 +543,11 @@ impl Studio {
 
     fn toolbar_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            let name = self
-                .doc
-                .as_ref()
-                .map_or_else(|| "no site".into(), |d| d.site.name.clone());
-            self.file_menu_ui(ui);
-            ui.strong(name);
-            ui.separator();
-            if ui.button("Save").clicked() {
-                self.save();
-            }
-            if ui
-                .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
-                .clicked()
-            {
-                self.undo();
-            }
-            if ui
-                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
-                .clicked()
-            {
-                self.redo();
-            }
-            let solving = self.solver.busy();
-            if ui
-                .add_enabled(!solving, egui::Button::new("Solve"))
-                .clicked()
-            {
-                let ctx = ui.ctx().clone();
-                self.start_solve(&ctx);
-            }
-            if solving {
-                ui.spinner();
-            }
-            if ui
-                .button("Fit view")
-                .on_hover_text("fit the whole photo into the view")
-                .clicked()
-            {
-                self.viewport.fitted = true;
-            }
-            ui.separator();
-            let r = ui.add(
-                egui::TextEdit::singleline(&mut self.open_path)
-                    .hint_text("site file path")
-                    .desired_width(220.0),
-            );
-            points::name_widget(ui, &r, "site path");
-            if ui.button("Open").clicked() && !self.open_path.trim().is_empty() {
-                let p = PathBuf::from(self.open_path.trim());
-                self.open(&p);
-            }
+            let ctx = panel_context!(self);
+            let mut actions = self.file_menu.ui(ui, &ctx);
+            actions.extend(self.toolbar.ui(ui, &ctx));
+            self.actions.extend(actions);
         });
-    }
-
-    fn messages_ui(&mut self, ui: &mut egui::Ui) {
-        egui::ScrollArea::vertical()
-            .stick_to_bottom(true)
-            .auto_shrink([false, false])
-            .show(ui, |ui| {
-                for m in &self.messages {
-                    if m.is_error {
-                        ui.colored_label(Color32::from_rgb(255, 90, 90), &m.text);
-                    } else {
-                        ui.label(&m.text);
-                    }
-                }
-            });
-    }
-
-    fn photo_strip_ui(&mut self, ui: &mut egui::Ui) {
-        ui.strong("Photos");
-        let Some(doc) = self.doc.as_ref() else {
-            return;
-        };
-        let mut chosen = None;
-        for p in &doc.site.photos {
-            let solved = p.exterior.as_ref().map_or_else(
-                || "not solved".to_string(),
-                |e| format!("RMS {:.2} px", e.rms_px),
-            );
-            let n = doc
-                .site
-                .observations
-                .iter()
-                .filter(|o| o.photo == p.id)
-                .count();
-            let text = format!("{}\n{n} obs · {solved}", p.id);
-            let sel = self.current_photo.as_deref() == Some(p.id.as_str());
-            let r = ui.selectable_label(sel, text);
-            points::name_widget(ui, &r, &format!("photo {}", p.id));
-            if r.clicked() {
-                chosen = Some(p.id.clone());
-            }
-        }
-        if let Some(id) = chosen {
-            self.select_photo(&id);
-        }
-        if let Some(id) = self.current_photo.clone()
-            && ui.button("Camera settings").clicked()
-        {
-            self.open_photo_settings(&id);
-        }
     }
 
     fn side_ui(&mut self, ui: &mut egui::Ui) {
@@ -670,81 +558,55 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Models, "Models");
             ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
             let r = ui.selectable_value(&mut self.tab, SideTab::Fit, "Fit");
-            points::name_widget(ui, &r, "Fit tab");
+            widgets::name_widget(ui, &r, "Fit tab");
         });
         ui.separator();
-        match self.tab {
-            SideTab::Points => self.points_tab_ui(ui),
-            SideTab::Solve => self.solve_tab_ui(ui),
-            SideTab::Render => self.render_tab_ui(ui),
-            SideTab::Models => self.models_tab_ui(ui),
-            SideTab::Scene => self.scene_tab_ui(ui),
-            SideTab::Fit => self.fit_tab_ui(ui),
-        }
+        let ctx = panel_context!(self);
+        let panel: &mut dyn Panel = match self.tab {
+            SideTab::Points => &mut self.points,
+            SideTab::Solve => &mut self.results,
+            SideTab::Render => &mut self.render,
+            SideTab::Models => &mut self.models,
+            SideTab::Scene => &mut self.scene,
+            SideTab::Fit => &mut self.fit,
+        };
+        let actions = panel.ui(ui, &ctx);
+        self.actions.extend(actions);
     }
 
-    fn points_tab_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            let r = ui.add(
-                egui::TextEdit::singleline(&mut self.import_path)
-                    .hint_text(points::IMPORT_HINT)
-                    .desired_width(330.0),
-            );
-            points::name_widget(ui, &r, "import path");
-            if ui.button("Import").clicked() {
-                self.import();
+    /// Does what a panel asked for (after the frame's layout).
+    fn run_action(&mut self, action: Action, ctx: &egui::Context) {
+        match action {
+            Action::Edit { command, merge_key } => self.apply(*command, merge_key),
+            Action::Save => self.save(),
+            Action::Undo => self.undo(),
+            Action::Redo => self.redo(),
+            Action::StartSolve => self.start_solve(ctx),
+            Action::FitView => self.viewport.fitted = true,
+            Action::OpenSite(path) => self.open(&path),
+            Action::SelectPhoto(id) => self.select_photo(&id),
+            Action::OpenPhotoSettings(id) => self.open_photo_settings(&id),
+            Action::RequestDialog(purpose) => self.request_dialog(purpose, ctx),
+            Action::CreateNewSite => self.create_new_site(),
+            Action::ShowNewSite => self.new_site.open = true,
+            Action::ImportPoints => self.import(),
+            Action::SetResiduals(r) => {
+                self.ui_state.show_residuals = r.show;
+                self.ui_state.residual_exaggeration = r.exaggeration;
             }
-        });
-        ui.horizontal(|ui| {
-            let r = ui.add(
-                egui::TextEdit::singleline(&mut self.new_point_id)
-                    .hint_text("tie point id (no survey)")
-                    .desired_width(160.0),
-            );
-            points::name_widget(ui, &r, "point id");
-            let id = self.new_point_id.trim();
-            if ui.button("Pick id").clicked() && !id.is_empty() {
-                self.selected_point = Some(id.to_owned());
-            }
-            // Points observed but not surveyed (tie points) are listed for picking too.
-            if let Some(doc) = self.doc.as_ref() {
-                let mut ties: Vec<&str> = doc
-                    .site
-                    .observations
-                    .iter()
-                    .map(|o| o.point.as_str())
-                    .filter(|p| !doc.site.control_points.iter().any(|c| c.id == *p))
-                    .collect();
-                ties.sort_unstable();
-                ties.dedup();
-                for t in ties {
-                    let sel = self.selected_point.as_deref() == Some(t);
-                    let r = ui.selectable_label(sel, t);
-                    points::name_widget(ui, &r, &format!("tie {t}"));
-                    if r.clicked() {
-                        self.selected_point = Some(t.to_owned());
-                    }
-                }
-            }
-        });
-        let sel = self.selected_point.clone().unwrap_or_else(|| "none".into());
-        ui.label(format!(
-            "selected: {sel} — click the photo to place it, drag a mark to move, Delete removes"
-        ));
-        let Some(doc) = self.doc.as_ref() else {
-            return;
-        };
-        let mut commands = Vec::new();
-        egui::ScrollArea::horizontal().show(ui, |ui| {
-            points::table_ui(
-                ui,
-                &doc.site,
-                self.current_photo.as_deref(),
-                &mut self.selected_point,
-                &mut commands,
-            );
-        });
-        self.pending.extend(commands);
+            Action::SelectPoint(id) => self.selected_point = Some(id),
+            Action::ImportModel(path) => self.import_model(&path),
+            Action::IntersectTiePoint(id) => self.intersect_tie_point(&id),
+            Action::CreatePolygon => self.create_polygon(),
+            Action::StartRender => self.start_render(ctx),
+            Action::CancelRender => self.render.cancel(),
+            Action::ExportRender => self.export_render(),
+            Action::ExportSheet => self.export_sheet(),
+            Action::MakeReport => self.make_report(),
+            Action::StartFit => self.start_fit(ctx),
+            Action::CancelFit => self.fit.worker.cancel(),
+            Action::ApplyFit => self.apply_fit_report(),
+        }
     }
 
     /// Imports control points (and observations) from the file named in the import field.
@@ -752,7 +614,7 @@ impl Studio {
         let Some(doc) = self.doc.as_ref() else {
             return;
         };
-        let path = PathBuf::from(self.import_path.trim());
+        let path = PathBuf::from(self.points.import_path.trim());
         match points::import_file(&doc.site, &path, self.current_photo.as_deref()) {
             Ok(Command::Batch(b)) if b.is_empty() => {
                 self.say(format!("{}: nothing to import", path.display()), true);
@@ -768,46 +630,7 @@ impl Studio {
 
     /// Sets the import field (what a user types).
     pub fn set_import_path(&mut self, path: &str) {
-        path.clone_into(&mut self.import_path);
-    }
-
-    fn solve_tab_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            let r = ui.checkbox(&mut self.ui_state.show_residuals, "residual vectors");
-            points::name_widget(ui, &r, "residual vectors");
-            let r = ui.add(
-                egui::Slider::new(&mut self.ui_state.residual_exaggeration, 1.0..=5000.0)
-                    .logarithmic(true)
-                    .text("×"),
-            );
-            points::name_widget(ui, &r, "residual exaggeration");
-        });
-        let Some(solution) = self.solution.as_ref() else {
-            ui.label("not solved yet: press Solve");
-            return;
-        };
-        if let Some(r) = solution.bundle_rms_px {
-            ui.strong(format!("bundle adjustment RMS {r:.3} px"));
-        }
-        for f in &solution.failures {
-            ui.colored_label(
-                Color32::from_rgb(255, 90, 90),
-                format!("{}: {}", f.id, f.error),
-            );
-        }
-        for w in &solution.warnings {
-            ui.colored_label(Color32::from_rgb(230, 160, 40), format!("warning: {w}"));
-        }
-        egui::ScrollArea::vertical().show(ui, |ui| {
-            // The current photo first, then the others.
-            let current = self.current_photo.as_deref();
-            let mut order: Vec<_> = solution.photos.iter().collect();
-            order.sort_by_key(|p| Some(p.id.as_str()) != current);
-            for p in order {
-                ui.separator();
-                solve::photo_solution_ui(ui, p);
-            }
-        });
+        path.clone_into(&mut self.points.import_path);
     }
 
     /// Writes the UI state (call on exit).

@@ -1,4 +1,5 @@
-//! `photomontage-studio [SITE] [--screenshot FILE --frames N] [--script FILE] [--headless] [--solve]`
+//! `photomontage-studio [SITE] [--screenshot FILE [--frames N]] [--script FILE] [--headless] [--solve]`
+//! (arguments parsed by clap; `--help` lists them)
 //!
 //! Opens SITE (default: the bundled courtyard sample) in the studio window.
 //! `--screenshot FILE --frames N`: run at least N frames (and until the photo is shown), save
@@ -9,66 +10,41 @@
 //! until killed — the crash-safety test uses it. `--solve`: start a solve on the first frame.
 
 use anyhow::{Context as _, bail};
+use clap::Parser as _;
 use eframe::egui;
 use photomontage_studio::{Studio, StudioOptions, commands, default_site_path, state, window};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
+/// The photomontage studio: opens SITE in the studio window.
+#[derive(Debug, clap::Parser)]
+#[command(
+    name = "photomontage-studio",
+    version,
+    about = "The photomontage studio: opens SITE (default: the bundled courtyard sample) in a window"
+)]
 struct Args {
-    site: PathBuf,
+    /// Site file to open (default: the bundled courtyard sample).
+    site: Option<PathBuf>,
+    /// Run at least --frames frames (and until the photo is shown), save egui's screenshot of
+    /// the window as PNG to FILE, exit.
+    #[arg(long, value_name = "FILE")]
     screenshot: Option<PathBuf>,
+    /// Frames to run before the screenshot.
+    #[arg(long, value_name = "N", default_value_t = 10, requires = "screenshot")]
     frames: u32,
+    /// Apply the edit commands in FILE through the studio's command path at start (one per
+    /// line: `place PHOTO POINT X Y`, `remove PHOTO POINT`, `control ID X Y Z`,
+    /// `enable|disable PHOTO POINT`).
+    #[arg(long, value_name = "FILE")]
     script: Option<PathBuf>,
+    /// Run the studio's frames without a window (no display needed; autosave and workers run
+    /// as usual) until killed.
+    #[arg(long, conflicts_with = "screenshot")]
     headless: bool,
+    /// Start a solve on the first frame.
+    #[arg(long)]
     solve: bool,
-}
-
-const USAGE: &str = "usage: photomontage-studio [SITE] [--screenshot FILE --frames N] [--script FILE] [--headless] [--solve]";
-
-fn parse_args() -> anyhow::Result<Args> {
-    let mut args = Args {
-        site: default_site_path(),
-        screenshot: None,
-        frames: 10,
-        script: None,
-        headless: false,
-        solve: false,
-    };
-    let mut it = std::env::args_os().skip(1);
-    let mut site = None;
-    while let Some(a) = it.next() {
-        match a.to_str() {
-            Some("--screenshot") => {
-                args.screenshot = Some(it.next().context("--screenshot needs a file")?.into());
-            }
-            Some("--frames") => {
-                let n = it.next().context("--frames needs a number")?;
-                args.frames = n
-                    .to_str()
-                    .and_then(|s| s.parse().ok())
-                    .context("--frames needs a whole number")?;
-            }
-            Some("--script") => {
-                args.script = Some(it.next().context("--script needs a file")?.into());
-            }
-            Some("--headless") => args.headless = true,
-            Some("--solve") => args.solve = true,
-            Some("-h" | "--help") => {
-                println!("{USAGE}");
-                std::process::exit(0);
-            }
-            Some(s) if s.starts_with("--") => bail!("unknown option {s}\n{USAGE}"),
-            _ => {
-                if site.replace(PathBuf::from(a)).is_some() {
-                    bail!("only one SITE may be given\n{USAGE}");
-                }
-            }
-        }
-    }
-    if let Some(s) = site {
-        args.site = s;
-    }
-    Ok(args)
 }
 
 fn apply_script(studio: &mut Studio, script: &PathBuf) -> anyhow::Result<()> {
@@ -166,9 +142,10 @@ fn run_headless(mut studio: Studio) -> anyhow::Result<()> {
 }
 
 fn main() -> anyhow::Result<()> {
-    let args = parse_args()?;
+    let args = Args::parse();
+    let site = args.site.clone().unwrap_or_else(default_site_path);
     let options = StudioOptions {
-        site_path: args.site.clone(),
+        site_path: site,
         state_path: if args.headless || args.screenshot.is_some() {
             None
         } else {
@@ -198,4 +175,46 @@ fn main() -> anyhow::Result<()> {
         Box::new(move |_cc| Ok(Box::new(shell))),
     )
     .map_err(|e| anyhow::anyhow!("cannot start the studio window: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::*;
+    use clap::CommandFactory as _;
+
+    #[test]
+    fn arguments_parse_as_documented() {
+        Args::command().debug_assert();
+        let a = Args::try_parse_from(["studio"]).unwrap();
+        assert!(a.site.is_none() && a.screenshot.is_none() && !a.headless && !a.solve);
+        assert_eq!(a.frames, 10);
+        let a = Args::try_parse_from([
+            "studio",
+            "s.toml",
+            "--screenshot",
+            "x.png",
+            "--frames",
+            "3",
+            "--solve",
+        ])
+        .unwrap();
+        assert_eq!(a.site, Some(PathBuf::from("s.toml")));
+        assert_eq!(a.screenshot, Some(PathBuf::from("x.png")));
+        assert_eq!(a.frames, 3);
+        assert!(a.solve);
+        let a = Args::try_parse_from(["studio", "--headless", "--script", "e.txt"]).unwrap();
+        assert!(a.headless && a.script == Some(PathBuf::from("e.txt")));
+        // Refused: frames without a screenshot, headless with a screenshot, two sites, a
+        // frame count that is not a whole number.
+        for bad in [
+            &["studio", "--frames", "3"][..],
+            &["studio", "--headless", "--screenshot", "x.png"],
+            &["studio", "a.toml", "b.toml"],
+            &["studio", "--screenshot", "x.png", "--frames", "many"],
+        ] {
+            assert!(Args::try_parse_from(bad).is_err(), "{bad:?} accepted");
+        }
+    }
 }

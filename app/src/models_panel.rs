@@ -5,16 +5,14 @@
 //! solved camera (`photomontage::camera::Camera::project`): the AVR1 "wireline" check of a
 //! verified view (Landscape Institute TGN 06/19, AVR levels).
 //!
-//! The model is loaded through the renderer's own importer (`site::render::site_scene` on a
-//! copy of the site holding only that model at the identity placement), cached per model file,
-//! and placed here exactly as the importer places it: scale, then rotation about world Z, then
-//! translation.
+//! The model's edges come from the library (`photomontage::site::models`: imported by the
+//! renderer's own importer at the identity placement, placed exactly as the importer places it,
+//! projected with the photo's camera); this panel caches them per model file, units and up axis.
 //!
-//! **Import model** (typed path or File → Import model…) adds a `[[models]]` entry as one
-//! undoable edit ([`crate::commands::Command::PutModel`]) after importing it once to check that it
-//! reads: id from the file name, path relative to the site file when it lies in the site's
-//! folder, units metres, up axis Y for glTF (its convention) and Z otherwise, placed at the
-//! centroid of the control points so that it lands in the surveyed area.
+//! **Import model** (typed path or File → Import model…) adds the `[[models]]` entry of
+//! `photomontage::site::models::new_model_entry` (id from the file name, path relative to the
+//! site file, placed at the control points' centroid) as one undoable edit
+//! ([`crate::commands::Command::PutModel`]) after importing it once to check that it reads.
 //!
 //! Each model's length unit and up axis (the importer's `LengthUnit` and `UpAxis`, written as
 //! `units` and `up_axis`) are chosen when adding it (the "added in" combo boxes) and edited
@@ -30,21 +28,14 @@
 
 use eframe::egui::{self, Color32};
 use photomontage::scene::{LengthUnit, UpAxis};
-use photomontage::site::render::{SiteWarning, site_camera, site_scene};
-use photomontage::site::{CadModel, ModelUnits, ModelUpAxis, Placement, SiteDocument};
-use std::collections::{HashMap, HashSet};
-use std::path::Path;
+use photomontage::site::models::{ModelEdges, model_edges, new_model_entry, wireframe_px};
+use photomontage::site::render::{SiteWarning, site_camera};
+use photomontage::site::{CadModel, SiteDocument};
+use std::collections::HashMap;
 
 use crate::commands::Command;
-
-/// A model's edges in its own frame after unit and up-axis conversion (identity placement).
-#[derive(Debug, Clone)]
-struct LocalEdges {
-    edges_m: Vec<[[f64; 3]; 2]>,
-    /// The importer's warnings for the model (an absurd extent after the unit conversion,
-    /// `SiteWarning::ModelScale`, among them).
-    warnings: Vec<SiteWarning>,
-}
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 
 /// The length units the importer reads (`photomontage::scene::LengthUnit`), with the site file
 /// spelling of `[[models]] units`.
@@ -91,7 +82,7 @@ fn choice_ui(
                 ui.selectable_value(value, (*o).to_owned(), label(o));
             }
         });
-    crate::points::name_widget(ui, &r.response, name);
+    name_widget(ui, &r.response, name);
     *value != before
 }
 
@@ -109,7 +100,7 @@ pub struct ModelsPanel {
     pub new_up_axis: Option<String>,
     /// Per model id: the (file, units, up axis) it was imported with and the result (errors are
     /// cached too, so a broken file is not re-read every frame).
-    cache: HashMap<String, (CacheKey, Result<LocalEdges, String>)>,
+    cache: HashMap<String, (CacheKey, Result<ModelEdges, String>)>,
 }
 
 /// What a model's import depends on: its file, units and up axis.
@@ -119,132 +110,13 @@ fn cache_key(m: &CadModel) -> CacheKey {
     (m.file.clone(), m.units.to_string(), m.up_axis.to_string())
 }
 
-/// World position of a model-frame point under `placement` (scale, rotation about Z,
-/// translation: the importer's order).
-#[must_use]
-pub fn place(p_m: [f64; 3], placement: &Placement) -> [f64; 3] {
-    let (sin, cos) = placement.rotation_z_deg.to_radians().sin_cos();
-    let [x, y, z] = p_m.map(|c| c * placement.scale);
-    let [tx, ty, tz] = placement.translation;
-    [cos * x - sin * y + tx, sin * x + cos * y + ty, z + tz]
-}
-
-/// The `[[models]]` entry that importing the file `path` into `doc` adds (see the module doc),
-/// with units and up axis as chosen (`None`: metres, the format's convention).
-#[must_use]
-pub fn model_entry_as(
-    doc: &SiteDocument,
-    path: &Path,
-    units: Option<&str>,
-    up_axis: Option<&str>,
-) -> CadModel {
-    let mut m = model_entry(doc, path);
-    if let Some(u) = units.and_then(|u| u.parse().ok()) {
-        m.units = u;
-    }
-    if let Some(a) = up_axis.and_then(|a| a.parse().ok()) {
-        m.up_axis = a;
-    }
-    m
-}
-
-/// The `[[models]]` entry that importing the file `path` into `doc` adds (see the module doc).
-#[must_use]
-pub fn model_entry(doc: &SiteDocument, path: &Path) -> CadModel {
-    let stem: String = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
-        .chars()
-        .map(|c| {
-            if c.is_alphanumeric() || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    let stem = if stem.is_empty() {
-        "model".into()
-    } else {
-        stem
-    };
-    let taken = |id: &str| doc.site.models.iter().any(|m| m.id == id);
-    let id = (1..)
-        .map(|n| {
-            if n == 1 {
-                stem.clone()
-            } else {
-                format!("{stem}_{n}")
-            }
-        })
-        .find(|id| !taken(id))
-        .unwrap_or(stem);
-    let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    let file = std::fs::canonicalize(doc.base_dir())
-        .ok()
-        .and_then(|base| absolute.strip_prefix(base).ok().map(Path::to_path_buf))
-        .unwrap_or(absolute);
-    let gltf = path.extension().is_some_and(|e| {
-        let e = e.to_string_lossy().to_ascii_lowercase();
-        e == "gltf" || e == "glb"
-    });
-    let points = &doc.site.control_points;
-    let mut centroid = [0.0; 3];
-    if !points.is_empty() {
-        for c in points {
-            for k in 0..3 {
-                centroid[k] += c.xyz[k] / points.len() as f64;
-            }
-        }
-    }
-    CadModel {
-        id,
-        file: file.to_string_lossy().into_owned(),
-        units: ModelUnits::Metre,
-        up_axis: if gltf { ModelUpAxis::Y } else { ModelUpAxis::Z },
-        placement: Placement {
-            translation: centroid,
-            ..Placement::default()
-        },
-        visible: true,
-    }
-}
-
-fn load_edges(doc: &SiteDocument, model: &CadModel) -> Result<LocalEdges, String> {
-    let mut one = doc.clone();
-    one.site.polygons.clear();
-    let mut m = model.clone();
-    m.placement = Placement::default();
-    m.visible = true;
-    one.site.models = vec![m];
-    let scene = site_scene(&one).map_err(|e| e.to_string())?;
-    let key_of = |a: &[f64; 3]| a.map(f64::to_bits);
-    let mut seen = HashSet::new();
-    let mut edges_m = Vec::new();
-    for t in scene.scene.triangles() {
-        let v = t.vertices_in_world_m.map(|p| [p.x, p.y, p.z]);
-        for (a, b) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
-            let (ka, kb) = (key_of(&a), key_of(&b));
-            let k = if ka < kb { (ka, kb) } else { (kb, ka) };
-            if seen.insert(k) {
-                edges_m.push([a, b]);
-            }
-        }
-    }
-    Ok(LocalEdges {
-        edges_m,
-        warnings: scene.warnings,
-    })
-}
-
 impl ModelsPanel {
     /// The model's edges, imported again when its file, units or up axis changed.
-    fn edges(&mut self, doc: &SiteDocument, model: &CadModel) -> &Result<LocalEdges, String> {
+    fn edges(&mut self, doc: &SiteDocument, model: &CadModel) -> &Result<ModelEdges, String> {
         let key = cache_key(model);
         let stale = self.cache.get(&model.id).is_none_or(|(k, _)| *k != key);
         if stale {
-            let loaded = load_edges(doc, model);
+            let loaded = model_edges(doc, model).map_err(|e| e.to_string());
             self.cache.insert(model.id.clone(), (key.clone(), loaded));
         }
         &self
@@ -295,15 +167,7 @@ impl ModelsPanel {
             .ok_or_else(|| format!("no model {model_id}"))?;
         let camera = site_camera(doc, photo_id).map_err(|e| e.to_string())?;
         let edges = self.edges(doc, model).as_ref().map_err(Clone::clone)?;
-        Ok(edges
-            .edges_m
-            .iter()
-            .filter_map(|[a, b]| {
-                let pa = camera.project(&place(*a, &model.placement).into())?;
-                let pb = camera.project(&place(*b, &model.placement).into())?;
-                Some([[pa.x, pa.y], [pb.x, pb.y]])
-            })
-            .collect())
+        Ok(wireframe_px(&camera, edges, &model.placement))
     }
 }
 
@@ -328,17 +192,23 @@ impl crate::Studio {
 
     /// Adds the CAD model file `path` to the site (one undoable edit) after checking that it
     /// imports; errors become messages and change nothing.
-    pub fn import_model(&mut self, path: &Path) {
+    pub fn import_model(&mut self, path: &std::path::Path) {
         let Some(doc) = self.doc.as_ref() else {
             return;
         };
-        let model = model_entry_as(
+        let model = new_model_entry(
             doc,
             path,
-            self.models.new_units.as_deref(),
-            self.models.new_up_axis.as_deref(),
+            self.models
+                .new_units
+                .as_deref()
+                .and_then(|u| u.parse().ok()),
+            self.models
+                .new_up_axis
+                .as_deref()
+                .and_then(|a| a.parse().ok()),
         );
-        match load_edges(doc, &model) {
+        match model_edges(doc, &model).map_err(|e| e.to_string()) {
             Ok(edges) => {
                 let text = format!(
                     "added model {} from {} in {}, {} (placed at the control points' \
@@ -386,32 +256,31 @@ impl crate::Studio {
             }
         }
     }
+}
 
-    pub(crate) fn models_tab_ui(&mut self, ui: &mut egui::Ui) {
-        let r = ui.checkbox(&mut self.models.show_wireframe, "wireframe overlay");
-        crate::points::name_widget(ui, &r, "wireframe overlay");
+impl Panel for ModelsPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut actions = Vec::new();
+        let r = ui.checkbox(&mut self.show_wireframe, "wireframe overlay");
+        name_widget(ui, &r, "wireframe overlay");
         let mut add = false;
         ui.horizontal(|ui| {
             let r = ui.add(
-                egui::TextEdit::singleline(&mut self.models.model_path)
+                egui::TextEdit::singleline(&mut self.model_path)
                     .hint_text("model file (.obj, .gltf, .glb, .dxf)")
                     .desired_width(260.0),
             );
-            crate::points::name_widget(ui, &r, "model path");
+            name_widget(ui, &r, "model path");
             add = ui.button("Add model").clicked();
         });
         ui.horizontal(|ui| {
             ui.label("added in");
-            let mut units = self.models.new_units.clone().unwrap_or_else(|| "m".into());
+            let mut units = self.new_units.clone().unwrap_or_else(|| "m".into());
             let names: Vec<&str> = UNITS.iter().map(|(u, _)| *u).collect();
             if choice_ui(ui, "new model units", &mut units, &names, unit_label) {
-                self.models.new_units = Some(units);
+                self.new_units = Some(units);
             }
-            let mut axis = self
-                .models
-                .new_up_axis
-                .clone()
-                .unwrap_or_else(|| "auto".into());
+            let mut axis = self.new_up_axis.clone().unwrap_or_else(|| "auto".into());
             let axes = ["auto", "z", "y"];
             let label = |a: &str| {
                 if a == "auto" {
@@ -421,23 +290,23 @@ impl crate::Studio {
                 }
             };
             if choice_ui(ui, "new model up axis", &mut axis, &axes, label) {
-                self.models.new_up_axis = (axis != "auto").then_some(axis);
+                self.new_up_axis = (axis != "auto").then_some(axis);
             }
         });
-        if add && !self.models.model_path.trim().is_empty() {
-            let path = std::path::PathBuf::from(self.models.model_path.trim());
-            self.import_model(&path);
+        if add && !self.model_path.trim().is_empty() {
+            let path = std::path::PathBuf::from(self.model_path.trim());
+            actions.push(Action::ImportModel(path));
         }
-        let Some(doc) = self.doc.as_ref() else {
-            return;
+        let Some(doc) = ctx.doc else {
+            return actions;
         };
         if doc.site.models.is_empty() {
             ui.label("the site has no [[models]]");
-            return;
+            return actions;
         }
-        let photo = self.current_photo.clone().unwrap_or_default();
+        let photo = ctx.current_photo.unwrap_or_default();
         let mut commands = Vec::new();
-        let warn = Color32::from_rgb(230, 160, 40);
+        let warn = crate::widgets::WARNING;
         for m in &doc.site.models {
             ui.separator();
             ui.strong(format!("{} ({})", m.id, m.file));
@@ -473,7 +342,7 @@ impl crate::Studio {
                     ));
                 }
             });
-            match self.models.model_warnings(doc, &m.id) {
+            match self.model_warnings(doc, &m.id) {
                 Ok(warnings) => {
                     for w in warnings {
                         ui.colored_label(warn, format!("importer: {w}"));
@@ -483,8 +352,8 @@ impl crate::Studio {
                     ui.colored_label(warn, e);
                 }
             }
-            if let Err(e) = self.models.wireframe_px(doc, &photo, &m.id)
-                && self.models.show_wireframe
+            if let Err(e) = self.wireframe_px(doc, photo, &m.id)
+                && self.show_wireframe
             {
                 ui.colored_label(warn, e);
             }
@@ -494,14 +363,14 @@ impl crate::Studio {
                 for (k, axis) in ["E", "N", "H"].iter().enumerate() {
                     ui.label(*axis);
                     let r = ui.add(egui::DragValue::new(&mut p.translation[k]).speed(0.05));
-                    crate::points::name_widget(ui, &r, &format!("{} {axis}", m.id));
+                    name_widget(ui, &r, &format!("{} {axis}", m.id));
                     changed |= r.changed();
                 }
             });
             ui.horizontal(|ui| {
                 ui.label("rotation Z °");
                 let r = ui.add(egui::DragValue::new(&mut p.rotation_z_deg).speed(0.1));
-                crate::points::name_widget(ui, &r, &format!("{} rotation", m.id));
+                name_widget(ui, &r, &format!("{} rotation", m.id));
                 changed |= r.changed();
                 ui.label("scale");
                 let r = ui.add(
@@ -509,7 +378,7 @@ impl crate::Studio {
                         .speed(0.001)
                         .range(1e-6..=1e6),
                 );
-                crate::points::name_widget(ui, &r, &format!("{} scale", m.id));
+                name_widget(ui, &r, &format!("{} scale", m.id));
                 changed |= r.changed();
             });
             if changed {
@@ -522,6 +391,14 @@ impl crate::Studio {
                 ));
             }
         }
-        self.pending.extend(commands);
+        actions.extend(
+            commands
+                .into_iter()
+                .map(|(command, merge_key)| Action::Edit {
+                    command: Box::new(command),
+                    merge_key,
+                }),
+        );
+        actions
     }
 }

@@ -1,5 +1,5 @@
 //! File → New site…: a window where the user chooses the photos (the multi-select dialog of
-//! [`crate::files::FilePicker`], or a typed path added one at a time) and where the site file
+//! [`crate::dialogs::FilePicker`], or a typed path added one at a time) and where the site file
 //! goes (a save dialog or a typed path), then creates the site with the library's
 //! [`photomontage::site::new::create_site`] (one photo entry per file, interior orientation from
 //! EXIF or the stated fallback, paths relative to the site file, saved atomically and never over
@@ -14,8 +14,9 @@
 use eframe::egui::{self, Color32};
 use std::path::{Path, PathBuf};
 
-use crate::files::DialogPurpose;
-use crate::points::name_widget;
+use crate::dialogs::DialogPurpose;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 
 /// State of the New site window.
 #[derive(Debug, Default)]
@@ -88,10 +89,13 @@ impl crate::Studio {
             }
         }
     }
+}
 
-    pub(crate) fn new_site_ui(&mut self, ctx: &egui::Context) {
-        if !self.new_site.open {
-            return;
+impl Panel for NewSiteDialog {
+    /// Shows the window (when open) over `ui`'s context.
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        if !self.open {
+            return Vec::new();
         }
         let mut open = true;
         let mut create = false;
@@ -102,9 +106,9 @@ impl crate::Studio {
             .default_width(520.0)
             // Right of the photo strip, below the toolbar.
             .default_pos(egui::pos2(170.0, 60.0))
-            .show(ctx, |ui| {
-                let busy = self.dialogs.busy();
-                let d = &mut self.new_site;
+            .show(ui.ctx(), |ui| {
+                let busy = ctx.dialog_open;
+                let d = &mut *self;
                 ui.label("Photos of the site:");
                 let mut remove = None;
                 for (i, p) in d.photos.iter().enumerate() {
@@ -159,7 +163,7 @@ impl crate::Studio {
                     }
                 });
                 if let Some(e) = &d.error {
-                    ui.colored_label(Color32::from_rgb(255, 90, 90), e);
+                    ui.colored_label(crate::widgets::ERROR, e);
                 }
                 let ready = !d.photos.is_empty() && !d.site_path.trim().is_empty();
                 if ui
@@ -170,13 +174,12 @@ impl crate::Studio {
                 }
             });
         if !open {
-            self.new_site.open = false;
+            self.open = false;
         }
-        if let Some(purpose) = dialog {
-            self.request_dialog(purpose, ctx);
-        }
+        let mut actions: Vec<Action> = dialog.map(Action::RequestDialog).into_iter().collect();
         if create {
-            self.create_new_site();
+            actions.push(Action::CreateNewSite);
         }
+        actions
     }
 }

@@ -17,13 +17,16 @@ use eframe::egui;
 use photomontage::site::{Interior, Photo, SelfCalibrationFlags};
 
 use crate::commands::Command;
-use crate::points::name_widget;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 
 /// Which photo's camera settings are shown.
 #[derive(Debug, Default)]
 pub struct PhotoSettings {
     /// The photo whose window is open.
     pub photo: Option<String>,
+    /// That photo's decoded size, set by the studio each frame (`None` until it is decoded).
+    pub size_px: Option<[u32; 2]>,
 }
 
 fn drag(
@@ -186,23 +189,21 @@ impl crate::Studio {
     pub fn open_photo_settings(&mut self, id: &str) {
         self.photo_settings.photo = Some(id.to_owned());
     }
+}
 
-    pub(crate) fn photo_settings_ui(&mut self, ctx: &egui::Context) {
-        let Some(id) = self.photo_settings.photo.clone() else {
-            return;
+impl Panel for PhotoSettings {
+    /// Shows the window of [`PhotoSettings::photo`] (when set) over `ui`'s context; its edits
+    /// come back as [`Action::Edit`]s.
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let Some(id) = self.photo.clone() else {
+            return Vec::new();
         };
-        let Some(photo) = self
+        let Some(photo) = ctx
             .doc
-            .as_ref()
             .and_then(|d| d.site.photos.iter().find(|p| p.id == id))
-            .cloned()
         else {
-            self.photo_settings.photo = None;
-            return;
-        };
-        let size_px = match self.photos.get(&id) {
-            Some(crate::PhotoView::Ready(p)) => Some(p.size_px),
-            _ => None,
+            self.photo = None;
+            return Vec::new();
         };
         let mut open = true;
         let mut close = false;
@@ -213,16 +214,22 @@ impl crate::Studio {
             .collapsible(false)
             // Right of the photo strip, below the toolbar (Undo stays reachable).
             .default_pos(egui::pos2(170.0, 60.0))
-            .show(ctx, |ui| {
-                settings_ui(ui, &photo, size_px, &mut commands);
+            .show(ui.ctx(), |ui| {
+                settings_ui(ui, photo, self.size_px, &mut commands);
                 ui.separator();
                 let r = ui.button("Close");
                 name_widget(ui, &r, "Close camera settings");
                 close = r.clicked();
             });
         if !open || close {
-            self.photo_settings.photo = None;
+            self.photo = None;
         }
-        self.pending.extend(commands);
+        commands
+            .into_iter()
+            .map(|(command, merge_key)| Action::Edit {
+                command: Box::new(command),
+                merge_key,
+            })
+            .collect()
     }
 }

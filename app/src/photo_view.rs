@@ -48,7 +48,7 @@ impl Studio {
                     egui::Align2::CENTER_CENTER,
                     e,
                     egui::FontId::proportional(14.0),
-                    Color32::from_rgb(255, 90, 90),
+                    crate::widgets::ERROR,
                 );
                 return;
             }

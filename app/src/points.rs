@@ -20,6 +20,8 @@ use photomontage::site::{ControlPoint, Observation, Site};
 use std::path::Path;
 
 use crate::commands::Command;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 
 /// σ given to imported control points that carry none (1 cm per axis, the site default).
 pub const DEFAULT_SIGMA_M: [f64; 3] = [0.01; 3];
@@ -129,13 +131,6 @@ pub fn import_file(
             }),
     );
     Ok(Command::Batch(batch))
-}
-
-/// Gives a widget an accessible name (for screen readers and the kittest tests).
-pub fn name_widget(ui: &egui::Ui, response: &egui::Response, name: &str) {
-    ui.ctx().accesskit_node_builder(response.id, |node| {
-        node.set_label(name.to_owned());
-    });
 }
 
 /// The table. `selected` is the selected point id; edits come back as commands.
@@ -294,5 +289,95 @@ mod tests {
         std::fs::write(&bad, "A,1,2\n").expect("write");
         let e = import_file(&site, &bad, Some("P1")).expect_err("bad");
         assert!(e.to_string().contains("line 1"), "{e}");
+    }
+}
+
+/// The Points tab: import of control points, picking a point to place, the control-point table.
+#[derive(Debug, Default)]
+pub struct PointsPanel {
+    /// Control-point file typed by the user (CSV or OpenDroneMap `gcp_list.txt`).
+    pub import_path: String,
+    /// A tie point id typed by the user (a point without survey).
+    pub new_point_id: String,
+}
+
+impl Panel for PointsPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut actions = Vec::new();
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.import_path)
+                    .hint_text(IMPORT_HINT)
+                    .desired_width(330.0),
+            );
+            name_widget(ui, &r, "import path");
+            if ui.button("Import").clicked() {
+                actions.push(Action::ImportPoints);
+            }
+        });
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.new_point_id)
+                    .hint_text("tie point id (no survey)")
+                    .desired_width(160.0),
+            );
+            name_widget(ui, &r, "point id");
+            let id = self.new_point_id.trim();
+            if ui.button("Pick id").clicked() && !id.is_empty() {
+                actions.push(Action::SelectPoint(id.to_owned()));
+            }
+            // Points observed but not surveyed (tie points) are listed for picking too.
+            if let Some(doc) = ctx.doc {
+                let mut ties: Vec<&str> = doc
+                    .site
+                    .observations
+                    .iter()
+                    .map(|o| o.point.as_str())
+                    .filter(|p| !doc.site.control_points.iter().any(|c| c.id == *p))
+                    .collect();
+                ties.sort_unstable();
+                ties.dedup();
+                for t in ties {
+                    let sel = ctx.selected_point == Some(t);
+                    let r = ui.selectable_label(sel, t);
+                    name_widget(ui, &r, &format!("tie {t}"));
+                    if r.clicked() {
+                        actions.push(Action::SelectPoint(t.to_owned()));
+                    }
+                }
+            }
+        });
+        let sel = ctx.selected_point.unwrap_or("none");
+        ui.label(format!(
+            "selected: {sel} — click the photo to place it, drag a mark to move, Delete removes"
+        ));
+        let Some(doc) = ctx.doc else {
+            return actions;
+        };
+        let mut commands = Vec::new();
+        let mut selected = ctx.selected_point.map(str::to_owned);
+        egui::ScrollArea::horizontal().show(ui, |ui| {
+            table_ui(
+                ui,
+                &doc.site,
+                ctx.current_photo,
+                &mut selected,
+                &mut commands,
+            );
+        });
+        if let Some(id) = selected
+            && ctx.selected_point != Some(id.as_str())
+        {
+            actions.push(Action::SelectPoint(id));
+        }
+        actions.extend(
+            commands
+                .into_iter()
+                .map(|(command, merge_key)| Action::Edit {
+                    command: Box::new(command),
+                    merge_key,
+                }),
+        );
+        actions
     }
 }

@@ -43,6 +43,22 @@ impl RenderPanel {
         write_sheet(path, &pdf).map_err(Box::new)?;
         Ok(())
     }
+
+    /// The view geometry report's table (label, value rows as on the sheet), when the report
+    /// is of `photo_id`.
+    pub(crate) fn report_ui(&self, ui: &mut egui::Ui, photo_id: &str) {
+        if let Some(report) = self.report.as_ref().filter(|r| r.photo_id == photo_id) {
+            egui::Grid::new("view geometry")
+                .striped(true)
+                .show(ui, |ui| {
+                    for (label, value) in geometry_rows(report) {
+                        ui.label(label);
+                        ui.label(value);
+                        ui.end_row();
+                    }
+                });
+        }
+    }
 }
 
 impl crate::Studio {
@@ -61,25 +77,6 @@ impl crate::Studio {
                 self.render.report = None;
                 self.say(e.to_string(), true);
             }
-        }
-    }
-
-    /// The Report button and the report's table (label, value rows as on the sheet).
-    pub(crate) fn report_ui(&mut self, ui: &mut egui::Ui) {
-        if ui.button("Report").clicked() {
-            self.make_report();
-        }
-        let id = self.current_photo.clone().unwrap_or_default();
-        if let Some(report) = self.render.report.as_ref().filter(|r| r.photo_id == id) {
-            egui::Grid::new("view geometry")
-                .striped(true)
-                .show(ui, |ui| {
-                    for (label, value) in geometry_rows(report) {
-                        ui.label(label);
-                        ui.label(value);
-                        ui.end_row();
-                    }
-                });
         }
     }
 

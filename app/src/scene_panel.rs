@@ -18,6 +18,8 @@ use photomontage::site::render::site_material_library;
 use photomontage::site::{Observation, Polygon, Site, SiteDocument, TiePoint, stored_camera};
 
 use crate::commands::Command;
+use crate::panel::{Action, Panel, PanelContext};
+use crate::widgets::name_widget;
 
 /// The (camera, observation) ray of `o`, when its photo is solved.
 fn observation_ray(site: &Site, o: &Observation) -> Option<(Camera, ImageObservation)> {
@@ -154,10 +156,12 @@ impl crate::Studio {
         self.apply(Command::PutPolygon { polygon, at: None }, None);
         self.say(format!("polygon {id} created"), false);
     }
+}
 
-    pub(crate) fn scene_tab_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(doc) = self.doc.as_ref() else {
-            return;
+impl Panel for ScenePanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let Some(doc) = ctx.doc else {
+            return Vec::new();
         };
         let ties: Vec<String> = {
             let mut t: Vec<String> = doc
@@ -184,7 +188,7 @@ impl crate::Studio {
         ui.horizontal_wrapped(|ui| {
             for t in &ties {
                 let r = ui.button(t);
-                crate::points::name_widget(ui, &r, &format!("intersect {t}"));
+                name_widget(ui, &r, &format!("intersect {t}"));
                 if r.clicked() {
                     intersect_id = Some(t.clone());
                 }
@@ -195,38 +199,38 @@ impl crate::Studio {
         ui.label("click the points on the photo (or in this list); Enter closes the polygon");
         ui.horizontal(|ui| {
             let r = ui.add(
-                egui::TextEdit::singleline(&mut self.scene.polygon_id)
+                egui::TextEdit::singleline(&mut self.polygon_id)
                     .hint_text("polygon id")
                     .desired_width(120.0),
             );
-            crate::points::name_widget(ui, &r, "polygon id");
-            let selected = if self.scene.material.is_empty() {
+            name_widget(ui, &r, "polygon id");
+            let selected = if self.material.is_empty() {
                 "material".to_owned()
             } else {
-                self.scene.material.clone()
+                self.material.clone()
             };
             egui::ComboBox::from_label("material")
                 .selected_text(selected)
                 .show_ui(ui, |ui| {
                     for m in &materials {
-                        ui.selectable_value(&mut self.scene.material, m.clone(), m);
+                        ui.selectable_value(&mut self.material, m.clone(), m);
                     }
                 });
         });
         ui.horizontal_wrapped(|ui| {
             for p in &points {
                 let r = ui.small_button(p);
-                crate::points::name_widget(ui, &r, &format!("vertex {p}"));
+                name_widget(ui, &r, &format!("vertex {p}"));
                 if r.clicked() {
-                    self.scene.vertices.push(p.clone());
+                    self.vertices.push(p.clone());
                 }
             }
         });
-        ui.label(format!("vertices: {}", self.scene.vertices.join(", ")));
+        ui.label(format!("vertices: {}", self.vertices.join(", ")));
         let mut create = false;
         ui.horizontal(|ui| {
             if ui.button("Remove last vertex").clicked() {
-                self.scene.vertices.pop();
+                self.vertices.pop();
             }
             create = ui.button("Create polygon").clicked();
         });
@@ -237,11 +241,13 @@ impl crate::Studio {
                 format!("{}: {} ({})", p.id, p.vertices.join(" "), p.material),
             );
         }
-        if let Some(t) = intersect_id {
-            self.intersect_tie_point(&t);
-        }
+        let mut actions: Vec<Action> = intersect_id
+            .map(Action::IntersectTiePoint)
+            .into_iter()
+            .collect();
         if create {
-            self.create_polygon();
+            actions.push(Action::CreatePolygon);
         }
+        actions
     }
 }

@@ -1,7 +1,7 @@
 //! Picking polygon vertices on the photo (Scene tab; Durisch 1992 §4.1, scene geometry built
 //! from surveyed and intersected points): the site's control points and intersected tie points
-//! are projected with the current photo's solved camera (`photomontage::camera::Camera::project`,
-//! lens distortion included); a click within [`PICK_RADIUS_POINTS`] of a projected point adds
+//! projected into the current photo by the library (`photomontage::site::photo_points`, lens
+//! distortion included); a click within [`PICK_RADIUS_POINTS`] of a projected point adds
 //! it to the polygon under construction (nearest wins), the polygon's outline is drawn live
 //! (with the site's existing polygons in grey), and Enter (or the panel's button) closes it as
 //! one undoable edit through the command path ([`crate::Studio::create_polygon`]).
@@ -16,50 +16,13 @@
 //! screen segments between projected vertices.
 
 use eframe::egui::{self, Color32, Key, PointerButton, Pos2};
-use photomontage::site::{Site, stored_camera};
+pub use photomontage::site::photo_points::{ProjectedPoint, projected_points};
 
 use crate::viewport::ViewTransform;
 
 /// How close (screen points) a click must be to a projected point to pick it: a little more
 /// than the drawn marker's radius, so that a click on the marker always picks it.
 pub const PICK_RADIUS_POINTS: f32 = 8.0;
-
-/// A scene point projected into a photo.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ProjectedPoint {
-    /// Control-point or tie-point id.
-    pub id: String,
-    /// Pixel position in the photo.
-    pub pixel_px: [f64; 2],
-}
-
-/// The site's control points and tie points (those with world coordinates) projected into the
-/// solved photo `photo_id`, keeping those in front of the camera and inside the image. Empty
-/// when the photo is not solved.
-#[must_use]
-pub fn projected_points(site: &Site, photo_id: &str) -> Vec<ProjectedPoint> {
-    let Some(camera) = stored_camera(site, photo_id) else {
-        return Vec::new();
-    };
-    let [w, h] = camera.intrinsics.image_size_px.map(f64::from);
-    let controls = site.control_points.iter().map(|c| (&c.id, c.xyz));
-    let ties = site
-        .tie_points
-        .iter()
-        .filter(|t| !site.control_points.iter().any(|c| c.id == t.id))
-        .map(|t| (&t.id, t.xyz));
-    controls
-        .chain(ties)
-        .filter_map(|(id, xyz)| {
-            let p = camera.project(&xyz.into())?;
-            let inside = (-0.5..w - 0.5).contains(&p.x) && (-0.5..h - 0.5).contains(&p.y);
-            inside.then(|| ProjectedPoint {
-                id: id.clone(),
-                pixel_px: [p.x, p.y],
-            })
-        })
-        .collect()
-}
 
 /// The id of the projected point nearest to `screen` under `t`, if within `radius_points`.
 #[must_use]

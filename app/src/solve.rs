@@ -1,7 +1,8 @@
 //! Solving in the studio: [`photomontage::site::solve_site`] (resection of every photo, then the
-//! bundle adjustment; Durisch 1992 §4.1) on a named worker thread, its result sent back over a
-//! channel; the residual table, the residual vectors drawn on the photo with a scale bar, and the
-//! warnings and failures as readable messages.
+//! bundle adjustment; Durisch 1992 §4.1) on the studio's [`crate::worker::Worker`] (a panic in
+//! the solver becomes a message); the Results tab ([`ResultsPanel`]) with the residual table,
+//! the residual vectors drawn on the photo with a scale bar, and the warnings and failures as
+//! readable messages.
 //!
 //! The table shows the numbers exactly as `photomontage solve` prints them (same rounding), so
 //! the two can be compared by eye and by the tests.
@@ -13,61 +14,24 @@
 use eframe::egui::{self, Color32, Pos2, Stroke};
 use egui_extras::{Column, TableBuilder};
 use photomontage::site::{SiteDocument, SiteSolution, solve::PhotoSolution};
-use std::sync::mpsc;
 
+use crate::panel::{Action, Panel, PanelContext};
 use crate::viewport::ViewTransform;
+use crate::widgets::{ERROR, WARNING, name_widget};
+use crate::worker::Worker;
 
-/// A solve running on the worker, or its outcome.
-#[derive(Default)]
-pub struct SolveWorker {
-    rx: Option<mpsc::Receiver<Result<SiteSolution, String>>>,
+/// The solve's worker: [`photomontage::site::solve_site`] on a snapshot of the site.
+pub type SolveWorker = Worker<SiteSolution>;
+
+/// A worker for solves, named `solve`.
+#[must_use]
+pub fn solve_worker() -> SolveWorker {
+    Worker::new("solve")
 }
 
-impl SolveWorker {
-    /// Starts solving a snapshot of the site. Returns false when a solve is already running.
-    pub fn start(&mut self, doc: SiteDocument, ctx: egui::Context) -> bool {
-        if self.rx.is_some() {
-            return false;
-        }
-        let (tx, rx) = mpsc::channel();
-        let spawned = std::thread::Builder::new()
-            .name("solve".into())
-            .spawn(move || {
-                let result = std::panic::catch_unwind(|| photomontage::site::solve_site(&doc))
-                    .map_err(|_| "the solver crashed; the site is unchanged".to_string());
-                let _ = tx.send(result);
-                ctx.request_repaint();
-            });
-        match spawned {
-            Ok(_) => {
-                self.rx = Some(rx);
-                true
-            }
-            Err(_) => false,
-        }
-    }
-
-    /// Whether a solve is running.
-    #[must_use]
-    pub fn busy(&self) -> bool {
-        self.rx.is_some()
-    }
-
-    /// The outcome, once the worker has finished.
-    pub fn poll(&mut self) -> Option<Result<SiteSolution, String>> {
-        let rx = self.rx.as_ref()?;
-        match rx.try_recv() {
-            Ok(r) => {
-                self.rx = None;
-                Some(r)
-            }
-            Err(mpsc::TryRecvError::Empty) => None,
-            Err(mpsc::TryRecvError::Disconnected) => {
-                self.rx = None;
-                Some(Err("the solve worker stopped without an answer".into()))
-            }
-        }
-    }
+/// Starts solving a snapshot of the site. Returns false when a solve is already running.
+pub fn start_solve(worker: &mut SolveWorker, doc: SiteDocument, ctx: &egui::Context) -> bool {
+    worker.spawn(ctx, move |_| photomontage::site::solve_site(&doc))
 }
 
 /// `|v|` and `|v|/σ` of a residual row, as the CLI computes them.
@@ -105,7 +69,7 @@ pub fn photo_solution_ui(ui: &mut egui::Ui, s: &PhotoSolution) {
         c.x, c.y, c.z, s.sigma_center_m[0], s.sigma_center_m[1], s.sigma_center_m[2]
     ));
     for w in &s.warnings {
-        ui.colored_label(Color32::from_rgb(230, 160, 40), format!("warning: {w}"));
+        ui.colored_label(crate::widgets::WARNING, format!("warning: {w}"));
     }
     TableBuilder::new(ui)
         .id_salt(("residuals", &s.id))
@@ -225,5 +189,53 @@ mod tests {
         assert!((scale_bar_px(3.0, 120.0) - 20.0).abs() < 1e-12);
         assert!((scale_bar_px(120.0, 120.0) - 1.0).abs() < 1e-12);
         assert!((scale_bar_px(500.0, 120.0) - 0.2).abs() < 1e-12);
+    }
+}
+
+/// The Results tab: residual-vector display, the solve's summary, failures, warnings and each
+/// photo's residual table (the current photo first).
+#[derive(Debug, Default)]
+pub struct ResultsPanel;
+
+impl Panel for ResultsPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &PanelContext<'_>) -> Vec<Action> {
+        let mut residuals = ctx.residuals;
+        ui.horizontal(|ui| {
+            let r = ui.checkbox(&mut residuals.show, "residual vectors");
+            name_widget(ui, &r, "residual vectors");
+            let r = ui.add(
+                egui::Slider::new(&mut residuals.exaggeration, 1.0..=5000.0)
+                    .logarithmic(true)
+                    .text("×"),
+            );
+            name_widget(ui, &r, "residual exaggeration");
+        });
+        let actions: Vec<Action> = (residuals != ctx.residuals)
+            .then_some(Action::SetResiduals(residuals))
+            .into_iter()
+            .collect();
+        let Some(solution) = ctx.solution else {
+            ui.label("not solved yet: press Solve");
+            return actions;
+        };
+        if let Some(r) = solution.bundle_rms_px {
+            ui.strong(format!("bundle adjustment RMS {r:.3} px"));
+        }
+        for f in &solution.failures {
+            ui.colored_label(ERROR, format!("{}: {}", f.id, f.error));
+        }
+        for w in &solution.warnings {
+            ui.colored_label(WARNING, format!("warning: {w}"));
+        }
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            // The current photo first, then the others.
+            let mut order: Vec<_> = solution.photos.iter().collect();
+            order.sort_by_key(|p| Some(p.id.as_str()) != ctx.current_photo);
+            for p in order {
+                ui.separator();
+                photo_solution_ui(ui, p);
+            }
+        });
+        actions
     }
 }

@@ -2,7 +2,7 @@
 //! pixel about the cursor, fit, pan by dragging with the middle or right button (or the left
 //! with space held), and a loupe for sub-pixel placing.
 //!
-//! Photos are decoded on a worker thread ([`PhotoLoader`]) into 8-bit tiles of at most
+//! Photos are decoded on the studio's worker ([`PhotoLoader`], [`crate::worker::Worker`]) into 8-bit tiles of at most
 //! [`TILE_PX`] and one downsampled mip level whose long side is at most [`MIP_MAX_PX`]. The mip
 //! is uploaded first and drawn whenever it is sharp enough or a tile is not uploaded yet; full
 //! resolution tiles are uploaded lazily, only when visible and only [`UPLOADS_PER_FRAME`] per
@@ -22,7 +22,8 @@ use eframe::egui::{self, Color32, ColorImage, Pos2, Rect, TextureHandle, Texture
 use photomontage::colour::tonemap::{ToneMap, encode_srgb8};
 use photomontage::photo::{self, Transfer};
 use std::path::PathBuf;
-use std::sync::mpsc;
+
+use crate::worker::{Poll, Worker};
 
 /// Largest tile side in pixels.
 pub const TILE_PX: u32 = 1024;
@@ -339,56 +340,49 @@ pub struct Decoded {
     pub result: Result<DecodedPhoto, String>,
 }
 
-/// Decodes photos on a named worker thread, one thread per request.
+/// Decodes photos on the studio's [`Worker`], one worker (thread) per requested photo.
+#[derive(Default)]
 pub struct PhotoLoader {
-    tx: mpsc::Sender<Decoded>,
-    rx: mpsc::Receiver<Decoded>,
-    in_flight: usize,
-}
-
-impl Default for PhotoLoader {
-    fn default() -> Self {
-        let (tx, rx) = mpsc::channel();
-        Self {
-            tx,
-            rx,
-            in_flight: 0,
-        }
-    }
+    in_flight: Vec<(String, Worker<Result<DecodedPhoto, String>>)>,
 }
 
 impl PhotoLoader {
     /// Starts decoding `path` for `photo_id`; `ctx` is woken when it is done.
-    pub fn request(&mut self, photo_id: String, path: PathBuf, ctx: egui::Context) {
-        let tx = self.tx.clone();
-        let spawned = std::thread::Builder::new()
-            .name(format!("decode {photo_id}"))
-            .spawn(move || {
-                let result = std::panic::catch_unwind(|| {
-                    photo::load(&path)
-                        .map(|img| prepare_display(&img))
-                        .map_err(|e| e.to_string())
-                })
-                .unwrap_or_else(|_| Err(format!("decoding {} crashed", path.display())));
-                let _ = tx.send(Decoded { photo_id, result });
-                ctx.request_repaint();
-            });
-        if spawned.is_ok() {
-            self.in_flight += 1;
+    pub fn request(&mut self, photo_id: String, path: PathBuf, ctx: &egui::Context) {
+        let mut worker = Worker::new(format!("decode {photo_id}"));
+        let spawned = worker.spawn(ctx, move |_| {
+            photo::load(&path)
+                .map(|img| prepare_display(&img))
+                .map_err(|e| e.to_string())
+        });
+        if spawned {
+            self.in_flight.push((photo_id, worker));
         }
     }
 
-    /// Decodes that finished since the last call.
+    /// Decodes that finished since the last call (a panicking decoder is a failed decode).
     pub fn poll(&mut self) -> Vec<Decoded> {
-        let done: Vec<Decoded> = self.rx.try_iter().collect();
-        self.in_flight = self.in_flight.saturating_sub(done.len());
+        let mut done = Vec::new();
+        self.in_flight.retain_mut(|(photo_id, worker)| {
+            let result = match worker.poll() {
+                Poll::Running(_) => return true,
+                Poll::Done(r) => r,
+                Poll::Failed(e) => Err(e),
+                Poll::Cancelled | Poll::Idle => Err(format!("decoding {photo_id} stopped")),
+            };
+            done.push(Decoded {
+                photo_id: std::mem::take(photo_id),
+                result,
+            });
+            false
+        });
         done
     }
 
     /// Whether a decode is running.
     #[must_use]
     pub fn busy(&self) -> bool {
-        self.in_flight > 0
+        !self.in_flight.is_empty()
     }
 }
 

@@ -15,7 +15,9 @@
 
 mod locate;
 pub mod luminaires;
+pub mod models;
 pub mod new;
+pub mod photo_points;
 pub mod render;
 pub mod render_error;
 pub mod render_photo;
