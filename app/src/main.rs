@@ -45,6 +45,12 @@ struct Args {
     /// Start a solve on the first frame.
     #[arg(long)]
     solve: bool,
+    /// Largest photo the studio decodes, in megapixels (as the CLI's option).
+    #[arg(long, value_name = "MP", default_value_t = 250.0)]
+    max_photo_megapixels: f64,
+    /// Most memory decoding one photo may take, in MiB (as the CLI's option).
+    #[arg(long, value_name = "MIB", default_value_t = 8192)]
+    max_decode_memory_mib: u64,
 }
 
 fn apply_script(studio: &mut Studio, script: &PathBuf) -> anyhow::Result<()> {
@@ -143,6 +149,12 @@ fn run_headless(mut studio: Studio) -> anyhow::Result<()> {
 
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
+    photomontage::photo::DecodeLimits::set_for_process(
+        photomontage::photo::DecodeLimits::from_megapixels_and_mib(
+            args.max_photo_megapixels,
+            args.max_decode_memory_mib,
+        )?,
+    )?;
     let site = args.site.clone().unwrap_or_else(default_site_path);
     let options = StudioOptions {
         site_path: site,

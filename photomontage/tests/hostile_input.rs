@@ -432,3 +432,32 @@ fn non_utf8_source_folder_is_refused_not_rewritten() {
     assert!(!outcome.stderr.contains('\u{fffd}') || outcome.stderr.contains("caf"));
     assert!(!out.exists(), "a site was written");
 }
+
+/// The photo decoding caps are configurable: a lower `--max-photo-megapixels` refuses the small
+/// site's 96×64 photo (its stated size, before the file is opened), the same render passes with
+/// the default, and a zero cap is an error, not "no limit".
+#[test]
+fn photo_decoding_caps_are_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = make_site(dir.path());
+    let out = dir.path().join("out.png");
+    let render_with = |extra: &[&str]| {
+        let mut args = vec![
+            os("render"),
+            site.as_os_str(),
+            os("--view"),
+            os("p1"),
+            os("--out"),
+            out.as_os_str(),
+        ];
+        args.extend(extra.iter().map(|a| os(a)));
+        run(&args)
+    };
+    assert_refused(
+        &render_with(&["--max-photo-megapixels", "0.005"]),
+        &["image_size_px", "96×64", "0.005 MP"],
+    );
+    assert_refused(&render_with(&["--max-decode-memory-mib", "0"]), &["limits"]);
+    let fine = render_with(&[]);
+    assert_eq!(fine.code, Some(0), "{}", fine.stderr);
+}

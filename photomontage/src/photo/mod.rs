@@ -37,6 +37,12 @@ pub enum PhotoError {
         height: u32,
         limits: DecodeLimits,
     },
+    #[error(
+        "photo decoding limits must be positive: {} MP, {} bytes",
+        limits.max_pixels as f64 / 1e6,
+        limits.max_bytes
+    )]
+    BadLimits { limits: DecodeLimits },
 }
 
 /// Caps on decoding a photo, checked against the header before any pixel is allocated.
@@ -48,14 +54,60 @@ pub struct DecodeLimits {
     pub max_bytes: u64,
 }
 
-impl Default for DecodeLimits {
+/// The limits a program set for itself with [`DecodeLimits::set_for_process`].
+static PROCESS_LIMITS: std::sync::RwLock<Option<DecodeLimits>> = std::sync::RwLock::new(None);
+
+impl DecodeLimits {
     /// 250 MP and 8 GiB: a 250 MP photo needs at most 2 GB (16-bit RGBA) + 3 GB (float RGB), so
-    /// the default leaves room for rendering on a 24 GB machine.
-    fn default() -> Self {
-        Self {
-            max_pixels: 250_000_000,
-            max_bytes: 8 << 30,
+    /// these leave room for rendering on a 24 GB machine.
+    pub const BUILT_IN: Self = Self {
+        max_pixels: 250_000_000,
+        max_bytes: 8 << 30,
+    };
+
+    /// Makes `limits` what [`DecodeLimits::default`] gives in this process (the CLI's
+    /// `--max-photo-megapixels` and `--max-decode-memory-mib`, the studio's same options).
+    ///
+    /// # Errors
+    /// [`PhotoError::BadLimits`] for a zero cap.
+    pub fn set_for_process(limits: Self) -> Result<(), PhotoError> {
+        if limits.max_pixels == 0 || limits.max_bytes == 0 {
+            return Err(PhotoError::BadLimits { limits });
         }
+        *PROCESS_LIMITS
+            .write()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(limits);
+        Ok(())
+    }
+
+    /// Limits from a cap in megapixels and one in MiB, as the command-line options give them.
+    ///
+    /// # Errors
+    /// [`PhotoError::BadLimits`] for a cap that is not positive and finite.
+    pub fn from_megapixels_and_mib(megapixels: f64, mib: u64) -> Result<Self, PhotoError> {
+        let limits = Self {
+            max_pixels: if megapixels.is_finite() && megapixels > 0.0 {
+                (megapixels * 1e6).round().min(u64::MAX as f64) as u64
+            } else {
+                0
+            },
+            max_bytes: mib.saturating_mul(1 << 20),
+        };
+        if limits.max_pixels == 0 || limits.max_bytes == 0 {
+            return Err(PhotoError::BadLimits { limits });
+        }
+        Ok(limits)
+    }
+}
+
+impl Default for DecodeLimits {
+    /// The limits set for this process ([`DecodeLimits::set_for_process`]), else
+    /// [`DecodeLimits::BUILT_IN`].
+    fn default() -> Self {
+        PROCESS_LIMITS
+            .read()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .unwrap_or(Self::BUILT_IN)
     }
 }
 

@@ -130,8 +130,9 @@ impl Site {
                     issues.push(issue(
                         format!("photos[{i}].interior.image_size_px"),
                         format!(
-                            "{w}×{h} px is more than the {} MP a photo may have",
-                            max_pixels / 1_000_000
+                            "{w}×{h} px is more than the {} MP a photo may have \
+                             (--max-photo-megapixels)",
+                            max_pixels as f64 / 1e6
                         ),
                     ));
                 }

@@ -27,6 +27,13 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Largest photo any command decodes, in megapixels (checked against the file header before
+    /// a pixel is allocated; larger photos are refused naming the file and its size).
+    #[arg(long, global = true, value_name = "MP", default_value_t = 250.0)]
+    max_photo_megapixels: f64,
+    /// Most memory decoding one photo may take (decoder plus float copy), in MiB.
+    #[arg(long, global = true, value_name = "MIB", default_value_t = 8192)]
+    max_decode_memory_mib: u64,
 }
 
 #[derive(Subcommand)]
@@ -77,6 +84,12 @@ enum Command {
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
+    photomontage::photo::DecodeLimits::set_for_process(
+        photomontage::photo::DecodeLimits::from_megapixels_and_mib(
+            cli.max_photo_megapixels,
+            cli.max_decode_memory_mib,
+        )?,
+    )?;
     match cli.command {
         Command::Info(args) => info::run(&args),
         Command::Solve(args) => solve::run(&args),
