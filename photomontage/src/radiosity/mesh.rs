@@ -215,7 +215,10 @@ impl Mesh {
             let area_m2 = 0.5 * cross.norm();
             let longest = longest_edge_m(&v);
             let finite = v.iter().all(|p| p.coords.iter().all(|c| c.is_finite()));
-            if !finite || !(area_m2 > DEGENERATE_AREA_RATIO * longest * longest) {
+            if !finite
+                || area_m2.partial_cmp(&(DEGENERATE_AREA_RATIO * longest * longest))
+                    != Some(std::cmp::Ordering::Greater)
+            {
                 mesh.warnings.push(MeshWarning::DegenerateTriangle {
                     object: name_of(tri.object),
                     triangle: index,
