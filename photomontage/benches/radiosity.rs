@@ -40,17 +40,44 @@ fn add(scene: &mut Scene, name: &str, triangles: Vec<Tri>, albedo: f64) {
 /// A 20 × 20 m court: ground (ρ 0.2), three 8 m walls facing in (ρ 0.4–0.7), open to the south.
 fn courtyard() -> Scene {
     let mut s = Scene::new();
-    add(&mut s, "ground", quad([0., 0., 0.], [20., 0., 0.], [20., 20., 0.], [0., 20., 0.]), 0.2);
-    add(&mut s, "west", quad([0., 0., 0.], [0., 20., 0.], [0., 20., 8.], [0., 0., 8.]), 0.5);
-    add(&mut s, "east", quad([20., 0., 0.], [20., 0., 8.], [20., 20., 8.], [20., 20., 0.]), 0.7);
-    add(&mut s, "north", quad([0., 20., 0.], [20., 20., 0.], [20., 20., 8.], [0., 20., 8.]), 0.4);
+    add(
+        &mut s,
+        "ground",
+        quad([0., 0., 0.], [20., 0., 0.], [20., 20., 0.], [0., 20., 0.]),
+        0.2,
+    );
+    add(
+        &mut s,
+        "west",
+        quad([0., 0., 0.], [0., 20., 0.], [0., 20., 8.], [0., 0., 8.]),
+        0.5,
+    );
+    add(
+        &mut s,
+        "east",
+        quad([20., 0., 0.], [20., 0., 8.], [20., 20., 8.], [20., 20., 0.]),
+        0.7,
+    );
+    add(
+        &mut s,
+        "north",
+        quad([0., 20., 0.], [20., 20., 0.], [20., 20., 8.], [0., 20., 8.]),
+        0.4,
+    );
     s
 }
 
 fn groups() -> Vec<LightGroup> {
     let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
     let sun = photomontage::sky::direction_from_elevation_azimuth(0.7, 2.6);
-    let sky = sky_sources(&SkyModel::cie_general(12).unwrap(), &sun, [0.3; 3], &dome, 0.1).unwrap();
+    let sky = sky_sources(
+        &SkyModel::cie_general(12).unwrap(),
+        &sun,
+        [0.3; 3],
+        &dome,
+        0.1,
+    )
+    .unwrap();
     vec![LightGroup::sun(sun, [3.0; 3]), LightGroup::sky(sky)]
 }
 
@@ -94,8 +121,16 @@ fn bench_solves(c: &mut Criterion) {
     let mut group = c.benchmark_group("radiosity_solve");
     group.sample_size(10);
     for (name, edge, solver) in [
-        ("hierarchical", 1.0, Solver::Hierarchical(HierarchicalParams::default())),
-        ("hierarchical", 0.5, Solver::Hierarchical(HierarchicalParams::default())),
+        (
+            "hierarchical",
+            1.0,
+            Solver::Hierarchical(HierarchicalParams::default()),
+        ),
+        (
+            "hierarchical",
+            0.5,
+            Solver::Hierarchical(HierarchicalParams::default()),
+        ),
         ("progressive", 2.0, Solver::Progressive),
     ] {
         let p = params(edge, solver);
