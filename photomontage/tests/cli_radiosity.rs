@@ -22,6 +22,7 @@ fn radiosity_reports_and_writes_mesh_and_convergence() {
     let site = common::make_site(dir.path());
     let ply = dir.path().join("mesh.ply");
     let csv = dir.path().join("convergence.csv");
+    let png = dir.path().join("convergence.png");
     let out = photomontage(&[
         "radiosity".as_ref(),
         site.as_os_str(),
@@ -31,6 +32,8 @@ fn radiosity_reports_and_writes_mesh_and_convergence() {
         ply.as_os_str(),
         "--convergence".as_ref(),
         csv.as_os_str(),
+        "--convergence-plot".as_ref(),
+        png.as_os_str(),
         "--json".as_ref(),
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -63,6 +66,8 @@ fn radiosity_reports_and_writes_mesh_and_convergence() {
     );
     let sun_passes = lines.filter(|l| l.starts_with("sun,")).count() as u64;
     assert_eq!(sun_passes, groups[0]["passes"].as_u64().unwrap());
+    let plot = image::open(&png).unwrap();
+    assert_eq!((plot.width(), plot.height()), (720, 440));
 }
 
 #[test]

@@ -31,6 +31,7 @@
 //! a light group.
 
 pub mod convergence;
+pub mod convergence_plot;
 pub mod direct;
 pub mod form_factor;
 pub mod hierarchical;

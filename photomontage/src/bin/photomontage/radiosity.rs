@@ -82,6 +82,9 @@ pub struct Args {
     /// Write the convergence record (every pass of every group) as CSV.
     #[arg(long, value_name = "FILE.csv")]
     convergence: Option<PathBuf>,
+    /// Plot the convergence record (log residual and mean change per pass and group) as PNG.
+    #[arg(long, value_name = "FILE.png")]
+    convergence_plot: Option<PathBuf>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -143,7 +146,12 @@ fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGrou
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    for path in args.mesh_out.iter().chain(&args.convergence) {
+    for path in args
+        .mesh_out
+        .iter()
+        .chain(&args.convergence)
+        .chain(&args.convergence_plot)
+    {
         probe_writable(path).with_context(|| format!("cannot write {}", path.display()))?;
     }
     let doc = SiteDocument::load(&args.site)?;
@@ -232,6 +240,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(path) = &args.convergence {
         write_atomically(path, csv(&rows).as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.convergence_plot {
+        photomontage::radiosity::convergence_plot::write_png(path, &rows, &stop)?;
     }
     let converged = solution.converged(&stop);
     let groups_json: Vec<serde_json::Value> = solution
