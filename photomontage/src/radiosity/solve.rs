@@ -111,6 +111,32 @@ pub struct GroupSolution {
     pub convergence: Vec<ConvergenceRow>,
 }
 
+impl GroupSolution {
+    /// Total irradiance (direct plus interreflected) per element, H = (B − π·L_e)/ρ per channel;
+    /// where ρ = 0 the interreflected part is unknown and only the direct irradiance is given.
+    #[must_use]
+    pub fn irradiance_rgb(&self, mesh: &Mesh, include_emission: bool) -> Vec<Rgb> {
+        (0..mesh.elements.len())
+            .map(|e| {
+                let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+                std::array::from_fn(|c| {
+                    let rho = surface.reflectance_rgb[c];
+                    let emitted = if include_emission {
+                        surface.emission_rgb[c]
+                    } else {
+                        0.0
+                    };
+                    if rho > 0.0 {
+                        (self.radiosity_rgb[e][c] - emitted) / rho
+                    } else {
+                        self.direct_irradiance_rgb[e][c]
+                    }
+                })
+            })
+            .collect()
+    }
+}
+
 /// The solution of all groups on one mesh.
 #[derive(Debug, Clone)]
 pub struct Solution {
