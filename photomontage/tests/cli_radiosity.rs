@@ -151,3 +151,46 @@ fn ctrl_c_cancels_without_writing() {
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
+
+/// Every enabled `[[luminaires]]` entry is its own light group, named after its id.
+#[test]
+fn luminaires_are_light_groups() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = common::make_site(dir.path());
+    std::fs::write(
+        dir.path().join("downlight.ies"),
+        include_str!("fixtures/downlight.ies"),
+    )
+    .unwrap();
+    let mut text = std::fs::read_to_string(&site).unwrap();
+    text.push_str(
+        "\n[[luminaires]]\nid = \"porch\"\nfile = \"downlight.ies\"\nposition_m = [5.0, 5.0, 2.0]\nscale = 1e-4\n\
+         \n[[luminaires]]\nid = \"off\"\nfile = \"downlight.ies\"\nposition_m = [-5.0, 5.0, 2.0]\nscale = 1e-4\nenabled = false\n",
+    );
+    std::fs::write(&site, text).unwrap();
+    let out = photomontage(&[
+        "radiosity".as_ref(),
+        site.as_os_str(),
+        "--element-edge-m".as_ref(),
+        "2".as_ref(),
+        "--json".as_ref(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let names: Vec<&str> = report["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["sun", "luminaire:porch"], "{report}");
+    let porch = &report["groups"][1];
+    assert!(
+        porch["mean_radiosity_luminance"].as_f64().unwrap() > 0.0,
+        "{report}"
+    );
+}

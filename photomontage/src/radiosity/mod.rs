@@ -27,8 +27,8 @@
 //! water materials are treated by their diffuse reflectance only. Elements are a uniform
 //! subdivision (midpoint 1→4 splits to the element size); there is no discontinuity meshing, the
 //! adaptivity is the hierarchical solver's (links at coarser levels where the transfer is small).
-//! The renderer does not use the solution yet. No spectral mode (RGB only). Luminaires are not yet
-//! a light group.
+//! The renderer does not use the solution yet. No spectral mode (RGB only). Luminaires are point
+//! sources.
 
 pub mod convergence;
 pub mod convergence_plot;
@@ -53,7 +53,7 @@ pub use convergence::{ConvergenceRow, StopRule};
 pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning};
 pub use solve::{GroupSolution, LightGroup, Solution, SolveParams, Solver, solve, solve_on_mesh};
-pub use sources::DistantSource;
+pub use sources::{DistantSource, PointSource};
 
 /// RGB triple (linear).
 pub type Rgb = [f64; 3];

@@ -8,7 +8,7 @@ use super::form_factor::{FormFactorEngine, FormFactorParams};
 use super::hierarchical::{HierarchicalParams, Hierarchy};
 use super::mesh::{Mesh, MeshParams};
 use super::progressive::RowCache;
-use super::sources::{self, DistantSource};
+use super::sources::{self, DistantSource, PointSource};
 use super::{RadiosityError, Rgb, direct, progressive};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
@@ -59,6 +59,8 @@ pub struct LightGroup {
     pub name: String,
     /// Distant sources.
     pub sources: Vec<DistantSource>,
+    /// Point sources (luminaires).
+    pub points: Vec<PointSource>,
     /// Whether the materials' emission belongs to this group.
     pub emission: bool,
 }
@@ -73,6 +75,7 @@ impl LightGroup {
                 dir_in_world: sun_dir_in_world,
                 normal_irradiance_rgb,
             }],
+            points: Vec::new(),
             emission: false,
         }
     }
@@ -83,6 +86,7 @@ impl LightGroup {
         Self {
             name: "sky".into(),
             sources,
+            points: Vec::new(),
             emission: false,
         }
     }
@@ -93,7 +97,19 @@ impl LightGroup {
         Self {
             name: "emitters".into(),
             sources: Vec::new(),
+            points: Vec::new(),
             emission: true,
+        }
+    }
+
+    /// One luminaire (or isotropic point light) named `name`.
+    #[must_use]
+    pub fn luminaire(name: &str, source: PointSource) -> Self {
+        Self {
+            name: name.to_owned(),
+            sources: Vec::new(),
+            points: vec![source],
+            emission: false,
         }
     }
 }
@@ -222,7 +238,16 @@ pub fn solve_on_mesh(
     let mut b0s = Vec::with_capacity(groups.len());
     for (g, group) in groups.iter().enumerate() {
         sources::validate(&group.name, &group.sources)?;
-        let direct = sources::direct_irradiance(&engine, &group.sources, g as u64);
+        sources::validate_points(&group.name, &group.points)?;
+        let mut direct = sources::direct_irradiance(&engine, &group.sources, g as u64);
+        if !group.points.is_empty() {
+            let from_points = sources::point_irradiance(&engine, &group.points, g as u64);
+            for (d, p) in direct.iter_mut().zip(from_points) {
+                for c in 0..3 {
+                    d[c] += p[c];
+                }
+            }
+        }
         let b0: Vec<Rgb> = (0..n)
             .map(|e| {
                 let node = mesh.element_node(e);

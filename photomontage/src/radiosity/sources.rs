@@ -10,18 +10,23 @@
 //! many-cluster sky), so an element costs max(N, S) rays. Each element draws from its own
 //! ChaCha8 stream (seed and group, stream = element index): thread-count independent.
 //!
+//! A point source (a luminaire, [`PointSource`]) of intensity I(ω) gives E = I(ω)·cos θ/d² at
+//! each of the element's N points, with a shadow ray to the source, averaged over the points.
+//!
 //! # Known limitations
 //! The sky is lit from above the horizon only; where the site's ground is not modelled, nothing
 //! lights from below (the "ground below the horizon" choice is not made yet). The sun is
-//! a point in direction d (no penumbra from the 0.53° disc). Luminaires are not a group yet.
+//! a point in direction d (no penumbra from the 0.53° disc). Luminaires are point sources (the
+//! opening's size is ignored, as in the renderer).
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use super::form_factor::FormFactorEngine;
 use super::{RadiosityError, Rgb};
+use crate::luminaire::Luminaire;
 use crate::sky::SkyModel;
 use crate::sky_dome::icosahedral::IcosahedralDome;
 
@@ -196,4 +201,99 @@ pub fn sky_sources(
                 .map(|k| k * c.integrated_luminance / horizontal),
         })
         .collect())
+}
+
+/// A point source: an isotropic light or a luminaire with its photometric web.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointSource {
+    /// Position (photometric centre), world metres.
+    pub position_in_world_m: Point3<f64>,
+    /// The positioned, aimed luminaire; `None` for an isotropic source.
+    pub luminaire: Option<Luminaire>,
+    /// Intensity per channel: the isotropic intensity, or the factor per candela of the web.
+    pub intensity_rgb: Rgb,
+}
+
+impl PointSource {
+    /// Intensity towards the unit direction `dir_from_light_in_world`, per channel.
+    #[must_use]
+    pub fn intensity_toward_rgb(&self, dir_from_light_in_world: &Vector3<f64>) -> Rgb {
+        let cd = self
+            .luminaire
+            .as_ref()
+            .map_or(1.0, |l| l.intensity_toward_cd(dir_from_light_in_world));
+        self.intensity_rgb.map(|k| k * cd)
+    }
+}
+
+/// Checks point sources: finite position, finite non-negative intensity.
+///
+/// # Errors
+/// [`RadiosityError::InvalidSource`] naming the group.
+pub fn validate_points(group: &str, points: &[PointSource]) -> Result<(), RadiosityError> {
+    for (k, p) in points.iter().enumerate() {
+        if !p.position_in_world_m.coords.iter().all(|c| c.is_finite())
+            || p.intensity_rgb
+                .iter()
+                .any(|v| !(v.is_finite() && *v >= 0.0))
+        {
+            return Err(RadiosityError::InvalidSource {
+                group: group.to_owned(),
+                reason: format!(
+                    "point source {k}: position {:?} and intensity {:?} must be finite (intensity ≥ 0)",
+                    p.position_in_world_m.coords, p.intensity_rgb
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Direct irradiance per element from point sources (module doc).
+#[must_use]
+pub fn point_irradiance(
+    engine: &FormFactorEngine<'_>,
+    points: &[PointSource],
+    group_index: u64,
+) -> Vec<Rgb> {
+    let mesh = engine.mesh();
+    let params = engine.params();
+    let n = params.samples_per_axis as usize;
+    #[allow(clippy::cast_precision_loss)]
+    let inv_n = 1.0 / n as f64;
+    (0..mesh.elements.len())
+        .into_par_iter()
+        .map(|e| {
+            let node = mesh.element_node(e);
+            let mut rng = ChaCha8Rng::seed_from_u64(params.seed ^ DIRECT_SEED_SALT ^ group_index);
+            rng.set_stream(e as u64);
+            let mut e_rgb = [0.0; 3];
+            #[allow(clippy::cast_precision_loss)]
+            for k in 0..n * n {
+                let u = ((k / n) as f64 + rng.random::<f64>()) * inv_n;
+                let v = ((k % n) as f64 + rng.random::<f64>()) * inv_n;
+                let x = node.point_at(u, v);
+                for p in points {
+                    let to_light = p.position_in_world_m - x;
+                    let d2 = to_light.norm_squared();
+                    if d2 <= 0.0 {
+                        continue;
+                    }
+                    let d = d2.sqrt();
+                    let cos = node.normal_in_world.dot(&to_light) / d;
+                    if cos <= 0.0 {
+                        continue;
+                    }
+                    if params.visibility && !engine.visible(&x, &p.position_in_world_m) {
+                        continue;
+                    }
+                    let intensity = p.intensity_toward_rgb(&(-to_light / d));
+                    for c in 0..3 {
+                        e_rgb[c] += intensity[c] * cos / d2;
+                    }
+                }
+            }
+            e_rgb.map(|v| v * inv_n * inv_n)
+        })
+        .collect()
 }

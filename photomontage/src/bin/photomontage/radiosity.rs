@@ -1,5 +1,5 @@
-//! `photomontage radiosity SITE`: mesh the site's scene, light it by the sun, the sky and the
-//! emitting materials as separate groups and solve the interreflection; report patches, links,
+//! `photomontage radiosity SITE`: mesh the site's scene, light it by the sun, the sky, each
+//! enabled luminaire and the emitting materials as separate groups and solve the interreflection; report patches, links,
 //! passes, time and residual, and optionally write the mesh (PLY), the convergence record (CSV)
 //! and a JSON report. Ctrl-C cancels between passes; nothing is written then.
 
@@ -15,9 +15,12 @@ use photomontage::radiosity::convergence::csv;
 use photomontage::radiosity::hierarchical::HierarchicalParams;
 use photomontage::radiosity::sources::sky_sources;
 use photomontage::radiosity::{
-    FormFactorParams, LightGroup, MeshParams, SolveParams, Solver, StopRule, luminance, solve,
+    FormFactorParams, LightGroup, MeshParams, PointSource, SolveParams, Solver, StopRule,
+    luminance, solve,
 };
+use photomontage::render::luminaire_light::ArtificialLight;
 use photomontage::site::SiteDocument;
+use photomontage::site::luminaires::site_luminaire_lights;
 use photomontage::site::render::{parse_sky_model, site_scene, site_sun_dir};
 use photomontage::sky::SkyModel;
 use photomontage::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
@@ -139,6 +142,29 @@ fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGrou
             args.sky_tolerance,
         )?));
     }
+    // One group per enabled [[luminaires]] entry, in the site's order (as the renderer lists them).
+    let lights = site_luminaire_lights(doc)?;
+    let names = doc
+        .site
+        .luminaires
+        .iter()
+        .filter(|l| l.enabled)
+        .map(|l| l.id.clone());
+    for (name, light) in names.zip(lights) {
+        let source = match light {
+            ArtificialLight::Point(p) => PointSource {
+                position_in_world_m: p.position_in_world_m,
+                luminaire: None,
+                intensity_rgb: p.intensity_rgb,
+            },
+            ArtificialLight::Luminaire(l) => PointSource {
+                position_in_world_m: l.luminaire.position_in_world,
+                luminaire: Some(l.luminaire.clone()),
+                intensity_rgb: l.rgb_per_cd,
+            },
+        };
+        groups.push(LightGroup::luminaire(&format!("luminaire:{name}"), source));
+    }
     if l.ambient_weight.iter().any(|&k| k != 0.0) {
         eprintln!("note: ambient_weight is the renderer's term; the radiosity solve ignores it");
     }
@@ -168,8 +194,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if groups.is_empty() {
         bail!(
-            "nothing lights {}: sun_weight and sky_weight are zero (or the sun is down) and no \
-             material emits",
+            "nothing lights {}: sun_weight and sky_weight are zero (or the sun is down), no \
+             luminaire is enabled and no material emits",
             args.site.display()
         );
     }
