@@ -21,6 +21,7 @@ pub mod luminaire;
 pub mod peer_scene;
 pub mod photo;
 pub mod photogrammetry;
+pub mod radiosity;
 pub mod render;
 pub mod scene;
 pub mod site;

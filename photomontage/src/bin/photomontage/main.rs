@@ -5,6 +5,7 @@ mod fit;
 mod info;
 mod luminaire;
 mod merge;
+mod radiosity;
 mod render;
 mod report;
 mod resect;
@@ -80,6 +81,11 @@ enum Command {
     /// The verified-view sheet (PDF or HTML) of one solved photo: the view at print scale with its
     /// viewing distance, ruler, geometry table, map inset, AVR level, methodology and residuals.
     Sheet(sheet::Args),
+    /// Radiosity on the site's scene: mesh into patches and elements, light by the sun, the sky
+    /// and emitting materials as separate groups, solve the interreflection (hierarchical,
+    /// progressive or direct); report patches, links, passes, time and residual, optionally
+    /// write the mesh (PLY) and the convergence record (CSV). Not yet used by `render`.
+    Radiosity(radiosity::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -108,5 +114,6 @@ fn main() -> anyhow::Result<()> {
         Command::Report(args) => view_report::run(&args),
         Command::View(args) => standard_view::run(&args),
         Command::Sheet(args) => sheet::run(&args),
+        Command::Radiosity(args) => radiosity::run(&args),
     }
 }

@@ -1,0 +1,328 @@
+//! `photomontage radiosity SITE`: mesh the site's scene, light it by the sun, the sky, each
+//! enabled luminaire and the emitting materials as separate groups and solve the interreflection; report patches, links,
+//! passes, time and residual, and optionally write the mesh (PLY), the convergence record (CSV)
+//! and a JSON report. Ctrl-C cancels between passes; nothing is written then.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use photomontage::atomic_file::{probe_writable, write_atomically};
+use photomontage::radiosity::convergence::csv;
+use photomontage::radiosity::hierarchical::HierarchicalParams;
+use photomontage::radiosity::sources::sky_sources;
+use photomontage::radiosity::{
+    FormFactorParams, LightGroup, MeshParams, PointSource, SolveParams, Solver, StopRule,
+    luminance, solve,
+};
+use photomontage::render::luminaire_light::ArtificialLight;
+use photomontage::site::SiteDocument;
+use photomontage::site::luminaires::site_luminaire_lights;
+use photomontage::site::render::{parse_sky_model, site_scene, site_sun_dir};
+use photomontage::sky::SkyModel;
+use photomontage::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
+
+use crate::render::{install_cancel, with_threads};
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum SolverArg {
+    /// Hierarchical radiosity with BF refinement (Hanrahan et al. 1991).
+    Hierarchical,
+    /// Progressive refinement: shoot the largest unshot power (Cohen et al. 1988).
+    Progressive,
+    /// Gauss–Seidel on the full element matrix (small scenes).
+    Direct,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The site file (TOML).
+    site: PathBuf,
+    /// Photo whose capture time places the sun (default: the first photo; not needed with
+    /// `sun_manual`).
+    #[arg(long, value_name = "PHOTO_ID")]
+    view: Option<String>,
+    /// Solver.
+    #[arg(long, value_enum, default_value_t = SolverArg::Hierarchical)]
+    solver: SolverArg,
+    /// Longest patch edge in metres (the global size).
+    #[arg(long, default_value_t = 4.0)]
+    patch_edge_m: f64,
+    /// Longest element edge in metres, unless the object has its own.
+    #[arg(long, default_value_t = 1.0)]
+    element_edge_m: f64,
+    /// Element size of one object, `NAME=METRES` (repeatable; object names as `info` lists
+    /// polygons and models).
+    #[arg(long, value_name = "NAME=METRES")]
+    object_element_edge: Vec<String>,
+    /// Form-factor samples per axis (n² per pair).
+    #[arg(long, default_value_t = 4)]
+    samples: u32,
+    /// Random seed of the form factors and shadow rays.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// HR BF tolerance (fraction of the mean brightness).
+    #[arg(long, default_value_t = HierarchicalParams::default().bf_tolerance)]
+    bf_tolerance: f64,
+    /// Sky clustering tolerance of the icosahedral dome.
+    #[arg(long, default_value_t = 0.1)]
+    sky_tolerance: f64,
+    /// Stop when the mean brightness changes by less than this between passes (Üncü & Kayakuş: 0.01).
+    #[arg(long, default_value_t = StopRule::default().mean_change)]
+    mean_change: f64,
+    /// ... and the relative residual is below this.
+    #[arg(long, default_value_t = StopRule::default().residual)]
+    residual: f64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Write the elements with their radiosity colours as PLY.
+    #[arg(long, value_name = "FILE.ply")]
+    mesh_out: Option<PathBuf>,
+    /// Write the convergence record (every pass of every group) as CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    convergence: Option<PathBuf>,
+    /// Plot the convergence record (log residual and mean change per pass and group) as PNG.
+    #[arg(long, value_name = "FILE.png")]
+    convergence_plot: Option<PathBuf>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn object_sizes(specs: &[String]) -> anyhow::Result<BTreeMap<String, f64>> {
+    specs
+        .iter()
+        .map(|s| {
+            let (name, size) = s
+                .rsplit_once('=')
+                .with_context(|| format!("--object-element-edge `{s}` is not NAME=METRES"))?;
+            let size: f64 = size.parse().with_context(|| {
+                format!("--object-element-edge `{s}`: `{size}` is not a number")
+            })?;
+            Ok((name.to_owned(), size))
+        })
+        .collect()
+}
+
+fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGroup>> {
+    let l = &doc.site.lighting;
+    let model = parse_sky_model(&l.sky_model)?;
+    let sun_weighted = l.sun_weight.iter().any(|&k| k != 0.0);
+    let sky_weighted = l.sky_weight.iter().any(|&k| k != 0.0);
+    let needs_sun = sun_weighted || (sky_weighted && matches!(model, SkyModel::CieGeneral(_)));
+    let view = args
+        .view
+        .clone()
+        .or_else(|| doc.site.photos.first().map(|p| p.id.clone()))
+        .unwrap_or_default();
+    let sun_dir = if needs_sun {
+        Some(site_sun_dir(doc, &view)?)
+    } else {
+        None
+    };
+    let mut groups = Vec::new();
+    if sun_weighted {
+        match sun_dir.filter(|d| d.z > 0.0) {
+            Some(d) => groups.push(LightGroup::sun(d, l.sun_weight)),
+            None => eprintln!("warning: the sun is below the horizon; no sun group"),
+        }
+    }
+    if sky_weighted {
+        let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
+        let sky_sun = sun_dir.unwrap_or_else(nalgebra::Vector3::z);
+        groups.push(LightGroup::sky(sky_sources(
+            &model,
+            &sky_sun,
+            l.sky_weight,
+            &dome,
+            args.sky_tolerance,
+        )?));
+    }
+    // One group per enabled [[luminaires]] entry, in the site's order (as the renderer lists them).
+    let lights = site_luminaire_lights(doc)?;
+    let names = doc
+        .site
+        .luminaires
+        .iter()
+        .filter(|l| l.enabled)
+        .map(|l| l.id.clone());
+    for (name, light) in names.zip(lights) {
+        let source = match light {
+            ArtificialLight::Point(p) => PointSource {
+                position_in_world_m: p.position_in_world_m,
+                luminaire: None,
+                intensity_rgb: p.intensity_rgb,
+            },
+            ArtificialLight::Luminaire(l) => PointSource {
+                position_in_world_m: l.luminaire.position_in_world,
+                luminaire: Some(l.luminaire.clone()),
+                intensity_rgb: l.rgb_per_cd,
+            },
+        };
+        groups.push(LightGroup::luminaire(&format!("luminaire:{name}"), source));
+    }
+    if l.ambient_weight.iter().any(|&k| k != 0.0) {
+        eprintln!("note: ambient_weight is the renderer's term; the radiosity solve ignores it");
+    }
+    Ok(groups)
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    for path in args
+        .mesh_out
+        .iter()
+        .chain(&args.convergence)
+        .chain(&args.convergence_plot)
+    {
+        probe_writable(path).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let doc = SiteDocument::load(&args.site)?;
+    let site = site_scene(&doc)?;
+    for w in &site.warnings {
+        eprintln!("warning: {w}");
+    }
+    let mut groups = light_groups(&doc, args)?;
+    if site.scene.materials().iter().any(|m| {
+        m.emission_rgb_w_m2_sr
+            .is_some_and(|e| e.iter().any(|&v| v > 0.0))
+    }) {
+        groups.push(LightGroup::emitters());
+    }
+    if groups.is_empty() {
+        bail!(
+            "nothing lights {}: sun_weight and sky_weight are zero (or the sun is down), no \
+             luminaire is enabled and no material emits",
+            args.site.display()
+        );
+    }
+    let stop = StopRule {
+        mean_change: args.mean_change,
+        residual: args.residual,
+        ..StopRule::default()
+    };
+    let params = SolveParams {
+        mesh: MeshParams {
+            max_patch_edge_m: args.patch_edge_m,
+            max_element_edge_m: args.element_edge_m,
+            object_element_edge_m: object_sizes(&args.object_element_edge)?,
+            ..MeshParams::default()
+        },
+        form_factors: FormFactorParams {
+            samples_per_axis: args.samples,
+            seed: args.seed,
+            visibility: true,
+        },
+        solver: match args.solver {
+            SolverArg::Hierarchical => Solver::Hierarchical(HierarchicalParams {
+                bf_tolerance: args.bf_tolerance,
+                ..HierarchicalParams::default()
+            }),
+            SolverArg::Progressive => Solver::Progressive,
+            SolverArg::Direct => Solver::Direct,
+        },
+        stop,
+        ..SolveParams::default()
+    };
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar.set_message("meshing and lighting (Ctrl-C cancels)");
+    let cancel = install_cancel()?;
+    eprintln!(
+        "solving radiosity: {} light group(s) (Ctrl-C cancels)",
+        groups.len()
+    );
+    let start = Instant::now();
+    let result = with_threads(args.threads, || {
+        Ok(solve(&site.scene, &groups, &params, cancel, &|row| {
+            bar.set_message(format!(
+                "{} pass {}: residual {:.2e}, mean change {:.2e}, {} interactions",
+                row.group, row.pass, row.residual, row.mean_change, row.interactions
+            ));
+        })?)
+    });
+    bar.finish_and_clear();
+    if cancel.load(Ordering::SeqCst) {
+        bail!("cancelled (Ctrl-C): nothing written");
+    }
+    let solution = result?;
+    let elapsed_s = start.elapsed().as_secs_f64();
+    for w in &solution.mesh.warnings {
+        eprintln!("warning: {w}");
+    }
+    let total = solution.total_radiosity_rgb();
+    if let Some(path) = &args.mesh_out {
+        let white = total.iter().map(luminance).fold(0.0, f64::max);
+        solution.mesh.write_ply(path, Some(&total), white)?;
+    }
+    let rows = solution.convergence();
+    if let Some(path) = &args.convergence {
+        write_atomically(path, csv(&rows).as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.convergence_plot {
+        photomontage::radiosity::convergence_plot::write_png(path, &rows, &stop)?;
+    }
+    let converged = solution.converged(&stop);
+    let groups_json: Vec<serde_json::Value> = solution
+        .groups
+        .iter()
+        .map(|g| {
+            let last = g.convergence.last();
+            serde_json::json!({
+                "name": g.name,
+                "passes": g.convergence.len(),
+                "residual": last.map_or(0.0, |r| r.residual),
+                "mean_change": last.map_or(0.0, |r| r.mean_change),
+                "mean_radiosity_luminance": last.map_or(0.0, |r| r.mean_brightness),
+            })
+        })
+        .collect();
+    let report = serde_json::json!({
+        "solver": format!("{:?}", args.solver).to_lowercase(),
+        "patches": solution.mesh.patches.len(),
+        "elements": solution.mesh.elements.len(),
+        "interactions": solution.interactions,
+        "refinement_passes": solution.refinement.len(),
+        "groups": groups_json,
+        "converged": converged,
+        "time_s": elapsed_s,
+        "warnings": solution.mesh.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "{} patches, {} elements, {} {} in {elapsed_s:.2} s{}",
+            solution.mesh.patches.len(),
+            solution.mesh.elements.len(),
+            solution.interactions,
+            match args.solver {
+                SolverArg::Hierarchical => "links",
+                SolverArg::Progressive => "form factors",
+                SolverArg::Direct => "matrix entries",
+            },
+            if converged { "" } else { " (NOT converged)" }
+        );
+        for g in &solution.groups {
+            if let Some(r) = g.convergence.last() {
+                println!(
+                    "  {:<9} {} passes, residual {:.2e}, mean change {:.2e}, mean radiosity {:.4}",
+                    g.name,
+                    g.convergence.len(),
+                    r.residual,
+                    r.mean_change,
+                    r.mean_brightness
+                );
+            }
+        }
+    }
+    Ok(())
+}

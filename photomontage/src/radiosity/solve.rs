@@ -1,0 +1,344 @@
+//! One entry point: mesh the scene, light each group directly, solve the interreflection with the
+//! chosen solver, keep every group's solution apart (they add linearly).
+
+use std::sync::atomic::AtomicBool;
+
+use super::convergence::{ConvergenceRow, StopRule};
+use super::form_factor::{FormFactorEngine, FormFactorParams};
+use super::hierarchical::{HierarchicalParams, Hierarchy};
+use super::mesh::{Mesh, MeshParams};
+use super::progressive::RowCache;
+use super::sources::{self, DistantSource, PointSource};
+use super::{RadiosityError, Rgb, direct, progressive};
+use crate::bvh::BuildQuality;
+use crate::scene::{Scene, SceneTracer};
+
+/// The interreflection solver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Solver {
+    /// Shoot the largest unshot power (Cohen et al. 1988), on the elements.
+    Progressive,
+    /// Hierarchical radiosity with BF refinement (Hanrahan et al. 1991).
+    Hierarchical(HierarchicalParams),
+    /// Gauss–Seidel on the full element matrix (small scenes, reference).
+    Direct,
+}
+
+/// Everything a solve needs besides the scene and the lights.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveParams {
+    /// Patch and element sizes.
+    pub mesh: MeshParams,
+    /// Form-factor (and direct-lighting) quadrature and seed.
+    pub form_factors: FormFactorParams,
+    /// The solver.
+    pub solver: Solver,
+    /// When to stop.
+    pub stop: StopRule,
+    /// Form factors the progressive solver may cache (f32 each).
+    pub row_cache_entries: usize,
+}
+
+impl Default for SolveParams {
+    /// Default mesh and quadrature, hierarchical solver, the seed's stop rule, 32 M cached factors.
+    fn default() -> Self {
+        Self {
+            mesh: MeshParams::default(),
+            form_factors: FormFactorParams::default(),
+            solver: Solver::Hierarchical(HierarchicalParams::default()),
+            stop: StopRule::default(),
+            row_cache_entries: 32 << 20,
+        }
+    }
+}
+
+/// A light group: distant sources and/or the scene's emitting materials.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightGroup {
+    /// Name (`sun`, `sky`, `emitters`, …).
+    pub name: String,
+    /// Distant sources.
+    pub sources: Vec<DistantSource>,
+    /// Point sources (luminaires).
+    pub points: Vec<PointSource>,
+    /// Whether the materials' emission belongs to this group.
+    pub emission: bool,
+}
+
+impl LightGroup {
+    /// The sun: one distant source.
+    #[must_use]
+    pub fn sun(sun_dir_in_world: nalgebra::Vector3<f64>, normal_irradiance_rgb: Rgb) -> Self {
+        Self {
+            name: "sun".into(),
+            sources: vec![DistantSource {
+                dir_in_world: sun_dir_in_world,
+                normal_irradiance_rgb,
+            }],
+            points: Vec::new(),
+            emission: false,
+        }
+    }
+
+    /// The sky as clustered dome sources ([`sources::sky_sources`]).
+    #[must_use]
+    pub fn sky(sources: Vec<DistantSource>) -> Self {
+        Self {
+            name: "sky".into(),
+            sources,
+            points: Vec::new(),
+            emission: false,
+        }
+    }
+
+    /// The emitting materials of the scene.
+    #[must_use]
+    pub fn emitters() -> Self {
+        Self {
+            name: "emitters".into(),
+            sources: Vec::new(),
+            points: Vec::new(),
+            emission: true,
+        }
+    }
+
+    /// One luminaire (or isotropic point light) named `name`.
+    #[must_use]
+    pub fn luminaire(name: &str, source: PointSource) -> Self {
+        Self {
+            name: name.to_owned(),
+            sources: Vec::new(),
+            points: vec![source],
+            emission: false,
+        }
+    }
+}
+
+/// One group's solution, per element.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroupSolution {
+    /// The group's name.
+    pub name: String,
+    /// Direct irradiance (shadowed), per element.
+    pub direct_irradiance_rgb: Vec<Rgb>,
+    /// Radiosity (exitance, emission included), per element.
+    pub radiosity_rgb: Vec<Rgb>,
+    /// How the solve converged.
+    pub convergence: Vec<ConvergenceRow>,
+}
+
+impl GroupSolution {
+    /// Total irradiance (direct plus interreflected) per element, H = (B − π·L_e)/ρ per channel;
+    /// where ρ = 0 the interreflected part is unknown and only the direct irradiance is given.
+    #[must_use]
+    pub fn irradiance_rgb(&self, mesh: &Mesh, include_emission: bool) -> Vec<Rgb> {
+        (0..mesh.elements.len())
+            .map(|e| {
+                let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+                std::array::from_fn(|c| {
+                    let rho = surface.reflectance_rgb[c];
+                    let emitted = if include_emission {
+                        surface.emission_rgb[c]
+                    } else {
+                        0.0
+                    };
+                    if rho > 0.0 {
+                        (self.radiosity_rgb[e][c] - emitted) / rho
+                    } else {
+                        self.direct_irradiance_rgb[e][c]
+                    }
+                })
+            })
+            .collect()
+    }
+}
+
+/// The solution of all groups on one mesh.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// Per-group solutions, in the order of the groups given.
+    pub groups: Vec<GroupSolution>,
+    /// Links (hierarchical), cached rows × elements (progressive), matrix entries (direct).
+    pub interactions: u64,
+    /// Convergence of the hierarchical refinement (empty for the other solvers).
+    pub refinement: Vec<ConvergenceRow>,
+}
+
+impl Solution {
+    /// Σ over groups of the radiosity, per element.
+    #[must_use]
+    pub fn total_radiosity_rgb(&self) -> Vec<Rgb> {
+        let n = self.mesh.elements.len();
+        let mut total = vec![[0.0; 3]; n];
+        for g in &self.groups {
+            for (t, b) in total.iter_mut().zip(&g.radiosity_rgb) {
+                for c in 0..3 {
+                    t[c] += b[c];
+                }
+            }
+        }
+        total
+    }
+
+    /// Every convergence row: the refinement's, then each group's.
+    #[must_use]
+    pub fn convergence(&self) -> Vec<ConvergenceRow> {
+        let mut rows = self.refinement.clone();
+        for g in &self.groups {
+            rows.extend(g.convergence.iter().cloned());
+        }
+        rows
+    }
+
+    /// Whether every group met the stop rule before its pass limit.
+    #[must_use]
+    pub fn converged(&self, stop: &StopRule) -> bool {
+        self.groups.iter().all(|g| {
+            g.convergence
+                .last()
+                .is_none_or(|r| stop.met(r) || r.mean_brightness <= 0.0)
+        })
+    }
+}
+
+/// Meshes `scene`, lights it by `groups` and solves (module doc). `on_pass` sees every pass.
+///
+/// # Errors
+/// Meshing, tracing and parameter errors; [`RadiosityError::Cancelled`] when `cancel` rises.
+pub fn solve(
+    scene: &Scene,
+    groups: &[LightGroup],
+    params: &SolveParams,
+    cancel: &AtomicBool,
+    on_pass: &dyn Fn(&ConvergenceRow),
+) -> Result<Solution, RadiosityError> {
+    params.stop.validate()?;
+    let mesh = Mesh::build(scene, &params.mesh)?;
+    let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
+    solve_on_mesh(mesh, &tracer, groups, params, cancel, on_pass)
+}
+
+/// [`solve`] on a mesh already built from the scene `tracer` traces.
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_on_mesh(
+    mesh: Mesh,
+    tracer: &SceneTracer,
+    groups: &[LightGroup],
+    params: &SolveParams,
+    cancel: &AtomicBool,
+    on_pass: &dyn Fn(&ConvergenceRow),
+) -> Result<Solution, RadiosityError> {
+    let engine = FormFactorEngine::new(&mesh, tracer, params.form_factors)?;
+    let n = mesh.elements.len();
+    let mut directs = Vec::with_capacity(groups.len());
+    let mut b0s = Vec::with_capacity(groups.len());
+    for (g, group) in groups.iter().enumerate() {
+        sources::validate(&group.name, &group.sources)?;
+        sources::validate_points(&group.name, &group.points)?;
+        let mut direct = sources::direct_irradiance(&engine, &group.sources, g as u64);
+        if !group.points.is_empty() {
+            let from_points = sources::point_irradiance(&engine, &group.points, g as u64);
+            for (d, p) in direct.iter_mut().zip(from_points) {
+                for c in 0..3 {
+                    d[c] += p[c];
+                }
+            }
+        }
+        let b0: Vec<Rgb> = (0..n)
+            .map(|e| {
+                let node = mesh.element_node(e);
+                let surface = &mesh.surfaces[node.surface as usize];
+                std::array::from_fn(|c| {
+                    let emitted = if group.emission {
+                        surface.emission_rgb[c]
+                    } else {
+                        0.0
+                    };
+                    surface.reflectance_rgb[c] * direct[e][c] + emitted
+                })
+            })
+            .collect();
+        directs.push(direct);
+        b0s.push(b0);
+    }
+    let mut refinement = Vec::new();
+    let mut solved = Vec::with_capacity(groups.len());
+    let interactions;
+    match params.solver {
+        Solver::Progressive => {
+            let mut cache = RowCache::new(n, params.row_cache_entries);
+            for (group, b0) in groups.iter().zip(&b0s) {
+                solved.push(progressive::solve(
+                    &engine,
+                    b0,
+                    &group.name,
+                    &params.stop,
+                    &mut cache,
+                    cancel,
+                    on_pass,
+                )?);
+            }
+            interactions = cache.rows_computed * n as u64;
+        }
+        Solver::Hierarchical(h) => {
+            let mut b0_all = vec![[0.0; 3]; n];
+            for b0 in &b0s {
+                for (t, b) in b0_all.iter_mut().zip(b0) {
+                    for c in 0..3 {
+                        t[c] += b[c];
+                    }
+                }
+            }
+            let hierarchy = Hierarchy::build(&engine, &h, &b0_all, &params.stop, cancel, on_pass)?;
+            for (group, b0) in groups.iter().zip(&b0s) {
+                solved.push(hierarchy.solve(
+                    &mesh,
+                    b0,
+                    &group.name,
+                    &params.stop,
+                    cancel,
+                    on_pass,
+                )?);
+            }
+            interactions = hierarchy.links.len() as u64;
+            refinement = hierarchy.refinement;
+        }
+        Solver::Direct => {
+            let matrix = direct::element_matrix(&engine, cancel)?;
+            for (group, b0) in groups.iter().zip(&b0s) {
+                solved.push(direct::solve(
+                    &engine,
+                    &matrix,
+                    b0,
+                    &group.name,
+                    &params.stop,
+                    cancel,
+                )?);
+            }
+            interactions = matrix.len() as u64;
+        }
+    }
+    let groups = groups
+        .iter()
+        .zip(directs)
+        .zip(solved)
+        .map(
+            |((group, direct), (radiosity, convergence))| GroupSolution {
+                name: group.name.clone(),
+                direct_irradiance_rgb: direct,
+                radiosity_rgb: radiosity,
+                convergence,
+            },
+        )
+        .collect();
+    Ok(Solution {
+        mesh,
+        groups,
+        interactions,
+        refinement,
+    })
+}
