@@ -21,7 +21,7 @@ use photomontage::radiosity::{
 use photomontage::render::luminaire_light::ArtificialLight;
 use photomontage::site::SiteDocument;
 use photomontage::site::luminaires::site_luminaire_lights;
-use photomontage::site::render::{parse_sky_model, site_scene, site_sun_dir};
+use photomontage::site::render::{site_scene, site_sky_model, site_sun_dir};
 use photomontage::sky::SkyModel;
 use photomontage::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
@@ -110,7 +110,7 @@ fn object_sizes(specs: &[String]) -> anyhow::Result<BTreeMap<String, f64>> {
 
 fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGroup>> {
     let l = &doc.site.lighting;
-    let model = parse_sky_model(&l.sky_model)?;
+    let model = site_sky_model(l.sky_model)?;
     let sun_weighted = l.sun_weight.iter().any(|&k| k != 0.0);
     let sky_weighted = l.sky_weight.iter().any(|&k| k != 0.0);
     let needs_sun = sun_weighted || (sky_weighted && matches!(model, SkyModel::CieGeneral(_)));
