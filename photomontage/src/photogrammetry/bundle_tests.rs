@@ -23,8 +23,11 @@ fn photos(b: &crate::photogrammetry::synthetic::SyntheticBlock) -> Vec<BundlePho
 
 fn check(spec: &BlockSpec) -> BundleReport {
     let b = block(spec);
-    let report =
-        bundle_adjust(&photos(&b), &b.control, &BundleOptions::default()).expect("solvable");
+    let options = BundleOptions {
+        point_covariance: true,
+        ..BundleOptions::default()
+    };
+    let report = bundle_adjust(&photos(&b), &b.control, &options).expect("solvable");
     assert!(report.converged, "{:?}", report.warnings);
     for (p, truth) in report.photos.iter().zip(&b.true_cameras) {
         let dc = p.camera.pose.camera_center_in_world - truth.pose.camera_center_in_world;

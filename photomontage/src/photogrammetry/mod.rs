@@ -109,6 +109,19 @@ pub enum PhotogrammetryError {
     Collinear,
     #[error("point {point_id} lies behind the camera")]
     PointBehindCamera { point_id: String },
+    /// Cheirality: points observed in a photo lie at depth ≤ 0 in its camera frame. No camera
+    /// is returned: a photo cannot show what lies behind it.
+    #[error(
+        "{} behind the camera{}: a photo cannot show a point behind it (check these points' coordinates and pixels)",
+        behind_points(.point_ids),
+        .photo.as_ref().map(|p| format!(" of photo {p}")).unwrap_or_default()
+    )]
+    PointsBehindCamera {
+        /// The photo, where the solver knows it (the bundle adjustment; a single resection
+        /// does not).
+        photo: Option<String>,
+        point_ids: Vec<String>,
+    },
     #[error(
         "intrinsics: {field} = {value:e} px is outside {min:e}–{max:e} px, the sane range for a {width}×{height} px image"
     )]
@@ -141,6 +154,14 @@ pub enum PhotogrammetryError {
     NoConvergence,
     #[error("degenerate geometry: {reason}")]
     Degenerate { reason: String },
+}
+
+/// "point a lies" / "points a, b lie" for [`PhotogrammetryError::PointsBehindCamera`].
+fn behind_points(point_ids: &[String]) -> String {
+    match point_ids {
+        [one] => format!("point {one} lies"),
+        many => format!("points {} lie", many.join(", ")),
+    }
 }
 
 /// Rejects non-finite coordinates and invalid σ in control points, and duplicate ids.

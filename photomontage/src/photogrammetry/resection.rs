@@ -196,6 +196,7 @@ impl<'a> Problem<'a> {
 
 impl NormalEquations for Problem<'_> {
     type State = Camera;
+    type Normal = DMatrix<f64>;
     fn unknowns(&self) -> usize {
         6 + self.intrinsic_columns.len()
     }

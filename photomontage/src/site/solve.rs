@@ -289,6 +289,8 @@ pub fn solve_site(doc: &SiteDocument) -> SiteSolution {
             .collect();
         let options = BundleOptions {
             outlier_threshold_sigma: site.solve.outlier_threshold_sigma,
+            // The tie points' σ are written back into the site.
+            point_covariance: true,
             ..BundleOptions::default()
         };
         match pg::bundle_adjust(&bundle_photos, &control, &options) {
