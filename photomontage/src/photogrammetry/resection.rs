@@ -8,7 +8,10 @@
 //! 1. validate the input (finite values, σ > 0, unique ids, every observed point is control,
 //!    not all collinear, no two plane points imaged onto the same pixel);
 //! 2. RANSAC over P3P (exhaustive when the number of triples is small), MSAC score on all points
-//!    with each point's σ including its control σ projected into the image;
+//!    with each point's σ including its control σ projected into the image; only points in
+//!    front of a pose count as its inliers (cheirality). When no such pose explains a fourth
+//!    point but one with the points behind the camera does, the error
+//!    [`PhotogrammetryError::PointsBehindCamera`] names those points;
 //! 3. Levenberg–Marquardt on the consensus set, reclassification of all points, repeated;
 //! 4. self-calibration: the requested parameters are freed only if their multiple correlation
 //!    with the other unknowns is below [`ResectionOptions::max_correlation`] and the redundancy
@@ -27,7 +30,11 @@
 //! # Known limitations
 //! At least four control points are needed (three give up to four poses). The initial focal
 //! length must be within a few tens of percent when it is to be estimated. Observations of two
-//! points on one ray are accepted for non-planar control (they can be genuine).
+//! points on one ray are accepted for non-planar control (they can be genuine). With planar
+//! control, points that lie behind the camera (e.g. mirrored through its centre) are explained
+//! exactly by the camera mirrored across the control plane, with every point in front: the data
+//! cannot tell the two apart, so that camera is returned (the solution in front is preferred;
+//! only a prior on the camera position, which [`resect`] does not take, could reject it).
 
 use std::collections::HashMap;
 
@@ -40,7 +47,7 @@ use super::least_squares::{
 use super::projection::{
     apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
 };
-use super::ransac::{normalised_error_sq, ransac};
+use super::ransac::{Side, error_sq_on_side, normalised_error_sq, ransac};
 use super::{
     ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, validate_control,
     validate_intrinsics, validate_observations,
@@ -234,6 +241,40 @@ impl NormalEquations for Problem<'_> {
     }
 }
 
+/// When no pose with the points in front explains the observations, whether one with them
+/// behind does: then the error names the points it puts behind the camera (cheirality), never
+/// a camera.
+fn behind_the_camera(
+    all: &[Obs],
+    observations: &[ImageObservation],
+    intrinsics: &Intrinsics,
+    options: &ResectionOptions,
+    gate_px: f64,
+) -> Option<PhotogrammetryError> {
+    let pose = ransac(all, intrinsics, options, gate_px, Side::Behind)?;
+    let camera = Camera {
+        intrinsics: *intrinsics,
+        pose,
+    };
+    let threshold = options.outlier_threshold_sigma;
+    let cap = |o: &Obs| {
+        if gate_px > 0.0 {
+            (gate_px / o.sigma_px).max(threshold).powi(2)
+        } else {
+            threshold * threshold
+        }
+    };
+    let point_ids: Vec<String> = all
+        .iter()
+        .filter(|o| error_sq_on_side(&camera, o, Side::Behind).is_some_and(|e| e < cap(o)))
+        .map(|o| observations[o.index].point_id.clone())
+        .collect();
+    (point_ids.len() >= MIN_POINTS).then_some(PhotogrammetryError::PointsBehindCamera {
+        photo: None,
+        point_ids,
+    })
+}
+
 /// C⁻¹ where C Cᵀ = σ_px² I + J_X Σ_X J_Xᵀ (control σ projected into the image).
 fn whitening_matrix(o: &Obs, camera: &Camera) -> Matrix2<f64> {
     let mut cov = Matrix2::identity() * (o.sigma_px * o.sigma_px);
@@ -342,11 +383,12 @@ pub fn resect(
     };
 
     // Step 2: robust start.
-    let start_pose = ransac(&all, &intrinsics, options, gate_px).ok_or_else(|| {
-        PhotogrammetryError::Degenerate {
-            reason: "no pose from any three control points explains a fourth".to_owned(),
-        }
-    })?;
+    let Some(start_pose) = ransac(&all, &intrinsics, options, gate_px, Side::Front) else {
+        return Err(behind_the_camera(&all, observations, &intrinsics, options, gate_px)
+            .unwrap_or_else(|| PhotogrammetryError::Degenerate {
+                reason: "no pose from any three control points explains a fourth".to_owned(),
+            }));
+    };
     let mut camera = Camera {
         intrinsics,
         pose: start_pose,
