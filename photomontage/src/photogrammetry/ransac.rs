@@ -5,10 +5,10 @@
 //!
 //! Cheirality (Hartley & Zisserman 2004 §21.1): a pose counts a point as an inlier only when
 //! the point lies in front of it (depth > 0), and a P3P pose that puts one of its own three
-//! points behind the camera is dropped. When no such pose explains a fourth point, the same
-//! search with [`Side::Behind`] (bearings reversed, depth < 0 required) tells whether the data
-//! are those of points behind the camera, so the caller can name them instead of failing with
-//! a bare "degenerate".
+//! points behind the camera is dropped. When the best such pose leaves points unexplained, the
+//! same search with [`Side::Behind`] (bearings reversed, depth < 0 required) tells whether the
+//! data are rather those of points behind the camera, so the caller can name them instead of
+//! returning a camera fitted to a chance handful of points.
 //!
 //! # Known limitations
 //! The focal length is taken from the initial intrinsics; with a focal error of tens of percent
@@ -79,14 +79,15 @@ pub(super) fn error_sq_on_side(camera: &Camera, o: &Obs, side: Side) -> Option<f
 }
 
 /// RANSAC over P3P samples; returns the pose with the best MSAC score among those with every
-/// inlier on `side` of the camera, if it has at least [`MIN_POINTS`] inliers.
+/// inlier on `side` of the camera, and its number of inliers, if that is at least
+/// [`MIN_POINTS`].
 pub(super) fn ransac(
     all: &[Obs],
     intrinsics: &Intrinsics,
     options: &ResectionOptions,
     gate_px: f64,
     side: Side,
-) -> Option<Pose> {
+) -> Option<(Pose, usize)> {
     let n = all.len();
     // Reversed bearings make P3P place its three points behind the camera.
     let bearings: Vec<Unit<Vector3<f64>>> = all
@@ -187,7 +188,7 @@ pub(super) fn ransac(
     }
     let (_, best_inliers, _) = *top.first()?;
     if best_inliers == n {
-        return top.first().map(|t| t.2);
+        return top.first().map(|t| (t.2, t.1));
     }
     // Local optimisation (Chum, Matas & Kittler 2003): a P3P pose from three noisy rays can miss
     // the other points by many σ (tele lenses, small sets). Refine the best candidates on their
@@ -222,5 +223,5 @@ pub(super) fn ransac(
             }
         }
     }
-    (best.1 >= MIN_POINTS).then_some(best.2)
+    (best.1 >= MIN_POINTS).then_some((best.2, best.1))
 }

@@ -9,9 +9,9 @@
 //!    not all collinear, no two plane points imaged onto the same pixel);
 //! 2. RANSAC over P3P (exhaustive when the number of triples is small), MSAC score on all points
 //!    with each point's σ including its control σ projected into the image; only points in
-//!    front of a pose count as its inliers (cheirality). When no such pose explains a fourth
-//!    point but one with the points behind the camera does, the error
-//!    [`PhotogrammetryError::PointsBehindCamera`] names those points;
+//!    front of a pose count as its inliers (cheirality). When the best such pose leaves points
+//!    unexplained and a pose with the points behind the camera explains more of them, the
+//!    error [`PhotogrammetryError::PointsBehindCamera`] names those points;
 //! 3. Levenberg–Marquardt on the consensus set, reclassification of all points, repeated;
 //! 4. self-calibration: the requested parameters are freed only if their multiple correlation
 //!    with the other unknowns is below [`ResectionOptions::max_correlation`] and the redundancy
@@ -241,17 +241,18 @@ impl NormalEquations for Problem<'_> {
     }
 }
 
-/// When no pose with the points in front explains the observations, whether one with them
-/// behind does: then the error names the points it puts behind the camera (cheirality), never
-/// a camera.
+/// When the best pose with the points in front leaves some unexplained, whether a pose with the
+/// points behind explains more than its `front_inliers`: then the error names the points it
+/// puts behind the camera (cheirality), never a camera.
 fn behind_the_camera(
     all: &[Obs],
     observations: &[ImageObservation],
     intrinsics: &Intrinsics,
     options: &ResectionOptions,
     gate_px: f64,
+    front_inliers: usize,
 ) -> Option<PhotogrammetryError> {
-    let pose = ransac(all, intrinsics, options, gate_px, Side::Behind)?;
+    let (pose, _) = ransac(all, intrinsics, options, gate_px, Side::Behind)?;
     let camera = Camera {
         intrinsics: *intrinsics,
         pose,
@@ -269,10 +270,12 @@ fn behind_the_camera(
         .filter(|o| error_sq_on_side(&camera, o, Side::Behind).is_some_and(|e| e < cap(o)))
         .map(|o| observations[o.index].point_id.clone())
         .collect();
-    (point_ids.len() >= MIN_POINTS).then_some(PhotogrammetryError::PointsBehindCamera {
-        photo: None,
-        point_ids,
-    })
+    (point_ids.len() >= MIN_POINTS && point_ids.len() > front_inliers).then_some(
+        PhotogrammetryError::PointsBehindCamera {
+            photo: None,
+            point_ids,
+        },
+    )
 }
 
 /// C⁻¹ where C Cᵀ = σ_px² I + J_X Σ_X J_Xᵀ (control σ projected into the image).
@@ -383,11 +386,18 @@ pub fn resect(
     };
 
     // Step 2: robust start.
-    let Some(start_pose) = ransac(&all, &intrinsics, options, gate_px, Side::Front) else {
-        return Err(behind_the_camera(&all, observations, &intrinsics, options, gate_px)
-            .unwrap_or_else(|| PhotogrammetryError::Degenerate {
-                reason: "no pose from any three control points explains a fourth".to_owned(),
-            }));
+    let front = ransac(&all, &intrinsics, options, gate_px, Side::Front);
+    let front_inliers = front.map_or(0, |(_, inliers)| inliers);
+    if front_inliers < n
+        && let Some(e) =
+            behind_the_camera(&all, observations, &intrinsics, options, gate_px, front_inliers)
+    {
+        return Err(e);
+    }
+    let Some((start_pose, _)) = front else {
+        return Err(PhotogrammetryError::Degenerate {
+            reason: "no pose from any three control points explains a fourth".to_owned(),
+        });
     };
     let mut camera = Camera {
         intrinsics,
