@@ -287,16 +287,26 @@ impl SparseNormal {
             let ci = c.try_inverse()?;
             let gq = rhs.fixed_rows::<3>(nc + 3 * q);
             let entries = self.cross(q);
-            for &(pa, ba) in entries {
+            for (a, &(pa, ba)) in entries.iter().enumerate() {
                 let (oa, ka) = (self.offsets[pa], self.sizes[pa]);
                 let bci = ba * ci;
                 let mut ra = rs.rows_mut(oa, ka);
                 ra -= (bci * gq).rows(0, ka);
-                for &(pb, bb) in entries {
+                // S_ab −= B_a C⁻¹ B_bᵀ over the photos' own unknowns only (k ≤ 11, usually 6),
+                // for b ≥ a; S_ba is its transpose.
+                for (b, &(pb, bb)) in entries.iter().enumerate().skip(a) {
                     let (ob, kb) = (self.offsets[pb], self.sizes[pb]);
-                    let product = bci * bb.transpose();
-                    let mut sab = s.view_mut((oa, ob), (ka, kb));
-                    sab -= product.view((0, 0), (ka, kb));
+                    for i in 0..ka {
+                        for j in 0..kb {
+                            let v = bci[(i, 0)] * bb[(j, 0)]
+                                + bci[(i, 1)] * bb[(j, 1)]
+                                + bci[(i, 2)] * bb[(j, 2)];
+                            s[(oa + i, ob + j)] -= v;
+                            if b != a {
+                                s[(ob + j, oa + i)] -= v;
+                            }
+                        }
+                    }
                 }
             }
             point_inverses.push(ci);
