@@ -33,7 +33,10 @@ fn adjust_in_this_process() {
         seed: 21,
     });
     let observations: usize = b.observations.iter().map(Vec::len).sum();
-    assert!(observations >= MIN_OBSERVATIONS, "{observations} observations");
+    assert!(
+        observations >= MIN_OBSERVATIONS,
+        "{observations} observations"
+    );
     let photos: Vec<BundlePhoto> = b
         .initial_cameras
         .iter()

@@ -168,7 +168,11 @@ pub(crate) fn bundle_adjust_dense_reference(
 
 /// Observations (active or flagged) of points still in the solution that lie at depth ≤ 0 in
 /// the photo observing them, as the error naming the first such photo and its points.
-fn cheirality(photos: &[BundlePhoto], problem: &Problem, state: &State) -> Option<PhotogrammetryError> {
+fn cheirality(
+    photos: &[BundlePhoto],
+    problem: &Problem,
+    state: &State,
+) -> Option<PhotogrammetryError> {
     let mut behind: Vec<Vec<String>> = vec![Vec::new(); photos.len()];
     for o in &problem.observations {
         if matches!(o.point, PointRef::Unknown(q) if problem.dropped[q]) {
@@ -180,7 +184,10 @@ fn cheirality(photos: &[BundlePhoto], problem: &Problem, state: &State) -> Optio
             behind[o.photo].push(o.observation.point_id.clone());
         }
     }
-    let (photo, point_ids) = behind.into_iter().enumerate().find(|(_, b)| !b.is_empty())?;
+    let (photo, point_ids) = behind
+        .into_iter()
+        .enumerate()
+        .find(|(_, b)| !b.is_empty())?;
     Some(PhotogrammetryError::PointsBehindCamera {
         photo: Some(photos[photo].id.clone()),
         point_ids,

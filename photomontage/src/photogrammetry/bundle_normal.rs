@@ -26,12 +26,14 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Point3, SMatrix, SVector, Vector3};
 
-use crate::photogrammetry::least_squares::{LinearSystem, MIN_DAMPING_DIAGONAL, NormalEquations, spd_inverse};
+use crate::camera::Camera;
+use crate::photogrammetry::least_squares::{
+    LinearSystem, MIN_DAMPING_DIAGONAL, NormalEquations, spd_inverse,
+};
 use crate::photogrammetry::projection::{
     apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
 };
 use crate::photogrammetry::{ImageObservation, SelfCalibration};
-use crate::camera::Camera;
 
 /// Most unknowns of one photo: 6 pose + focal, principal point (2), k1, k2.
 pub(super) const MAX_CAMERA_UNKNOWNS: usize = 11;
@@ -272,7 +274,8 @@ impl SparseNormal {
         let mut s = DMatrix::zeros(nc, nc);
         for (p, block) in self.camera_blocks.iter().enumerate() {
             let (o, k) = (self.offsets[p], self.sizes[p]);
-            s.view_mut((o, o), (k, k)).copy_from(&block.view((0, 0), (k, k)));
+            s.view_mut((o, o), (k, k))
+                .copy_from(&block.view((0, 0), (k, k)));
             for i in 0..k {
                 s[(o + i, o + i)] += lambda * block[(i, i)].max(MIN_DAMPING_DIAGONAL);
             }

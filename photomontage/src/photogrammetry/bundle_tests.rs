@@ -303,7 +303,12 @@ fn sparse_normal_equations_give_the_dense_solution() {
             assert_close(&format!("{} rotation", s.id), *a, *b, 1.0);
         }
         assert_close("focal", cs.intrinsics.focal_px, cd.intrinsics.focal_px, 1.0);
-        assert_close("k1", cs.intrinsics.distortion.k1, cd.intrinsics.distortion.k1, 1.0);
+        assert_close(
+            "k1",
+            cs.intrinsics.distortion.k1,
+            cd.intrinsics.distortion.k1,
+            1.0,
+        );
         assert_close(
             "σ focal",
             s.sigma_focal_px.unwrap_or(0.0),
@@ -352,7 +357,10 @@ fn point_covariances_only_on_request() {
         }
         assert_eq!(a.point_in_world, b.point_in_world);
     }
-    assert_eq!(without.photos[0].sigma_center_m, with.photos[0].sigma_center_m);
+    assert_eq!(
+        without.photos[0].sigma_center_m,
+        with.photos[0].sigma_center_m
+    );
 }
 
 #[test]
@@ -387,7 +395,11 @@ fn points_behind_a_photo_are_an_error_naming_photo_and_points() {
             for id in &control_seen {
                 assert!(point_ids.contains(id), "{id} missing from {point_ids:?}");
             }
-            let seen: Vec<&str> = ph[2].observations.iter().map(|o| o.point_id.as_str()).collect();
+            let seen: Vec<&str> = ph[2]
+                .observations
+                .iter()
+                .map(|o| o.point_id.as_str())
+                .collect();
             assert!(point_ids.iter().all(|id| seen.contains(&id.as_str())));
         }
         other => panic!("expected PointsBehindCamera, got {other:?}"),

@@ -128,8 +128,7 @@ pub(super) fn ransac(
         for pose in p3p::p3p(&b, &p) {
             // Cheirality of the sample itself (P3P's positive distances already imply it; a
             // near-degenerate triple can still flip a point through rounding).
-            if p
-                .iter()
+            if p.iter()
                 .any(|x| pose.camera_from_world(x).z * side.sign() <= 0.0)
             {
                 continue;

@@ -389,8 +389,14 @@ pub fn resect(
     let front = ransac(&all, &intrinsics, options, gate_px, Side::Front);
     let front_inliers = front.map_or(0, |(_, inliers)| inliers);
     if front_inliers < n
-        && let Some(e) =
-            behind_the_camera(&all, observations, &intrinsics, options, gate_px, front_inliers)
+        && let Some(e) = behind_the_camera(
+            &all,
+            observations,
+            &intrinsics,
+            options,
+            gate_px,
+            front_inliers,
+        )
     {
         return Err(e);
     }

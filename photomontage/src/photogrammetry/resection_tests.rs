@@ -435,7 +435,11 @@ fn planar_control_behind_the_camera_gives_the_mirrored_camera_with_points_in_fro
     let options = ResectionOptions::new(s.camera.intrinsics);
     let r = resect(&control, &s.observations, &options).expect("the mirrored camera");
     for c in &control {
-        assert!(r.camera.pose.camera_from_world(&c.point_in_world).z > 0.0, "{}", c.id);
+        assert!(
+            r.camera.pose.camera_from_world(&c.point_in_world).z > 0.0,
+            "{}",
+            c.id
+        );
     }
     assert!(r.outliers.len() <= MAX_FALSE_FLAGS, "{:?}", r.outliers);
 }

@@ -29,8 +29,15 @@ fn assert_same_solution(name: &str) {
     let sparse = solve_site_with(&doc, pg::bundle_adjust);
     let dense = solve_site_with(&doc, bundle_adjust_dense_reference);
     assert!(sparse.failures.is_empty(), "{name}: {:?}", sparse.failures);
-    assert!(sparse.bundle_rms_px.is_some(), "{name}: no bundle adjustment ran");
-    assert!(sparse.photos.len() >= 2, "{name}: {} photos", sparse.photos.len());
+    assert!(
+        sparse.bundle_rms_px.is_some(),
+        "{name}: no bundle adjustment ran"
+    );
+    assert!(
+        sparse.photos.len() >= 2,
+        "{name}: {} photos",
+        sparse.photos.len()
+    );
     assert_eq!(sparse.photos.len(), dense.photos.len());
     for (s, d) in sparse.photos.iter().zip(&dense.photos) {
         assert_eq!(s.id, d.id);
