@@ -180,7 +180,7 @@ fn cheirality(
         }
         let x = Problem::point_position(state, o.point);
         let depth_m = state.cameras[o.photo].pose.camera_from_world(&x).z;
-        if !(depth_m > 0.0) {
+        if depth_m.is_nan() || depth_m <= 0.0 {
             behind[o.photo].push(o.observation.point_id.clone());
         }
     }
