@@ -18,10 +18,10 @@ use nalgebra::{Unit, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::SelfCalibration;
 use super::least_squares::levenberg_marquardt;
 use super::p3p;
 use super::resection::{MIN_POINTS, Obs, Problem, ResectionOptions};
+use super::{ImageObservation, PhotogrammetryError, SelfCalibration};
 use crate::camera::{Camera, Intrinsics, Pose};
 
 /// Samples drawn even when the adaptive stop says fewer suffice: with every point an inlier the
@@ -223,4 +223,41 @@ pub(super) fn ransac(
         }
     }
     (best.1 >= MIN_POINTS).then_some((best.2, best.1))
+}
+
+/// When the best pose with the points in front leaves some unexplained, whether a pose with the
+/// points behind explains more than its `front_inliers`: then the error names the points it
+/// puts behind the camera (cheirality), never a camera.
+pub(super) fn behind_the_camera(
+    all: &[Obs],
+    observations: &[ImageObservation],
+    intrinsics: &Intrinsics,
+    options: &ResectionOptions,
+    gate_px: f64,
+    front_inliers: usize,
+) -> Option<PhotogrammetryError> {
+    let (pose, _) = ransac(all, intrinsics, options, gate_px, Side::Behind)?;
+    let camera = Camera {
+        intrinsics: *intrinsics,
+        pose,
+    };
+    let threshold = options.outlier_threshold_sigma;
+    let cap = |o: &Obs| {
+        if gate_px > 0.0 {
+            (gate_px / o.sigma_px).max(threshold).powi(2)
+        } else {
+            threshold * threshold
+        }
+    };
+    let point_ids: Vec<String> = all
+        .iter()
+        .filter(|o| error_sq_on_side(&camera, o, Side::Behind).is_some_and(|e| e < cap(o)))
+        .map(|o| observations[o.index].point_id.clone())
+        .collect();
+    (point_ids.len() >= MIN_POINTS && point_ids.len() > front_inliers).then_some(
+        PhotogrammetryError::PointsBehindCamera {
+            photo: None,
+            point_ids,
+        },
+    )
 }

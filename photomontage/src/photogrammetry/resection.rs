@@ -47,7 +47,7 @@ use super::least_squares::{
 use super::projection::{
     apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
 };
-use super::ransac::{Side, error_sq_on_side, normalised_error_sq, ransac};
+use super::ransac::{Side, behind_the_camera, normalised_error_sq, ransac};
 use super::{
     ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, validate_control,
     validate_intrinsics, validate_observations,
@@ -239,43 +239,6 @@ impl NormalEquations for Problem<'_> {
             intrinsics: apply_intrinsics_increment(&camera.intrinsics, &self.free, &d[6..]),
         }
     }
-}
-
-/// When the best pose with the points in front leaves some unexplained, whether a pose with the
-/// points behind explains more than its `front_inliers`: then the error names the points it
-/// puts behind the camera (cheirality), never a camera.
-fn behind_the_camera(
-    all: &[Obs],
-    observations: &[ImageObservation],
-    intrinsics: &Intrinsics,
-    options: &ResectionOptions,
-    gate_px: f64,
-    front_inliers: usize,
-) -> Option<PhotogrammetryError> {
-    let (pose, _) = ransac(all, intrinsics, options, gate_px, Side::Behind)?;
-    let camera = Camera {
-        intrinsics: *intrinsics,
-        pose,
-    };
-    let threshold = options.outlier_threshold_sigma;
-    let cap = |o: &Obs| {
-        if gate_px > 0.0 {
-            (gate_px / o.sigma_px).max(threshold).powi(2)
-        } else {
-            threshold * threshold
-        }
-    };
-    let point_ids: Vec<String> = all
-        .iter()
-        .filter(|o| error_sq_on_side(&camera, o, Side::Behind).is_some_and(|e| e < cap(o)))
-        .map(|o| observations[o.index].point_id.clone())
-        .collect();
-    (point_ids.len() >= MIN_POINTS && point_ids.len() > front_inliers).then_some(
-        PhotogrammetryError::PointsBehindCamera {
-            photo: None,
-            point_ids,
-        },
-    )
 }
 
 /// C⁻¹ where C Cᵀ = σ_px² I + J_X Σ_X J_Xᵀ (control σ projected into the image).
