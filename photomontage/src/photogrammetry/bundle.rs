@@ -28,7 +28,7 @@
 //!
 //! # Known limitations
 //! The reduced camera system is dense and factored by Cholesky: fine for hundreds of photos, not
-//! thousands (measured: 20 photos × 6000 tie points, 10⁵ observations, in `docs/benchmarks.md`).
+//! thousands (measured: 20 photos × 5000 points, 10⁵ observations, in `docs/benchmarks.md`).
 //! The datum comes from the control only (at least three non-collinear control points are
 //! needed); no free-network adjustment. Outliers are tested without redundancy numbers.
 
@@ -194,7 +194,6 @@ fn cheirality(
     })
 }
 
-#[allow(clippy::too_many_lines)] // one pass from input to report; the steps are marked
 fn adjust(
     photos: &[BundlePhoto],
     control: &[ControlPoint],
