@@ -9,8 +9,8 @@
 //!    not all collinear, no two plane points imaged onto the same pixel);
 //! 2. RANSAC over P3P (exhaustive when the number of triples is small), MSAC score on all points
 //!    with each point's σ including its control σ projected into the image; only points in
-//!    front of a pose count as its inliers (cheirality). When the best such pose leaves points
-//!    unexplained and a pose with the points behind the camera explains more of them, the
+//!    front of a pose count as its inliers (cheirality). When the best such pose leaves at least
+//!    half the points unexplained and a pose with the points behind the camera explains more, the
 //!    error [`PhotogrammetryError::PointsBehindCamera`] names those points;
 //! 3. Levenberg–Marquardt on the consensus set, reclassification of all points, repeated;
 //! 4. self-calibration: the requested parameters are freed only if their multiple correlation
@@ -351,7 +351,10 @@ pub fn resect(
     // Step 2: robust start.
     let front = ransac(&all, &intrinsics, options, gate_px, Side::Front);
     let front_inliers = front.map_or(0, |(_, inliers)| inliers);
-    if front_inliers < n
+    // A pose behind can explain more points only when the front one leaves at least half
+    // unexplained (a point rarely fits both); checking only then keeps the second search off
+    // the ordinary photo with a few gross errors.
+    if 2 * front_inliers <= n
         && let Some(e) = behind_the_camera(
             &all,
             observations,
