@@ -6,9 +6,9 @@
 //! Cheirality (Hartley & Zisserman 2004 §21.1): a pose counts a point as an inlier only when
 //! the point lies in front of it (depth > 0), and a P3P pose that puts one of its own three
 //! points behind the camera is dropped. When the best such pose leaves half the points or more
-//! unexplained, the same search with [`Side::Behind`] (bearings reversed, depth < 0 required) tells whether the
-//! data are rather those of points behind the camera, so the caller can name them instead of
-//! returning a camera fitted to a chance handful of points.
+//! unexplained, the same search with [`Side::Behind`] (bearings reversed, depth < 0 required)
+//! tells whether the data are rather those of points behind the camera, so the caller can name
+//! them instead of returning a camera fitted to a chance handful of points.
 //!
 //! # Known limitations
 //! The focal length is taken from the initial intrinsics; with a focal error of tens of percent
