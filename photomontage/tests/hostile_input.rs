@@ -92,18 +92,7 @@ fn assert_refused(outcome: &Outcome, needles: &[&str]) {
 /// A points CSV `id,X,Y,Z,x,y` of a seeded synthetic photo (12 points at 30 m, f = 3000 px,
 /// 4000 × 3000 px), with `edit` applied to its lines.
 fn points_csv(dir: &Path, name: &str, edit: impl FnOnce(&mut Vec<String>)) -> PathBuf {
-    let scene = single_photo(&SceneSpec {
-        focal_px: 3000.0,
-        image_size_px: [4000, 3000],
-        distance_m: 30.0,
-        points: 12,
-        layout: Layout::Volume {
-            depth_fraction: 0.3,
-        },
-        sigma_px: 0.5,
-        outlier_fraction: 0.0,
-        seed: 3,
-    });
+    let scene = points_scene();
     let mut lines = vec!["id,X,Y,Z,x,y".to_owned()];
     for (c, o) in scene.control.iter().zip(&scene.observations) {
         let p = c.point_in_world;
@@ -118,6 +107,22 @@ fn points_csv(dir: &Path, name: &str, edit: impl FnOnce(&mut Vec<String>)) -> Pa
     path
 }
 
+/// The seeded synthetic photo behind [`points_csv`].
+fn points_scene() -> photomontage::photogrammetry::synthetic::SyntheticScene {
+    single_photo(&SceneSpec {
+        focal_px: 3000.0,
+        image_size_px: [4000, 3000],
+        distance_m: 30.0,
+        points: 12,
+        layout: Layout::Volume {
+            depth_fraction: 0.3,
+        },
+        sigma_px: 0.5,
+        outlier_fraction: 0.0,
+        seed: 3,
+    })
+}
+
 fn resect(points: &Path, focal: &str) -> Outcome {
     run(&[
         os("resect"),
@@ -128,6 +133,31 @@ fn resect(points: &Path, focal: &str) -> Outcome {
         os("--focal-px"),
         os(focal),
     ])
+}
+
+/// Class: cheirality. Control points all behind the camera (mirrored through its centre, so
+/// every pixel is unchanged) once gave exit 0 with a camera far off; now the error names them.
+#[test]
+fn control_behind_the_camera_is_refused_naming_the_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = points_scene().camera.pose.camera_center_in_world;
+    let path = points_csv(dir.path(), "behind.csv", |lines| {
+        for line in lines.iter_mut().skip(1) {
+            let f: Vec<&str> = line.split(',').collect();
+            let x: Vec<f64> = f[1..4].iter().map(|v| v.parse().unwrap()).collect();
+            *line = format!(
+                "{},{},{},{},{},{}",
+                f[0],
+                2.0 * c.x - x[0],
+                2.0 * c.y - x[1],
+                2.0 * c.z - x[2],
+                f[4],
+                f[5]
+            );
+        }
+    });
+    let outcome = resect(&path, "3000");
+    assert_refused(&outcome, &["behind the camera", "p000", "p011"]);
 }
 
 /// Class 1: absurd intrinsics once sent NaN into P3P and never returned.

@@ -9,8 +9,17 @@
 //! among others gets σ = [`FIXED_AXIS_SIGMA_M`]). Tie points (ids observed in ≥ 2 photos and
 //! not control) start from [`super::intersect`] with the initial cameras.
 //!
-//! The normal equations are assembled densely but solved by eliminating the 3×3 point blocks
-//! (Schur complement), so a step costs O(points · cameras²) + O(cameras³).
+//! The normal equations are stored sparsely, as the camera blocks, the 3×3 point blocks and one
+//! camera–point block per observation, and solved through the reduced camera system (Schur
+//! complement of the point blocks, module [`normal`]): memory grows with photos² + observations,
+//! a step costs O(observations · rays · k²) + O((k · photos)³) for k unknowns per photo.
+//! Covariances of the cameras come from the inverse of the reduced system; those of the points
+//! only when [`BundleOptions::point_covariance`] asks for them.
+//!
+//! Cheirality: a photo cannot see a point behind it. When the start cameras or the adjusted
+//! ones put an observed point at depth ≤ 0 in a photo observing it, the adjustment fails with
+//! [`PhotogrammetryError::PointsBehindCamera`] naming the photo and the points, rather than
+//! returning a camera.
 //!
 //! Outliers: after convergence the observation with the largest whitened residual is removed
 //! when it exceeds the threshold, and the adjustment repeated (at most
@@ -18,25 +27,34 @@
 //! Without redundancy numbers this test is conservative (residuals are shrunk by √r).
 //!
 //! # Known limitations
-//! Dense camera block: fine for tens of photos, not thousands. The datum comes from the
-//! control only (at least three non-collinear control points are needed); no free-network
-//! adjustment.
+//! The reduced camera system is dense and factored by Cholesky: fine for hundreds of photos, not
+//! thousands (measured: 20 photos × 5000 points, 10⁵ observations, in `docs/benchmarks.md`).
+//! The datum comes from the control only (at least three non-collinear control points are
+//! needed); no free-network adjustment. Outliers are tested without redundancy numbers.
 
 use std::collections::HashMap;
 
-use nalgebra::{DMatrix, DVector, Matrix3, Point3, Vector3};
+use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
-use super::least_squares::{NormalEquations, levenberg_marquardt, multiple_correlation};
-use super::projection::{
-    apply_intrinsics_increment, apply_pose_increment, intrinsic_indices, project_with_jacobian,
+use super::least_squares::{
+    LinearSystem, NormalEquations, correlation_from_diagonals, levenberg_marquardt,
 };
+use super::projection::intrinsic_indices;
 use super::resection::ObservationResidual;
 use super::{
     ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, intersect,
     validate_control, validate_intrinsics, validate_observations,
 };
 use crate::camera::Camera;
+use normal::{Assembly, Obs, PointRef, Problem, State};
+
+#[path = "bundle_normal.rs"]
+mod normal;
+
+#[cfg(test)]
+#[path = "bundle_dense.rs"]
+mod dense;
 
 /// σ used for an axis given as 0 on a control point whose other axes are free (metres).
 pub const FIXED_AXIS_SIGMA_M: f64 = 1e-6;
@@ -60,6 +78,9 @@ pub struct BundleOptions {
     pub max_outlier_rounds: usize,
     /// Requested intrinsics whose multiple correlation exceeds this stay fixed.
     pub max_correlation: f64,
+    /// Compute the 3×3 covariance of every unknown point (for [`BundlePointReport::sigma_m`]).
+    /// Off by default: without it `sigma_m` of unknown points is NaN (fixed control: 0).
+    pub point_covariance: bool,
 }
 
 impl Default for BundleOptions {
@@ -68,6 +89,7 @@ impl Default for BundleOptions {
             outlier_threshold_sigma: 3.5,
             max_outlier_rounds: 20,
             max_correlation: 0.999,
+            point_covariance: false,
         }
     }
 }
@@ -93,7 +115,8 @@ pub struct BundlePhotoReport {
 pub struct BundlePointReport {
     pub id: String,
     pub point_in_world: Point3<f64>,
-    /// σ along world X, Y, Z (0 for fixed control).
+    /// σ along world X, Y, Z (0 for fixed control; NaN unless
+    /// [`BundleOptions::point_covariance`] was set, and for dropped tie points).
     pub sigma_m: [f64; 3],
     /// RMS of its image residuals per coordinate.
     pub rms_px: f64,
@@ -116,251 +139,66 @@ pub struct BundleReport {
     pub converged: bool,
 }
 
-#[derive(Clone)]
-struct State {
-    cameras: Vec<Camera>,
-    /// Reduced coordinates of the unknown points.
-    points: Vec<Point3<f64>>,
-}
-
-struct Obs {
-    photo: usize,
-    /// Index of an unknown point, or the fixed point in reduced coordinates.
-    point: PointRef,
-    observation: ImageObservation,
-    active: bool,
-}
-
-#[derive(Clone, Copy)]
-enum PointRef {
-    Unknown(usize),
-    Fixed(Point3<f64>),
-}
-
-struct Problem {
-    observations: Vec<Obs>,
-    /// Per unknown point: surveyed position (reduced) and σ, for weighted control.
-    priors: Vec<Option<(Point3<f64>, [f64; 3])>>,
-    /// Tie points left with fewer than two rays after outlier removal: kept in the system
-    /// with an identity block (zero step) and reported without σ.
-    dropped: Vec<bool>,
-    free: Vec<SelfCalibration>,
-    /// First column of each photo's block.
-    offsets: Vec<usize>,
-    camera_columns: usize,
-}
-
-impl Problem {
-    fn camera_block(&self, photo: usize) -> usize {
-        6 + intrinsic_indices(&self.free[photo]).len()
-    }
-
-    fn point_position(state: &State, r: PointRef) -> Point3<f64> {
-        match r {
-            PointRef::Unknown(q) => state.points[q],
-            PointRef::Fixed(p) => p,
-        }
-    }
-}
-
-impl NormalEquations for Problem {
-    type State = State;
-    fn unknowns(&self) -> usize {
-        self.camera_columns + 3 * self.priors.len()
-    }
-    fn cost(&self, s: &State) -> Option<f64> {
-        let mut cost = 0.0;
-        for o in self.observations.iter().filter(|o| o.active) {
-            let p = s.cameras[o.photo].project(&Self::point_position(s, o.point))?;
-            cost += ((p - o.observation.pixel) / o.observation.sigma_px).norm_squared();
-        }
-        for (q, prior) in self.priors.iter().enumerate() {
-            if let Some((x0, sigma)) = prior {
-                let d = s.points[q] - x0;
-                cost += (0..3).map(|i| (d[i] / sigma[i]).powi(2)).sum::<f64>();
-            }
-        }
-        Some(cost)
-    }
-    fn normal_equations(&self, s: &State) -> Option<(DMatrix<f64>, DVector<f64>, f64)> {
-        let m = self.unknowns();
-        let mut n = DMatrix::zeros(m, m);
-        let mut g = DVector::zeros(m);
-        let mut cost = 0.0;
-        for o in self.observations.iter().filter(|o| o.active) {
-            let camera = &s.cameras[o.photo];
-            let pj = project_with_jacobian(camera, &Self::point_position(s, o.point))?;
-            let w = 1.0 / o.observation.sigma_px;
-            let r = (pj.pixel - o.observation.pixel) * w;
-            cost += r.norm_squared();
-            let cols = intrinsic_indices(&self.free[o.photo]);
-            let k = 6 + cols.len();
-            let mut jc = DMatrix::zeros(2, k);
-            jc.view_mut((0, 0), (2, 6)).copy_from(&(pj.d_pose * w));
-            for (c, &col) in cols.iter().enumerate() {
-                jc[(0, 6 + c)] = pj.d_intrinsics[(0, col)] * w;
-                jc[(1, 6 + c)] = pj.d_intrinsics[(1, col)] * w;
-            }
-            let oc = self.offsets[o.photo];
-            let jct = jc.transpose();
-            let mut ncc = n.view_mut((oc, oc), (k, k));
-            ncc += &jct * &jc;
-            let mut gc = g.rows_mut(oc, k);
-            gc += &jct * DVector::from_column_slice(r.as_slice());
-            if let PointRef::Unknown(q) = o.point {
-                let op = self.camera_columns + 3 * q;
-                let jp = pj.d_point * w;
-                let jpt = jp.transpose();
-                let npp = jpt * jp;
-                let mut block = n.fixed_view_mut::<3, 3>(op, op);
-                block += npp;
-                let ncp = &jct * DMatrix::from_column_slice(2, 3, jp.as_slice());
-                let mut upper = n.view_mut((oc, op), (k, 3));
-                upper += &ncp;
-                let mut lower = n.view_mut((op, oc), (3, k));
-                lower += ncp.transpose();
-                let mut gp = g.fixed_rows_mut::<3>(op);
-                gp += jpt * r;
-            }
-        }
-        for (q, dropped) in self.dropped.iter().enumerate() {
-            if *dropped {
-                let op = self.camera_columns + 3 * q;
-                for i in 0..3 {
-                    n[(op + i, op + i)] += 1.0;
-                }
-            }
-        }
-        for (q, prior) in self.priors.iter().enumerate() {
-            if let Some((x0, sigma)) = prior {
-                let op = self.camera_columns + 3 * q;
-                let d = s.points[q] - x0;
-                for i in 0..3 {
-                    let w2 = 1.0 / (sigma[i] * sigma[i]);
-                    n[(op + i, op + i)] += w2;
-                    g[op + i] += d[i] * w2;
-                    cost += d[i] * d[i] * w2;
-                }
-            }
-        }
-        Some((n, g, cost))
-    }
-    fn update(&self, s: &State, delta: &DVector<f64>) -> State {
-        let d = delta.as_slice();
-        let cameras = s
-            .cameras
-            .iter()
-            .enumerate()
-            .map(|(p, c)| {
-                let o = self.offsets[p];
-                let k = self.camera_block(p);
-                Camera {
-                    pose: apply_pose_increment(&c.pose, &d[o..o + 6]),
-                    intrinsics: apply_intrinsics_increment(
-                        &c.intrinsics,
-                        &self.free[p],
-                        &d[o + 6..o + k],
-                    ),
-                }
-            })
-            .collect();
-        let points = s
-            .points
-            .iter()
-            .enumerate()
-            .map(|(q, x)| {
-                let o = self.camera_columns + 3 * q;
-                x + Vector3::new(d[o], d[o + 1], d[o + 2])
-            })
-            .collect();
-        State { cameras, points }
-    }
-    fn solve(&self, damped: &DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
-        schur_solve(damped, rhs, self.camera_columns, self.priors.len())
-    }
-}
-
-/// Solves N x = b by eliminating the 3×3 point blocks.
-fn schur_solve(
-    n: &DMatrix<f64>,
-    b: &DVector<f64>,
-    nc: usize,
-    points: usize,
-) -> Option<DVector<f64>> {
-    let (s, rs, cinv) = reduce(n, b, nc, points)?;
-    let chol = s.cholesky()?;
-    let xc = chol.solve(&rs);
-    let mut x = DVector::zeros(nc + 3 * points);
-    x.rows_mut(0, nc).copy_from(&xc);
-    for (q, ci) in cinv.iter().enumerate() {
-        let o = nc + 3 * q;
-        let bq = n.view((0, o), (nc, 3));
-        let rhs = b.fixed_rows::<3>(o) - bq.transpose() * &xc;
-        x.fixed_rows_mut::<3>(o).copy_from(&(ci * rhs));
-    }
-    Some(x)
-}
-
-type Reduced = (DMatrix<f64>, DVector<f64>, Vec<Matrix3<f64>>);
-
-/// Reduced camera system S = A − B C⁻¹ Bᵀ, its right-hand side and the C_q⁻¹.
-fn reduce(n: &DMatrix<f64>, b: &DVector<f64>, nc: usize, points: usize) -> Option<Reduced> {
-    let mut s = n.view((0, 0), (nc, nc)).clone_owned();
-    let mut rs = b.rows(0, nc).clone_owned();
-    let mut cinv = Vec::with_capacity(points);
-    for q in 0..points {
-        let o = nc + 3 * q;
-        let ci = n.fixed_view::<3, 3>(o, o).into_owned().try_inverse()?;
-        let bq = n.view((0, o), (nc, 3));
-        // Only cameras observing q have non-zero rows in B_q.
-        let rows: Vec<usize> = (0..nc)
-            .filter(|&i| bq.row(i).iter().any(|v| *v != 0.0))
-            .collect();
-        let bci: Vec<nalgebra::RowVector3<f64>> = rows
-            .iter()
-            .map(|&i| bq.fixed_view::<1, 3>(i, 0) * ci)
-            .collect();
-        let bq_rhs = b.fixed_rows::<3>(o);
-        for (a, &i) in rows.iter().enumerate() {
-            for &j in &rows {
-                s[(i, j)] -= (bci[a] * bq.fixed_view::<1, 3>(j, 0).transpose())[0];
-            }
-            rs[i] -= (bci[a] * bq_rhs)[0];
-        }
-        cinv.push(ci);
-    }
-    Some((s, rs, cinv))
-}
-
-/// Camera block of N⁻¹ and the 3×3 point blocks of N⁻¹.
-fn reduced_inverse(
-    n: &DMatrix<f64>,
-    nc: usize,
-    points: usize,
-) -> Option<(DMatrix<f64>, Vec<Matrix3<f64>>)> {
-    let zero = DVector::zeros(nc + 3 * points);
-    let (s, _, cinv) = reduce(n, &zero, nc, points)?;
-    let s_inv = super::least_squares::spd_inverse(&s)?;
-    let mut point_cov = Vec::with_capacity(points);
-    for (q, ci) in cinv.iter().enumerate() {
-        let o = nc + 3 * q;
-        let bq = n.view((0, o), (nc, 3));
-        let t = ci * bq.transpose(); // 3 × nc
-        point_cov.push(ci + &t * &s_inv * t.transpose());
-    }
-    Some((s_inv, point_cov))
-}
-
 /// Adjusts all photos, points and requested intrinsics together.
 ///
 /// # Errors
 /// Invalid input (non-finite values, duplicate ids, σ ≤ 0), `NotEnoughPoints` when fewer than
 /// two photos or no usable observations, `Degenerate` when the control does not fix the datum,
-/// `PointBehindCamera` when a tie point cannot be initialised in front of its cameras.
+/// `PointsBehindCamera` when an observed point lies at depth ≤ 0 in a photo observing it, at
+/// the start or after the adjustment (tie points that cannot be initialised in front of their
+/// cameras are left out with a warning).
 pub fn bundle_adjust(
     photos: &[BundlePhoto],
     control: &[ControlPoint],
     options: &BundleOptions,
+) -> Result<BundleReport, PhotogrammetryError> {
+    adjust(photos, control, options, Assembly::Sparse)
+}
+
+/// [`bundle_adjust`] on the dense normal equations the sparse ones replaced (memory
+/// O(points²)): the reference of the tests.
+#[cfg(test)]
+pub(crate) fn bundle_adjust_dense_reference(
+    photos: &[BundlePhoto],
+    control: &[ControlPoint],
+    options: &BundleOptions,
+) -> Result<BundleReport, PhotogrammetryError> {
+    adjust(photos, control, options, Assembly::DenseReference)
+}
+
+/// Observations (active or flagged) of points still in the solution that lie at depth ≤ 0 in
+/// the photo observing them, as the error naming the first such photo and its points.
+fn cheirality(
+    photos: &[BundlePhoto],
+    problem: &Problem,
+    state: &State,
+) -> Option<PhotogrammetryError> {
+    let mut behind: Vec<Vec<String>> = vec![Vec::new(); photos.len()];
+    for o in &problem.observations {
+        if matches!(o.point, PointRef::Unknown(q) if problem.dropped[q]) {
+            continue;
+        }
+        let x = Problem::point_position(state, o.point);
+        let depth_m = state.cameras[o.photo].pose.camera_from_world(&x).z;
+        if depth_m.is_nan() || depth_m <= 0.0 {
+            behind[o.photo].push(o.observation.point_id.clone());
+        }
+    }
+    let (photo, point_ids) = behind
+        .into_iter()
+        .enumerate()
+        .find(|(_, b)| !b.is_empty())?;
+    Some(PhotogrammetryError::PointsBehindCamera {
+        photo: Some(photos[photo].id.clone()),
+        point_ids,
+    })
+}
+
+fn adjust(
+    photos: &[BundlePhoto],
+    control: &[ControlPoint],
+    options: &BundleOptions,
+    assembly: Assembly,
 ) -> Result<BundleReport, PhotogrammetryError> {
     validate_control(control)?;
     let mut ids = std::collections::HashSet::new();
@@ -481,20 +319,7 @@ pub fn bundle_adjust(
         points: start_points,
     };
     let build = |free: &[SelfCalibration], observations: Vec<Obs>| {
-        let mut offsets = Vec::with_capacity(free.len());
-        let mut col = 0;
-        for f in free {
-            offsets.push(col);
-            col += 6 + intrinsic_indices(f).len();
-        }
-        Problem {
-            dropped: vec![false; priors.len()],
-            observations,
-            priors: priors.clone(),
-            free: free.to_vec(),
-            offsets,
-            camera_columns: col,
-        }
+        Problem::new(free, observations, priors.clone(), assembly)
     };
     let mut problem = build(&free, observations);
     let unsolvable = || {
@@ -504,15 +329,18 @@ pub fn bundle_adjust(
     };
 
     // Solve; drop unsupported intrinsics; then outlier rounds.
+    if let Some(e) = cheirality(photos, &problem, &state) {
+        return Err(e);
+    }
     let mut solution =
         levenberg_marquardt(&problem, state.clone()).ok_or(PhotogrammetryError::NoConvergence)?;
     if free.iter().any(SelfCalibration::any) {
-        let (s_inv, _) = reduced_inverse(
-            &solution.normal,
-            problem.camera_columns,
-            problem.priors.len(),
-        )
-        .ok_or_else(unsolvable)?;
+        let s_inv = solution
+            .normal
+            .covariances(false)
+            .ok_or_else(unsolvable)?
+            .cameras;
+        let diagonal = solution.normal.diagonal();
         let mut changed = false;
         for (p, f) in free.iter_mut().enumerate() {
             let cols = intrinsic_indices(f);
@@ -521,7 +349,8 @@ pub fn bundle_adjust(
                 let Some(pos) = cols.iter().position(|c| *c == index) else {
                     continue;
                 };
-                let rho = multiple_correlation(&solution.normal, &s_inv, o + 6 + pos);
+                let i = o + 6 + pos;
+                let rho = correlation_from_diagonals(diagonal[i], s_inv[(i, i)]);
                 if rho > options.max_correlation {
                     warnings.push(format!(
                         "photo {}: {name} kept fixed (multiple correlation {rho:.5} > {})",
@@ -591,10 +420,16 @@ pub fn bundle_adjust(
         state = solution.state.clone();
     }
 
+    if let Some(e) = cheirality(photos, &problem, &state) {
+        return Err(e);
+    }
+
     // Statistics.
-    let nc = problem.camera_columns;
-    let (s_inv, point_cov) =
-        reduced_inverse(&solution.normal, nc, problem.priors.len()).ok_or_else(unsolvable)?;
+    let covariances = solution
+        .normal
+        .covariances(options.point_covariance)
+        .ok_or_else(unsolvable)?;
+    let s_inv = covariances.cameras;
     let active = problem.observations.iter().filter(|o| o.active).count();
     let prior_rows: usize = problem.priors.iter().flatten().count() * 3;
     let redundancy = (2 * active + prior_rows) as i64 - problem.unknowns() as i64;
@@ -692,11 +527,12 @@ pub fn bundle_adjust(
     }
     let mut points = Vec::new();
     for (q, id) in point_ids.iter().enumerate() {
-        let cov = point_cov[q] * variance;
-        let sigma_m = if problem.dropped[q] {
-            [f64::NAN; 3]
-        } else {
-            [0, 1, 2].map(|i| cov[(i, i)].max(0.0).sqrt())
+        let sigma_m = match &covariances.points {
+            Some(point_cov) if !problem.dropped[q] => {
+                let cov = point_cov[q] * variance;
+                [0, 1, 2].map(|i| cov[(i, i)].max(0.0).sqrt())
+            }
+            _ => [f64::NAN; 3],
         };
         points.push(BundlePointReport {
             id: id.clone(),

@@ -1,6 +1,7 @@
 //! Known-answer tests of [`super::bundle_adjust`] on seeded synthetic blocks.
 
 use super::*;
+use crate::photogrammetry::PhotogrammetryError;
 use crate::photogrammetry::synthetic::{BlockSpec, block, rotation_error};
 
 /// Errors must lie within this many reported σ per axis: for Gaussian errors a 4.5 σ excursion
@@ -23,8 +24,11 @@ fn photos(b: &crate::photogrammetry::synthetic::SyntheticBlock) -> Vec<BundlePho
 
 fn check(spec: &BlockSpec) -> BundleReport {
     let b = block(spec);
-    let report =
-        bundle_adjust(&photos(&b), &b.control, &BundleOptions::default()).expect("solvable");
+    let options = BundleOptions {
+        point_covariance: true,
+        ..BundleOptions::default()
+    };
+    let report = bundle_adjust(&photos(&b), &b.control, &options).expect("solvable");
     assert!(report.converged, "{:?}", report.warnings);
     for (p, truth) in report.photos.iter().zip(&b.true_cameras) {
         let dc = p.camera.pose.camera_center_in_world - truth.pose.camera_center_in_world;
@@ -218,4 +222,188 @@ fn non_finite_start_pose_or_absurd_focal_is_refused_naming_it() {
             ..
         })
     ));
+}
+
+/// Sparse and dense paths solve the same normal equations and differ only in the order of
+/// floating-point sums; both stop when every step is below 1e-10 σ. 1e-9 relative is far above
+/// that difference and far below any reported precision.
+const SPARSE_DENSE_RELATIVE: f64 = 1e-9;
+
+fn assert_close(what: &str, a: f64, b: f64, scale: f64) {
+    assert!(
+        (a - b).abs() <= SPARSE_DENSE_RELATIVE * a.abs().max(b.abs()).max(scale),
+        "{what}: sparse {a} vs dense {b}"
+    );
+}
+
+#[test]
+fn sparse_normal_equations_give_the_dense_solution() {
+    // Everything the solver does at once: weighted and fixed control, focal length and k1 per
+    // photo, a gross error removed by the outlier rounds, point covariances.
+    let spec = BlockSpec {
+        photos: 8,
+        points: 80,
+        control: 8,
+        control_sigma_m: 0.01,
+        sigma_px: 0.5,
+        initial_center_error_m: 0.3,
+        initial_rotation_error: 0.005,
+        seed: 16,
+    };
+    let b = block(&spec);
+    let mut control = b.control.clone();
+    control[0].sigma_m = [0.0; 3];
+    control[1].sigma_m = [0.0, 0.0, 0.02];
+    let mut ph = photos(&b);
+    for p in &mut ph {
+        p.camera.intrinsics.focal_px *= 1.02;
+        p.self_calibration.focal = true;
+        p.self_calibration.k1 = true;
+    }
+    ph[3].observations[5].pixel.y -= 30.0;
+    let options = BundleOptions {
+        point_covariance: true,
+        ..BundleOptions::default()
+    };
+    let sparse = bundle_adjust(&ph, &control, &options).expect("solvable");
+    let dense = bundle_adjust_dense_reference(&ph, &control, &options).expect("solvable");
+    assert!(sparse.converged && dense.converged);
+    assert_eq!(sparse.redundancy, dense.redundancy);
+    assert_close("σ0", sparse.sigma0, dense.sigma0, 0.0);
+    let flagged: usize = sparse.photos.iter().map(|p| p.outliers.len()).sum();
+    assert_eq!(flagged, 1, "{:?}", sparse.warnings);
+    for (s, d) in sparse.photos.iter().zip(&dense.photos) {
+        assert_eq!(s.outliers, d.outliers);
+        assert_eq!(s.estimated, d.estimated);
+        let (cs, cd) = (&s.camera, &d.camera);
+        for axis in 0..3 {
+            let id = &s.id;
+            assert_close(
+                &format!("{id} centre"),
+                cs.pose.camera_center_in_world[axis],
+                cd.pose.camera_center_in_world[axis],
+                1.0,
+            );
+            assert_close(
+                &format!("{id} σ centre"),
+                s.sigma_center_m[axis],
+                d.sigma_center_m[axis],
+                0.0,
+            );
+            assert_close(
+                &format!("{id} σ angle"),
+                s.sigma_angles_deg[axis],
+                d.sigma_angles_deg[axis],
+                0.0,
+            );
+        }
+        let rs = cs.pose.rotation_world_from_camera.matrix();
+        let rd = cd.pose.rotation_world_from_camera.matrix();
+        for (a, b) in rs.iter().zip(rd.iter()) {
+            assert_close(&format!("{} rotation", s.id), *a, *b, 1.0);
+        }
+        assert_close("focal", cs.intrinsics.focal_px, cd.intrinsics.focal_px, 1.0);
+        assert_close(
+            "k1",
+            cs.intrinsics.distortion.k1,
+            cd.intrinsics.distortion.k1,
+            1.0,
+        );
+        assert_close(
+            "σ focal",
+            s.sigma_focal_px.unwrap_or(0.0),
+            d.sigma_focal_px.unwrap_or(0.0),
+            0.0,
+        );
+    }
+    for (s, d) in sparse.points.iter().zip(&dense.points) {
+        assert_eq!(s.id, d.id);
+        for axis in 0..3 {
+            assert_close(&s.id, s.point_in_world[axis], d.point_in_world[axis], 1.0);
+            assert_close(&s.id, s.sigma_m[axis], d.sigma_m[axis], 0.0);
+        }
+    }
+}
+
+#[test]
+#[allow(clippy::float_cmp)] // exact: fixed control's σ is set to 0, and the camera σ are computed
+// by the same operations with and without point covariances
+fn point_covariances_only_on_request() {
+    let spec = BlockSpec {
+        photos: 4,
+        points: 30,
+        control: 6,
+        control_sigma_m: 0.0,
+        sigma_px: 0.5,
+        initial_center_error_m: 0.1,
+        initial_rotation_error: 0.001,
+        seed: 17,
+    };
+    let b = block(&spec);
+    let without = bundle_adjust(&photos(&b), &b.control, &BundleOptions::default()).expect("ok");
+    let with = bundle_adjust(
+        &photos(&b),
+        &b.control,
+        &BundleOptions {
+            point_covariance: true,
+            ..BundleOptions::default()
+        },
+    )
+    .expect("ok");
+    for (a, b) in without.points.iter().zip(&with.points) {
+        if a.is_control {
+            assert_eq!(a.sigma_m, [0.0; 3]);
+        } else {
+            assert!(a.sigma_m.iter().all(|s| s.is_nan()), "{}", a.id);
+            assert!(b.sigma_m.iter().all(|s| *s > 0.0), "{}", b.id);
+        }
+        assert_eq!(a.point_in_world, b.point_in_world);
+    }
+    assert_eq!(
+        without.photos[0].sigma_center_m,
+        with.photos[0].sigma_center_m
+    );
+}
+
+#[test]
+fn points_behind_a_photo_are_an_error_naming_photo_and_points() {
+    let spec = BlockSpec {
+        photos: 5,
+        points: 40,
+        control: 10,
+        control_sigma_m: 0.0,
+        sigma_px: 0.5,
+        initial_center_error_m: 0.1,
+        initial_rotation_error: 0.001,
+        seed: 18,
+    };
+    let b = block(&spec);
+    let mut ph = photos(&b);
+    // Photo 2 starts turned half round about the vertical: everything it observes is behind it.
+    let pose = &mut ph[2].camera.pose;
+    pose.rotation_world_from_camera =
+        nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI)
+            * pose.rotation_world_from_camera;
+    let control_seen: Vec<String> = ph[2]
+        .observations
+        .iter()
+        .map(|o| o.point_id.clone())
+        .filter(|id| id.starts_with('c'))
+        .collect();
+    assert!(!control_seen.is_empty());
+    match bundle_adjust(&ph, &b.control, &BundleOptions::default()) {
+        Err(PhotogrammetryError::PointsBehindCamera { photo, point_ids }) => {
+            assert_eq!(photo.as_deref(), Some("photo02"));
+            for id in &control_seen {
+                assert!(point_ids.contains(id), "{id} missing from {point_ids:?}");
+            }
+            let seen: Vec<&str> = ph[2]
+                .observations
+                .iter()
+                .map(|o| o.point_id.as_str())
+                .collect();
+            assert!(point_ids.iter().all(|id| seen.contains(&id.as_str())));
+        }
+        other => panic!("expected PointsBehindCamera, got {other:?}"),
+    }
 }

@@ -47,6 +47,7 @@ struct Problem<'a> {
 
 impl NormalEquations for Problem<'_> {
     type State = Point3<f64>;
+    type Normal = DMatrix<f64>;
     fn unknowns(&self) -> usize {
         3
     }

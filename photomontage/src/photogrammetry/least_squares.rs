@@ -2,37 +2,62 @@
 //! scaling `(N + λ·diag N) δ = −g`; Nocedal & Wright 2006 §10.3), plus the covariance and
 //! parameter-support measures the adjustments report.
 //!
-//! The problem supplies N = JᵀJ and g = Jᵀr of its whitened residuals r, never J itself, so the
-//! bundle adjustment can assemble N block by block.
+//! The problem supplies N = JᵀJ and g = Jᵀr of its whitened residuals r, never J itself, in a
+//! representation of its choosing ([`LinearSystem`]): a dense matrix for the resection, the
+//! sparse blocks of the bundle adjustment ([`super::bundle`]) solved through the reduced camera
+//! system. The damping is applied by the representation, always as `λ·max(N_ii, 10⁻¹²)` on the
+//! diagonal, so every representation takes the same steps.
 //!
 //! # Known limitations
-//! Dense Cholesky: cost O(n³) in the number of unknowns, fine up to a few thousand.
+//! The dense representation uses Cholesky at O(n³) in the number of unknowns, fine up to a few
+//! thousand; larger problems need a structured representation.
 
 use nalgebra::{DMatrix, DVector};
+
+/// Smallest diagonal element used to scale the damping (keeps a zero column damped).
+pub(crate) const MIN_DAMPING_DIAGONAL: f64 = 1e-12;
+
+/// A normal matrix N in some representation.
+pub(crate) trait LinearSystem {
+    /// Diagonal of N.
+    fn diagonal(&self) -> DVector<f64>;
+    /// Solves `(N + λ·diag(max(N_ii, MIN_DAMPING_DIAGONAL))) x = rhs`; `None` when singular.
+    fn solve_damped(&self, lambda: f64, rhs: &DVector<f64>) -> Option<DVector<f64>>;
+}
+
+impl LinearSystem for DMatrix<f64> {
+    fn diagonal(&self) -> DVector<f64> {
+        DMatrix::diagonal(self)
+    }
+    fn solve_damped(&self, lambda: f64, rhs: &DVector<f64>) -> Option<DVector<f64>> {
+        let mut damped = self.clone();
+        for i in 0..self.nrows() {
+            damped[(i, i)] += lambda * self[(i, i)].max(MIN_DAMPING_DIAGONAL);
+        }
+        damped.cholesky().map(|c| c.solve(rhs))
+    }
+}
 
 /// A weighted least-squares problem in whitened form (cost = Σ r², r = W^½ (f(x) − l)).
 pub(crate) trait NormalEquations {
     type State: Clone;
+    /// Representation of N.
+    type Normal: LinearSystem;
     /// Number of unknowns.
     fn unknowns(&self) -> usize;
     /// Cost at `state`; `None` when the state is invalid (e.g. a point behind a camera).
     fn cost(&self, state: &Self::State) -> Option<f64>;
     /// (N, g, cost) at `state`.
-    fn normal_equations(&self, state: &Self::State) -> Option<(DMatrix<f64>, DVector<f64>, f64)>;
+    fn normal_equations(&self, state: &Self::State) -> Option<(Self::Normal, DVector<f64>, f64)>;
     /// `state ⊕ delta`.
     fn update(&self, state: &Self::State, delta: &DVector<f64>) -> Self::State;
-    /// Solves the damped normal equations `damped · x = rhs` (dense Cholesky unless the
-    /// problem knows a better structure).
-    fn solve(&self, damped: &DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
-        damped.clone().cholesky().map(|c| c.solve(rhs))
-    }
 }
 
 /// The solution of [`levenberg_marquardt`].
-pub(crate) struct Solution<S> {
+pub(crate) struct Solution<S, N> {
     pub state: S,
     /// Normal matrix at the solution (undamped).
-    pub normal: DMatrix<f64>,
+    pub normal: N,
     pub cost: f64,
     pub converged: bool,
 }
@@ -49,19 +74,15 @@ const MAX_ITERATIONS: usize = 200;
 pub(crate) fn levenberg_marquardt<P: NormalEquations>(
     problem: &P,
     start: P::State,
-) -> Option<Solution<P::State>> {
+) -> Option<Solution<P::State, P::Normal>> {
     let mut state = start;
     let (mut normal, mut gradient, mut cost) = problem.normal_equations(&state)?;
     let n = problem.unknowns();
     let mut lambda = 1e-4;
     let mut converged = false;
+    let mut diagonal = normal.diagonal();
     for _ in 0..MAX_ITERATIONS {
-        let mut damped = normal.clone();
-        for i in 0..n {
-            let d = normal[(i, i)].max(1e-12);
-            damped[(i, i)] += lambda * d;
-        }
-        let Some(step) = problem.solve(&damped, &gradient) else {
+        let Some(step) = normal.solve_damped(lambda, &gradient) else {
             lambda *= 10.0;
             if lambda > 1e16 {
                 break;
@@ -70,7 +91,7 @@ pub(crate) fn levenberg_marquardt<P: NormalEquations>(
         };
         let delta = -step;
         let small_step =
-            (0..n).all(|i| delta[i].abs() * normal[(i, i)].max(1e-300).sqrt() <= STEP_TOLERANCE);
+            (0..n).all(|i| delta[i].abs() * diagonal[i].max(1e-300).sqrt() <= STEP_TOLERANCE);
         let trial = problem.update(&state, &delta);
         match problem.cost(&trial) {
             Some(trial_cost) if trial_cost <= cost => {
@@ -80,6 +101,7 @@ pub(crate) fn levenberg_marquardt<P: NormalEquations>(
                     break;
                 };
                 normal = nn;
+                diagonal = normal.diagonal();
                 gradient = gg;
                 cost = cc;
                 lambda = (lambda * 0.1).max(1e-12);
@@ -133,7 +155,12 @@ pub(crate) fn multiple_correlation(
     inverse: &DMatrix<f64>,
     index: usize,
 ) -> f64 {
-    let product = normal[(index, index)] * inverse[(index, index)];
+    correlation_from_diagonals(normal[(index, index)], inverse[(index, index)])
+}
+
+/// ρ = √(1 − 1 / (N_ii · (N⁻¹)_ii)) from the two diagonal elements.
+pub(crate) fn correlation_from_diagonals(normal_ii: f64, inverse_ii: f64) -> f64 {
+    let product = normal_ii * inverse_ii;
     if product <= 1.0 {
         0.0
     } else {
@@ -155,6 +182,7 @@ mod tests {
 
     impl NormalEquations for Exp {
         type State = [f64; 2];
+        type Normal = DMatrix<f64>;
         fn unknowns(&self) -> usize {
             2
         }

@@ -216,6 +216,18 @@ pub fn control_points(site: &Site) -> Vec<ControlPoint> {
 /// Solves every photo of a site (and the bundle adjustment when the site asks for it).
 #[must_use]
 pub fn solve_site(doc: &SiteDocument) -> SiteSolution {
+    solve_site_with(doc, pg::bundle_adjust)
+}
+
+/// The bundle adjustment [`solve_site_with`] runs (the tests swap in the dense reference).
+pub(crate) type BundleAdjust = fn(
+    &[BundlePhoto],
+    &[ControlPoint],
+    &BundleOptions,
+) -> Result<pg::BundleReport, PhotogrammetryError>;
+
+/// [`solve_site`] with the bundle adjustment `adjust`.
+pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteSolution {
     let site = &doc.site;
     let control = control_points(site);
     let control_ids: HashSet<&str> = control.iter().map(|c| c.id.as_str()).collect();
@@ -289,9 +301,11 @@ pub fn solve_site(doc: &SiteDocument) -> SiteSolution {
             .collect();
         let options = BundleOptions {
             outlier_threshold_sigma: site.solve.outlier_threshold_sigma,
+            // The tie points' σ are written back into the site.
+            point_covariance: true,
             ..BundleOptions::default()
         };
-        match pg::bundle_adjust(&bundle_photos, &control, &options) {
+        match adjust(&bundle_photos, &control, &options) {
             Ok(report) => {
                 bundle_rms_px = Some(report.rms_px);
                 warnings.extend(report.warnings.iter().cloned());
@@ -414,3 +428,7 @@ pub fn stored_camera(site: &Site, photo_id: &str) -> Option<Camera> {
         },
     })
 }
+
+#[cfg(test)]
+#[path = "solve_tests.rs"]
+mod tests;

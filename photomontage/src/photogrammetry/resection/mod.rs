@@ -8,7 +8,10 @@
 //! 1. validate the input (finite values, σ > 0, unique ids, every observed point is control,
 //!    not all collinear, no two plane points imaged onto the same pixel);
 //! 2. RANSAC over P3P (exhaustive when the number of triples is small), MSAC score on all points
-//!    with each point's σ including its control σ projected into the image;
+//!    with each point's σ including its control σ projected into the image; only points in
+//!    front of a pose count as its inliers (cheirality). When the best such pose leaves at least
+//!    half the points unexplained and a pose with the points behind the camera explains more, the
+//!    error [`PhotogrammetryError::PointsBehindCamera`] names those points;
 //! 3. Levenberg–Marquardt on the consensus set, reclassification of all points, repeated;
 //! 4. self-calibration: the requested parameters are freed only if their multiple correlation
 //!    with the other unknowns is below [`ResectionOptions::max_correlation`] and the redundancy
@@ -27,7 +30,11 @@
 //! # Known limitations
 //! At least four control points are needed (three give up to four poses). The initial focal
 //! length must be within a few tens of percent when it is to be estimated. Observations of two
-//! points on one ray are accepted for non-planar control (they can be genuine).
+//! points on one ray are accepted for non-planar control (they can be genuine). With planar
+//! control, points that lie behind the camera (e.g. mirrored through its centre) are explained
+//! exactly by the camera mirrored across the control plane, with every point in front: the data
+//! cannot tell the two apart, so that camera is returned (the solution in front is preferred;
+//! only a prior on the camera position, which [`resect`] does not take, could reject it).
 
 use std::collections::HashMap;
 
@@ -47,7 +54,7 @@ use super::{
     validate_intrinsics, validate_observations,
 };
 use crate::camera::{Camera, Intrinsics};
-use ransac::{normalised_error_sq, ransac};
+use ransac::{Side, behind_the_camera, normalised_error_sq, ransac};
 
 /// Tunables of [`resect`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -198,6 +205,7 @@ impl<'a> Problem<'a> {
 
 impl NormalEquations for Problem<'_> {
     type State = Camera;
+    type Normal = DMatrix<f64>;
     fn unknowns(&self) -> usize {
         6 + self.intrinsic_columns.len()
     }
@@ -343,11 +351,28 @@ pub fn resect(
     };
 
     // Step 2: robust start.
-    let start_pose = ransac(&all, &intrinsics, options, gate_px).ok_or_else(|| {
-        PhotogrammetryError::Degenerate {
+    let front = ransac(&all, &intrinsics, options, gate_px, Side::Front);
+    let front_inliers = front.map_or(0, |(_, inliers)| inliers);
+    // A pose behind can explain more points only when the front one leaves at least half
+    // unexplained (a point rarely fits both); checking only then keeps the second search off
+    // the ordinary photo with a few gross errors.
+    if 2 * front_inliers <= n
+        && let Some(e) = behind_the_camera(
+            &all,
+            observations,
+            &intrinsics,
+            options,
+            gate_px,
+            front_inliers,
+        )
+    {
+        return Err(e);
+    }
+    let Some((start_pose, _)) = front else {
+        return Err(PhotogrammetryError::Degenerate {
             reason: "no pose from any three control points explains a fourth".to_owned(),
-        }
-    })?;
+        });
+    };
     let mut camera = Camera {
         intrinsics,
         pose: start_pose,

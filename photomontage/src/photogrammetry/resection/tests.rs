@@ -370,3 +370,76 @@ fn absurd_focal_or_principal_point_is_refused_before_any_work() {
         assert!(err.to_string().contains(field), "{err}");
     }
 }
+
+/// Control points mirrored through the true camera centre: every pixel is unchanged but every
+/// point lies behind the camera.
+fn mirrored_through_the_camera(
+    s: &crate::photogrammetry::synthetic::SyntheticScene,
+) -> Vec<ControlPoint> {
+    let c = s.camera.pose.camera_center_in_world;
+    s.control
+        .iter()
+        .map(|p| ControlPoint {
+            point_in_world: c - (p.point_in_world - c),
+            ..p.clone()
+        })
+        .collect()
+}
+
+#[test]
+fn control_all_behind_the_camera_is_an_error_naming_the_points() {
+    for points in [4, 6, 12] {
+        let s = single_photo(&SceneSpec {
+            focal_px: 3000.0,
+            image_size_px: IMAGE,
+            distance_m: 30.0,
+            points,
+            layout: Layout::Volume {
+                depth_fraction: 0.3,
+            },
+            sigma_px: 0.5,
+            outlier_fraction: 0.0,
+            seed: 3,
+        });
+        let control = mirrored_through_the_camera(&s);
+        let options = ResectionOptions::new(s.camera.intrinsics);
+        match resect(&control, &s.observations, &options) {
+            Err(PhotogrammetryError::PointsBehindCamera { photo, point_ids }) => {
+                assert_eq!(photo, None);
+                let mut expected: Vec<String> = control.iter().map(|c| c.id.clone()).collect();
+                let mut got = point_ids.clone();
+                expected.sort();
+                got.sort();
+                assert_eq!(got, expected, "{points} points");
+            }
+            other => panic!("{points} points: expected PointsBehindCamera, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn planar_control_behind_the_camera_gives_the_mirrored_camera_with_points_in_front() {
+    // The known limitation: the camera mirrored across the plane sees the same pixels with every
+    // point in front; that camera is returned, and it has all points at positive depth.
+    let s = single_photo(&SceneSpec {
+        focal_px: 3000.0,
+        image_size_px: IMAGE,
+        distance_m: 30.0,
+        points: 8,
+        layout: Layout::Ground,
+        sigma_px: 0.5,
+        outlier_fraction: 0.0,
+        seed: 3,
+    });
+    let control = mirrored_through_the_camera(&s);
+    let options = ResectionOptions::new(s.camera.intrinsics);
+    let r = resect(&control, &s.observations, &options).expect("the mirrored camera");
+    for c in &control {
+        assert!(
+            r.camera.pose.camera_from_world(&c.point_in_world).z > 0.0,
+            "{}",
+            c.id
+        );
+    }
+    assert!(r.outliers.len() <= MAX_FALSE_FLAGS, "{:?}", r.outliers);
+}
