@@ -90,20 +90,24 @@ done
 
 # One target for $seconds; the summary line goes to $work/logs/<target>.summary.
 run_one() {
-    local t="$1" max_len=65536 log="$work/logs/$t.log"
+    local t="$1"
+    local max_len=65536 log="$work/logs/$t.log"
     case "$t" in photo|exif) max_len=262144 ;; esac
     local seeds start end
     seeds=$(find "$work/corpus/$t" -type f | wc -l)
+    # Run a copy, so that a rebuild during a long campaign cannot touch a running binary.
+    mkdir -p "$work/bin"
+    cp "$bin_dir/$t" "$work/bin/$t"
     start=$(date +%s)
     set +e
-    nice -n 19 "$bin_dir/$t" "$work/corpus/$t" \
+    nice -n 19 "$work/bin/$t" "$work/corpus/$t" \
         -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" \
         -artifact_prefix="$work/artifacts/$t/" -print_final_stats=1 > "$log" 2>&1
     local rc=$?
     set -e
     end=$(date +%s)
     local execs files bytes findings
-    execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+    execs=$(grep -a -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
     files=$(find "$work/corpus/$t" -type f | wc -l)
     bytes=$(du -sb "$work/corpus/$t" | cut -f1)
     findings=$(find "$work/artifacts/$t" -type f | wc -l)
@@ -119,5 +123,5 @@ printf '%s\n' "${targets[@]}" | xargs -P "$parallel" -I{} bash -c 'run_one "$@"'
 echo
 printf 'target\twall_s\texecs\tseeds\tcorpus_files\tcorpus_bytes\tartifacts\texit\n'
 for t in "${targets[@]}"; do cat "$work/logs/$t.summary"; done
-echo "engine: $(grep -m1 -o 'INFO: Seed: [0-9]*' "$work/logs/${targets[0]}.log" >/dev/null && echo libFuzzer) via cargo-fuzz $(cargo fuzz --version 2>/dev/null | cut -d' ' -f2)"
+echo "engine: libFuzzer (libfuzzer-sys $(grep -A1 '^name = "libfuzzer-sys"' "$here/Cargo.lock" | grep -o '[0-9][0-9.]*')) via $(cargo fuzz --version 2>/dev/null), $(rustc +nightly --version)"
 echo "corpora: $work/corpus   artifacts: $work/artifacts   logs: $work/logs"

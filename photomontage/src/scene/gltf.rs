@@ -19,7 +19,7 @@ use super::import::{
     ImportOptions, ImportWarning, ImportedModel, LengthUnit, ModelBuilder, ModelError, UpAxis,
 };
 use super::material::{Material, Specular};
-use crate::bounded_read::{MAX_MODEL_FILE_BYTES, check_regular_file};
+use crate::bounded_read::{MAX_MODEL_FILE_BYTES, check_regular_file, read_bounded};
 
 /// Node nesting depth at which traversal stops (guards against malicious recursion).
 pub const MAX_NODE_DEPTH: usize = 64;
@@ -230,6 +230,36 @@ impl Walker<'_> {
 
 /// Refuses a node hierarchy with a cycle (the glTF crate would follow it until the depth cap,
 /// compounding transforms into a 10¹⁰ m bounding box), by depth-first search over all nodes.
+/// Parses and validates glTF or GLB bytes. gltf-json 1.4's validation indexes `accessors` with
+/// a primitive's `POSITION` index before checking it (a panic on an index past the end; found
+/// by the `gltf` fuzz target), so the file is parsed without validation, the `POSITION` indices
+/// are checked here, and only then is the crate's validation run.
+fn parse_validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
+    let json = document.into_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&gltf::json::validation::Checked::Valid(
+                    gltf::Semantic::Positions,
+                ));
+            if let Some(index) = position
+                && index.value() >= accessors
+            {
+                return Err(format!(
+                    "meshes[{m}].primitives[{p}].attributes.POSITION is accessor {}, but there are {accessors} accessors",
+                    index.value()
+                ));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(|e| e.to_string())?;
+    Ok(gltf::Gltf { document, blob })
+}
+
 fn check_node_cycles(document: &gltf::Document, path: &str) -> Result<(), GltfError> {
     #[derive(Clone, Copy, PartialEq)]
     enum Mark {
@@ -379,8 +409,11 @@ pub fn load_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, 
         path: path_str.clone(),
         source: Box::new(source),
     };
-    check_regular_file(path, MAX_MODEL_FILE_BYTES).map_err(referenced)?;
-    let file = gltf::Gltf::open(path).map_err(load_err)?;
+    let bytes = read_bounded(path, MAX_MODEL_FILE_BYTES).map_err(referenced)?;
+    let file = parse_validated(&bytes).map_err(|reason| GltfError::Load {
+        path: path_str.clone(),
+        reason,
+    })?;
     check_node_cycles(&file.document, &path_str)?;
     check_buffers(&file, path.parent(), &path_str)?;
     let buffers =
