@@ -11,6 +11,8 @@ use photomontage_fuzz::{check_model, clear_scratch, write_scratch};
 const MTL_MARKER: &[u8] = b"\n#%MTL%\n";
 /// Most MTL names written per input (an OBJ may name many libraries).
 const MAX_MTL_FILES: usize = 4;
+/// Longest MTL name written (file systems refuse names over 255 bytes).
+const MAX_MTL_NAME_BYTES: usize = 200;
 
 fuzz_target!(|data: &[u8]| {
     let (obj, mtl) = match data.windows(MTL_MARKER.len()).position(|w| w == MTL_MARKER) {
@@ -24,7 +26,13 @@ fuzz_target!(|data: &[u8]| {
             .lines()
             .filter_map(|l| l.trim_start().strip_prefix("mtllib"))
             .flat_map(str::split_whitespace)
-            .filter(|n| !n.is_empty() && !n.contains(['/', '\\', '\0']) && *n != "." && *n != "..")
+            .filter(|n| {
+                !n.is_empty()
+                    && n.len() <= MAX_MTL_NAME_BYTES
+                    && !n.contains(['/', '\\', '\0'])
+                    && *n != "."
+                    && *n != ".."
+            })
             .take(MAX_MTL_FILES);
         for name in names {
             write_scratch(name, mtl);

@@ -230,11 +230,27 @@ impl Walker<'_> {
 
 /// Refuses a node hierarchy with a cycle (the glTF crate would follow it until the depth cap,
 /// compounding transforms into a 10¹⁰ m bounding box), by depth-first search over all nodes.
+/// Size of the GLB file header (magic, version, total length), glTF 2.0 §4.4.2.
+const GLB_HEADER_BYTES: u32 = 12;
+
 /// Parses and validates glTF or GLB bytes. gltf-json 1.4's validation indexes `accessors` with
 /// a primitive's `POSITION` index before checking it (a panic on an index past the end; found
 /// by the `gltf` fuzz target), so the file is parsed without validation, the `POSITION` indices
 /// are checked here, and only then is the crate's validation run.
 fn parse_validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    // gltf 1.4's `Glb::from_slice` subtracts the 12-byte header from the declared length
+    // unchecked (an overflow panic with overflow checks on; found by the `gltf` fuzz target).
+    if let Some(declared) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .and_then(|b| <[u8; 4]>::try_from(b).ok())
+        .map(u32::from_le_bytes)
+        && declared < GLB_HEADER_BYTES
+    {
+        return Err(format!(
+            "GLB header declares a total length of {declared} bytes, less than the {GLB_HEADER_BYTES}-byte header itself"
+        ));
+    }
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
     let json = document.into_json();
