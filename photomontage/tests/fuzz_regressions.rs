@@ -160,7 +160,7 @@ fn every_saved_fuzz_finding_replays_without_panic() {
     }
     // The inputs stored so far (docs/fuzzing.md); the count only grows.
     assert!(
-        replayed >= 4,
+        replayed >= 5,
         "only {replayed} saved inputs under {}",
         root.display()
     );
@@ -212,26 +212,70 @@ fn mtl_colour_with_three_values_still_loads() {
     assert_eq!(model.materials[0].name, "a");
 }
 
+/// The `quad_nodes.gltf` fixture as JSON, to be broken one field at a time.
+fn quad_fixture() -> serde_json::Value {
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/quad_nodes.gltf");
+    serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap()
+}
+
+/// The `GltfError::Load` reason for `json`, failing the test on any other outcome.
+fn gltf_load_reason(json: &serde_json::Value) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "model.gltf", json.to_string().as_bytes());
+    match load_gltf(&path, &ImportOptions::default()) {
+        Err(GltfError::Load { reason, .. }) => reason,
+        other => panic!("expected a load error, got {other:?}"),
+    }
+}
+
+/// gltf 1.4 reached `unreachable!()` reading an index accessor of a signed type (SHORT, 5122);
+/// now it is a load error naming the primitive and accessor.
+#[test]
+fn gltf_signed_index_accessor_is_a_load_error() {
+    let mut json = quad_fixture();
+    let indices = json["meshes"][0]["primitives"][0]["indices"]
+        .as_u64()
+        .unwrap();
+    json["accessors"][indices as usize]["componentType"] = 5122.into();
+    assert_eq!(
+        gltf_load_reason(&json),
+        format!(
+            "meshes[0].primitives[0].indices (accessor {indices}) must be SCALAR of UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT (5121, 5123, 5125)"
+        )
+    );
+}
+
+/// A POSITION buffer view whose stride is shorter than a VEC3 of floats would make gltf 1.4
+/// assert on a short slice; it is refused up front.
+#[test]
+fn gltf_position_stride_shorter_than_a_vertex_is_a_load_error() {
+    let mut json = quad_fixture();
+    let position = json["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+        .as_u64()
+        .unwrap() as usize;
+    let view = json["accessors"][position]["bufferView"].as_u64().unwrap() as usize;
+    json["bufferViews"][view]["byteStride"] = 8.into();
+    assert_eq!(
+        gltf_load_reason(&json),
+        format!(
+            "meshes[0].primitives[0].attributes.POSITION: bufferViews[{view}].byteStride 8 is smaller than one element (12 bytes)"
+        )
+    );
+}
+
 /// gltf-json 1.4 panicked (index out of bounds in its validation) on a `POSITION` accessor
 /// index past the end; now it is a load error naming the mesh, primitive and index.
 #[test]
 fn gltf_position_accessor_out_of_range_is_a_load_error() {
-    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/quad_nodes.gltf");
-    let mut json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
+    let mut json = quad_fixture();
     let accessors = json["accessors"].as_array().unwrap().len();
     json["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = accessors.into();
-    let dir = tempfile::tempdir().unwrap();
-    let path = write(dir.path(), "model.gltf", json.to_string().as_bytes());
-    match load_gltf(&path, &ImportOptions::default()) {
-        Err(GltfError::Load { reason, .. }) => assert_eq!(
-            reason,
-            format!(
-                "meshes[0].primitives[0].attributes.POSITION is accessor {accessors}, but there are {accessors} accessors"
-            )
-        ),
-        other => panic!("expected a load error, got {other:?}"),
-    }
+    assert_eq!(
+        gltf_load_reason(&json),
+        format!(
+            "meshes[0].primitives[0].attributes.POSITION is accessor {accessors}, but there are {accessors} accessors"
+        )
+    );
 }
 
 /// gltf 1.4 subtracted the 12-byte GLB header from the declared total length unchecked (an

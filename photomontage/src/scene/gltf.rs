@@ -236,7 +236,8 @@ const GLB_HEADER_BYTES: u32 = 12;
 /// Parses and validates glTF or GLB bytes. gltf-json 1.4's validation indexes `accessors` with
 /// a primitive's `POSITION` index before checking it (a panic on an index past the end; found
 /// by the `gltf` fuzz target), so the file is parsed without validation, the `POSITION` indices
-/// are checked here, and only then is the crate's validation run.
+/// are checked here, and only then is the crate's validation run; then the accessors the
+/// importer reads are checked against what the crate's readers assume (`gltf_accessors`).
 fn parse_validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
     // gltf 1.4's `Glb::from_slice` subtracts the 12-byte header from the declared length
     // unchecked (an overflow panic with overflow checks on; found by the `gltf` fuzz target).
@@ -254,25 +255,9 @@ fn parse_validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
     let json = document.into_json();
-    let accessors = json.accessors.len();
-    for (m, mesh) in json.meshes.iter().enumerate() {
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            let position = primitive
-                .attributes
-                .get(&gltf::json::validation::Checked::Valid(
-                    gltf::Semantic::Positions,
-                ));
-            if let Some(index) = position
-                && index.value() >= accessors
-            {
-                return Err(format!(
-                    "meshes[{m}].primitives[{p}].attributes.POSITION is accessor {}, but there are {accessors} accessors",
-                    index.value()
-                ));
-            }
-        }
-    }
+    super::gltf_accessors::check_position_indices(&json)?;
     let document = gltf::Document::from_json(json).map_err(|e| e.to_string())?;
+    super::gltf_accessors::check_primitive_accessors(document.as_json())?;
     Ok(gltf::Gltf { document, blob })
 }
 
