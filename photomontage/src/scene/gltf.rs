@@ -19,7 +19,7 @@ use super::import::{
     ImportOptions, ImportWarning, ImportedModel, LengthUnit, ModelBuilder, ModelError, UpAxis,
 };
 use super::material::{Material, Specular};
-use crate::bounded_read::{MAX_MODEL_FILE_BYTES, check_regular_file};
+use crate::bounded_read::{MAX_MODEL_FILE_BYTES, check_regular_file, read_bounded};
 
 /// Node nesting depth at which traversal stops (guards against malicious recursion).
 pub const MAX_NODE_DEPTH: usize = 64;
@@ -230,6 +230,37 @@ impl Walker<'_> {
 
 /// Refuses a node hierarchy with a cycle (the glTF crate would follow it until the depth cap,
 /// compounding transforms into a 10¹⁰ m bounding box), by depth-first search over all nodes.
+/// Size of the GLB file header (magic, version, total length), glTF 2.0 §4.4.2.
+const GLB_HEADER_BYTES: u32 = 12;
+
+/// Parses and validates glTF or GLB bytes. gltf-json 1.4's validation indexes `accessors` with
+/// a primitive's `POSITION` index before checking it (a panic on an index past the end; found
+/// by the `gltf` fuzz target), so the file is parsed without validation, the `POSITION` indices
+/// are checked here, and only then is the crate's validation run; then the accessors the
+/// importer reads are checked against what the crate's readers assume (`gltf_accessors`).
+fn parse_validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    // gltf 1.4's `Glb::from_slice` subtracts the 12-byte header from the declared length
+    // unchecked (an overflow panic with overflow checks on; found by the `gltf` fuzz target).
+    if let Some(declared) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .and_then(|b| <[u8; 4]>::try_from(b).ok())
+        .map(u32::from_le_bytes)
+        && declared < GLB_HEADER_BYTES
+    {
+        return Err(format!(
+            "GLB header declares a total length of {declared} bytes, less than the {GLB_HEADER_BYTES}-byte header itself"
+        ));
+    }
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
+    let json = document.into_json();
+    super::gltf_accessors::check_position_indices(&json)?;
+    let document = gltf::Document::from_json(json).map_err(|e| e.to_string())?;
+    super::gltf_accessors::check_primitive_accessors(document.as_json())?;
+    Ok(gltf::Gltf { document, blob })
+}
+
 fn check_node_cycles(document: &gltf::Document, path: &str) -> Result<(), GltfError> {
     #[derive(Clone, Copy, PartialEq)]
     enum Mark {
@@ -379,8 +410,11 @@ pub fn load_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, 
         path: path_str.clone(),
         source: Box::new(source),
     };
-    check_regular_file(path, MAX_MODEL_FILE_BYTES).map_err(referenced)?;
-    let file = gltf::Gltf::open(path).map_err(load_err)?;
+    let bytes = read_bounded(path, MAX_MODEL_FILE_BYTES).map_err(referenced)?;
+    let file = parse_validated(&bytes).map_err(|reason| GltfError::Load {
+        path: path_str.clone(),
+        reason,
+    })?;
     check_node_cycles(&file.document, &path_str)?;
     check_buffers(&file, path.parent(), &path_str)?;
     let buffers =

@@ -16,6 +16,7 @@
 
 pub mod dxf;
 pub mod gltf;
+mod gltf_accessors;
 pub mod import;
 pub mod material;
 pub mod obj;

@@ -93,6 +93,27 @@ fn material_from_mtl(m: &tobj::Material) -> Material {
     out
 }
 
+/// The first MTL colour statement (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three values, as
+/// `line N: ...`. tobj 4.0 panics on those (an `unwrap` in its `parse_float3`; found by the
+/// `obj_mtl` fuzz target), so the library is checked before tobj reads it. Lines split as tobj
+/// splits them (`\n`, an optional `\r` dropped).
+fn short_colour_line(mtl: &[u8]) -> Option<String> {
+    String::from_utf8_lossy(mtl)
+        .lines()
+        .enumerate()
+        .find_map(|(index, line)| {
+            let mut words = line.split_whitespace();
+            let keyword = words.next()?;
+            let values = words.count();
+            (matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke") && values < 3).then(|| {
+                format!(
+                    "line {}: `{keyword}` needs 3 numbers (r g b), found {values}",
+                    index + 1
+                )
+            })
+        })
+}
+
 /// Reads an OBJ file (and its MTL libraries) into world coordinates.
 ///
 /// # Errors
@@ -124,13 +145,22 @@ pub fn load_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, O
     // MTL libraries go through the same check; tobj's loader can only say "failed", so the
     // reason waits here.
     let mtl_refusal = std::cell::RefCell::new(None);
+    let mtl_malformed: std::cell::RefCell<Option<String>> = std::cell::RefCell::new(None);
     let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let loaded =
         tobj::load_obj_buf(
             &mut obj_bytes.as_slice(),
             &load_options,
             |mtl_path| match read_bounded(&folder.join(mtl_path), MAX_MTL_FILE_BYTES) {
-                Ok(bytes) => tobj::load_mtl_buf(&mut bytes.as_slice()),
+                Ok(bytes) => match short_colour_line(&bytes) {
+                    Some(reason) => {
+                        mtl_malformed
+                            .borrow_mut()
+                            .get_or_insert_with(|| format!("{}: {reason}", mtl_path.display()));
+                        Err(tobj::LoadError::MaterialParseError)
+                    }
+                    None => tobj::load_mtl_buf(&mut bytes.as_slice()),
+                },
                 Err(BoundedReadError::Io { .. }) => Err(tobj::LoadError::OpenFileFailed),
                 Err(e) => {
                     mtl_refusal.borrow_mut().get_or_insert(e);
@@ -157,7 +187,7 @@ pub fn load_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, O
                 .warnings
                 .push(ImportWarning::MissingMaterialLibrary {
                     name: mtllib_names(&obj_bytes).join(", "),
-                    reason: e.to_string(),
+                    reason: mtl_malformed.take().unwrap_or_else(|| e.to_string()),
                 });
             Vec::new()
         }
