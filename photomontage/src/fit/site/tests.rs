@@ -4,12 +4,18 @@
 //! chosen), a material library with the material's ρ_d.
 
 use super::*;
+use crate::fit::daylight::{irradiance_components, normalised_sky_facets};
+use crate::scene::Material;
 use crate::scene::{ObjectKind, SceneObject};
+use crate::site::render::site_sun_dir;
+use crate::site::stored_camera;
 use crate::site::{
     ControlPoint, Exterior, HorizonSample, Interior, Location, Photo, Polygon, Sample,
     SunShadowPair,
 };
+use crate::sky_dome::durisch_facets::durisch_dome;
 use image::{Rgb, Rgb32FImage};
+use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
