@@ -137,10 +137,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     p.display()
                 )
             })?;
-            photo::initial_focal_px(&exif, size)
+            photo::focal_px_from_exif(&exif, size)
                 .with_context(|| {
                     format!(
-                        "no --focal-px given and {} has no focal length in EXIF",
+                        "no --focal-px given and {} gives no focal length in pixels",
                         p.display()
                     )
                 })?
