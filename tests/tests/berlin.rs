@@ -113,7 +113,7 @@ const EXIF_FOCAL_MM: f64 = 4.3;
 const EXIF_FOCAL_ROUNDING_REL: f64 = 0.05 / 4.3;
 /// The 35 mm tag is a whole number of mm: ±0.5 mm of 35 mm (±1.43 %).
 const EXIF_35MM_ROUNDING_REL: f64 = 0.5 / 35.0;
-/// iPhone 4S pixel pitch (Sony IMX145, Apple's and Sony's specifications): 1.4 µm.
+/// iPhone 4S pixel pitch, 1.4 µm (as reported for its Sony IMX145 sensor).
 const PIXEL_PITCH_MM: f64 = 0.0014;
 /// Image size of the three photos.
 const SIZE_PX: [u32; 2] = [3264, 2448];
