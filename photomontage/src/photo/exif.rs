@@ -5,9 +5,10 @@
 //! The initial focal length in pixels is taken, in order of trust, from
 //! 1. the focal-plane resolution (pixels per unit on the sensor), rescaled when the stored image
 //!    is smaller than the size EXIF describes;
-//! 2. a sensor-width table for known camera models ([`super::sensor_table`], make and model
-//!    matched robustly);
-//! 3. the 35 mm equivalent focal length (diagonal of 43.27 mm).
+//! 2. the 35 mm equivalent focal length the camera states (diagonal of 43.27 mm), which
+//!    accounts for crop modes and digital zoom;
+//! 3. a sensor-width table for known camera models ([`super::sensor_table`], make and model
+//!    matched robustly), for bodies that state neither.
 //!
 //! When none applies, [`focal_px_from_exif`] says exactly which tags are missing.
 //!
@@ -320,18 +321,22 @@ pub fn initial_focal_px(exif: &ExifInfo, image_size_px: [u32; 2]) -> Option<Foca
             });
         }
     }
-    if let (Some(f_mm), Some([w_mm, h_mm])) = (
-        exif.focal_length_mm,
-        super::sensor_table::sensor_size_mm(exif.make.as_deref(), exif.model.as_deref()),
-    ) {
+    // The camera's own 35 mm statement before the nominal sensor table: it accounts for crop
+    // modes and digital zoom (the Panasonic FZ30 sample's tag is 17 % longer than its
+    // FocalLength on the full nominal sensor).
+    if let Some(f35) = exif.focal_length_35mm {
         return Some(FocalEstimate {
-            focal_px: f_mm * long_side / w_mm.max(h_mm),
-            source: FocalSource::SensorTable,
+            focal_px: f35 * long_side.hypot(short_side) / FULL_FRAME_DIAGONAL_MM,
+            source: FocalSource::Equivalent35mm,
         });
     }
-    exif.focal_length_35mm.map(|f35| FocalEstimate {
-        focal_px: f35 * long_side.hypot(short_side) / FULL_FRAME_DIAGONAL_MM,
-        source: FocalSource::Equivalent35mm,
+    let (f_mm, [w_mm, h_mm]) = (
+        exif.focal_length_mm?,
+        super::sensor_table::sensor_size_mm(exif.make.as_deref(), exif.model.as_deref())?,
+    );
+    Some(FocalEstimate {
+        focal_px: f_mm * long_side / w_mm.max(h_mm),
+        source: FocalSource::SensorTable,
     })
 }
 
