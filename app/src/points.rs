@@ -2,7 +2,8 @@
 //! and the point's observation in the current photo (position, on/off, delete); plus importing
 //! control points from a CSV (`id,X,Y,Z[,σ]`, or `id,X,Y,Z,x,y[,σ_px]` with observations in the
 //! current photo) or an OpenDroneMap `gcp_list.txt` (observations matched to photos by file
-//! name). The table only emits [`Command`]s; `crate::Studio` applies them.
+//! name; a list in another CRS, WGS 84 included, is reprojected into the site's `location.crs`).
+//! The table only emits [`Command`]s; `crate::Studio` applies them.
 //!
 //! File formats: `photomontage::photogrammetry::control_io` (ODM's documented GCP format).
 //!
@@ -13,6 +14,7 @@
 
 use eframe::egui;
 use egui_extras::{Column, TableBuilder};
+use photomontage::geo::{ProjectedCrs, SourceCrs};
 use photomontage::photogrammetry::control_io::{
     ControlIoError, parse_control_points_csv, parse_odm_gcp_list, parse_points_csv,
 };
@@ -43,6 +45,16 @@ pub enum ImportError {
     },
     #[error("{path}: observations need a photo; select one first")]
     NoPhoto { path: String },
+    #[error("the site's location.crs `{name}` cannot be used to reproject {path}: {source}")]
+    SiteCrs {
+        path: String,
+        name: String,
+        source: photomontage::geo::GeoError,
+    },
+    #[error(
+        "{path}: the control points are geographic (`{header}`); set the site's location.crs (e.g. EPSG:32633) so they can be reprojected"
+    )]
+    NoSiteCrs { path: String, header: String },
 }
 
 /// Control points (and observations) of a file, as one undoable batch.
@@ -70,7 +82,26 @@ pub fn import_file(
     let control;
     let mut observations = Vec::new();
     if is_gcp_list {
-        let list = parse_odm_gcp_list(&text).map_err(parse_err)?;
+        let mut list = parse_odm_gcp_list(&text).map_err(parse_err)?;
+        // Control in any CRS: into the site's CRS when it names one.
+        match site.location.as_ref().and_then(|l| l.crs.as_deref()) {
+            Some(name) => {
+                let target =
+                    ProjectedCrs::from_name(name).map_err(|source| ImportError::SiteCrs {
+                        path: shown.clone(),
+                        name: name.to_owned(),
+                        source,
+                    })?;
+                list = list.reprojected(Some(&target)).map_err(parse_err)?.0;
+            }
+            None if SourceCrs::from_header(&list.crs).is_ok_and(|c| c.is_geographic()) => {
+                return Err(ImportError::NoSiteCrs {
+                    path: shown.clone(),
+                    header: list.crs.clone(),
+                });
+            }
+            None => {}
+        }
         control = list.control_points(DEFAULT_SIGMA_M).map_err(parse_err)?;
         for image in list.images() {
             let photo = site.photos.iter().find(|p| {
@@ -289,6 +320,44 @@ mod tests {
         std::fs::write(&bad, "A,1,2\n").expect("write");
         let e = import_file(&site, &bad, Some("P1")).expect_err("bad");
         assert!(e.to_string().contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn wgs84_gcp_list_is_reprojected_into_the_site_crs() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut site = Site::default();
+        site.photos.push(photomontage::site::Photo {
+            id: "P1".into(),
+            file: "photos/01.jpg".into(),
+            taken_at: None,
+            interior: None,
+            self_calibration: Default::default(),
+            exterior: None,
+        });
+        let gcp = dir.path().join("gcp_list.txt");
+        std::fs::write(&gcp, "WGS84\n13.4 52.52 12.5 40 50 01.jpg g1\n").expect("write");
+        // Without a site CRS the geographic list is refused, naming what to set.
+        let e = import_file(&site, &gcp, None).expect_err("no crs");
+        assert!(e.to_string().contains("location.crs"), "{e}");
+        site.location = Some(photomontage::site::Location {
+            latitude_deg: 52.52,
+            longitude_deg: 13.4,
+            elevation_m: 0.0,
+            crs: Some("EPSG:32633".into()),
+            grid_convergence_deg: 0.0,
+        });
+        let Command::Batch(b) = import_file(&site, &gcp, None).expect("import") else {
+            panic!("a batch");
+        };
+        let zone33 = ProjectedCrs::from_name("EPSG:32633").expect("valid");
+        let (e, n) = zone33.from_lat_lon_deg(52.52, 13.4).expect("converts");
+        assert!(matches!(&b[0], Command::PutControlPoint { point, .. }
+            if (point.xyz[0] - e).abs() < 1e-6 && (point.xyz[1] - n).abs() < 1e-6
+                && (point.xyz[2] - 12.5).abs() < 1e-12));
+        // A site CRS the library cannot use is named.
+        site.location.as_mut().expect("set").crs = Some("EPSG:9999".into());
+        let e = import_file(&site, &gcp, None).expect_err("bad crs");
+        assert!(e.to_string().contains("EPSG:9999"), "{e}");
     }
 }
 

@@ -7,11 +7,17 @@
 //! [+south] +datum=WGS84`), Swiss LV95 (EPSG:2056) and the British National Grid (EPSG:27700),
 //! both with their standard 7-parameter `+towgs84` datum shifts.
 //!
+//! Control coordinates may come in another CRS than the site's ([`SourceCrs`]: the header of an
+//! OpenDroneMap `gcp_list.txt`, geographic WGS 84 included) and are reprojected with
+//! [`SourceCrs::to_projected`]; [`utm_zone_of`] picks a UTM zone when no target is named.
+//!
 //! # Known limitations
 //! - Grid-based datum shifts (NTv2, OSTN15) are not available, so national-grid conversions carry
 //!   the metre-level error of the 3/7-parameter shift; for the sun position 1 km is only 0.01°,
 //!   far below what matters.
-//! - Heights are passed through unchanged (no geoid model).
+//! - Heights are passed through unchanged (no geoid model): a GPS height stays ellipsoidal, an
+//!   orthometric height stays orthometric.
+//! - EPSG codes beyond the presets are not looked up (no EPSG database); give a PROJ.4 string.
 
 use proj4rs::proj::Proj;
 
@@ -244,6 +250,181 @@ impl ProjectedCrs {
     }
 }
 
+/// PROJ.4 definition of geographic WGS 84 (EPSG:4326), longitude and latitude in degrees.
+pub const WGS84_GEOGRAPHIC: &str = "+proj=longlat +ellps=WGS84 +datum=WGS84 +no_defs";
+
+/// The CRS control coordinates are given in (the header of a GCP list): geographic longitude and
+/// latitude in degrees, or a projected grid in metres.
+// One value per control list, never stored in bulk: the size difference costs nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone)]
+pub enum SourceCrs {
+    /// Longitude (x) and latitude (y) in degrees on the datum of `definition` (PROJ's
+    /// `+proj=longlat` axis order, which is also OpenDroneMap's and OpenSfM's for `WGS84`).
+    Geographic {
+        /// The PROJ.4 definition.
+        definition: String,
+        /// The parsed definition (boxed: it is the larger variant's bulk).
+        proj: Box<Proj>,
+    },
+    /// Easting and northing in metres.
+    Projected(ProjectedCrs),
+}
+
+impl SourceCrs {
+    /// The CRS a GCP-list header names: `WGS84`, `WGS 84` or `EPSG:4326` (geographic WGS 84),
+    /// OpenDroneMap's `WGS84 UTM 32N` / `WGS84 UTM 32S`, a PROJ.4 string (`+proj=longlat …` is
+    /// geographic, any other projected) or one of the EPSG codes [`ProjectedCrs::from_name`]
+    /// knows. Case and surrounding blanks are ignored.
+    ///
+    /// # Errors
+    /// [`GeoError::UnknownName`], [`GeoError::InvalidDefinition`] or
+    /// [`GeoError::UtmZoneOutOfRange`] for a header that names no CRS `proj4rs` can use.
+    pub fn from_header(header: &str) -> Result<Self, GeoError> {
+        let trimmed = header.trim();
+        let upper = trimmed.to_ascii_uppercase();
+        let compact: String = upper.split_whitespace().collect();
+        if compact == "WGS84" || compact == "EPSG:4326" {
+            return Self::geographic(WGS84_GEOGRAPHIC);
+        }
+        if let Some(zone) = compact.strip_prefix("WGS84UTM") {
+            let unknown = || GeoError::UnknownName {
+                name: header.to_owned(),
+            };
+            let (digits, hemisphere) = match zone.chars().last() {
+                Some('N') => (&zone[..zone.len() - 1], Hemisphere::North),
+                Some('S') => (&zone[..zone.len() - 1], Hemisphere::South),
+                _ => return Err(unknown()),
+            };
+            let zone: u8 = digits.parse().map_err(|_| unknown())?;
+            return ProjectedCrs::utm(zone, hemisphere).map(Self::Projected);
+        }
+        if trimmed.starts_with('+') {
+            let proj =
+                Proj::from_proj_string(trimmed).map_err(|e| GeoError::InvalidDefinition {
+                    definition: trimmed.to_owned(),
+                    message: e.to_string(),
+                })?;
+            if proj.is_latlong() {
+                return Ok(Self::Geographic {
+                    definition: trimmed.to_owned(),
+                    proj: Box::new(proj),
+                });
+            }
+        }
+        ProjectedCrs::from_name(trimmed).map(Self::Projected)
+    }
+
+    fn geographic(definition: &str) -> Result<Self, GeoError> {
+        let proj = Proj::from_proj_string(definition).map_err(|e| GeoError::InvalidDefinition {
+            definition: definition.to_owned(),
+            message: e.to_string(),
+        })?;
+        Ok(Self::Geographic {
+            definition: definition.to_owned(),
+            proj: Box::new(proj),
+        })
+    }
+
+    /// Whether coordinates are longitude/latitude in degrees.
+    #[must_use]
+    pub fn is_geographic(&self) -> bool {
+        matches!(self, Self::Geographic { .. })
+    }
+
+    /// The PROJ.4 definition.
+    #[must_use]
+    pub fn definition(&self) -> &str {
+        match self {
+            Self::Geographic { definition, .. } => definition,
+            Self::Projected(p) => p.definition(),
+        }
+    }
+
+    /// A point `(x, y)` of this CRS (longitude, latitude in degrees, or easting, northing in
+    /// metres) in `target`'s easting and northing (metres). Heights are not touched.
+    ///
+    /// # Errors
+    /// [`GeoError::Conversion`] when the point cannot be converted.
+    pub fn to_projected(
+        &self,
+        x: f64,
+        y: f64,
+        target: &ProjectedCrs,
+    ) -> Result<(f64, f64), GeoError> {
+        let fail = |message: String| GeoError::Conversion { x, y, message };
+        let (source, mut point) = match self {
+            Self::Geographic { proj, .. } => {
+                if !(-90.0..=90.0).contains(&y) || !x.is_finite() {
+                    return Err(fail("latitude or longitude out of range".to_owned()));
+                }
+                (&**proj, (x.to_radians(), y.to_radians(), 0.0))
+            }
+            Self::Projected(p) if p.definition() == target.definition() => return Ok((x, y)),
+            Self::Projected(p) => (&p.projected, (x, y, 0.0)),
+        };
+        proj4rs::transform::transform(source, &target.projected, &mut point)
+            .map_err(|e| fail(e.to_string()))?;
+        if point.0.is_finite() && point.1.is_finite() {
+            Ok((point.0, point.1))
+        } else {
+            Err(fail("result is not finite".to_owned()))
+        }
+    }
+
+    /// WGS 84 latitude and longitude (degrees) of a point of this CRS.
+    ///
+    /// # Errors
+    /// [`GeoError::Conversion`] when the point cannot be converted.
+    pub fn to_lat_lon_deg(&self, x: f64, y: f64) -> Result<(f64, f64), GeoError> {
+        match self {
+            Self::Projected(p) => p.to_lat_lon_deg(x, y),
+            Self::Geographic { proj, .. } => {
+                let wgs84 = Proj::from_proj_string(WGS84_GEOGRAPHIC).map_err(|e| {
+                    GeoError::InvalidDefinition {
+                        definition: WGS84_GEOGRAPHIC.to_owned(),
+                        message: e.to_string(),
+                    }
+                })?;
+                let mut point = (x.to_radians(), y.to_radians(), 0.0);
+                proj4rs::transform::transform(proj, &wgs84, &mut point).map_err(|e| {
+                    GeoError::Conversion {
+                        x,
+                        y,
+                        message: e.to_string(),
+                    }
+                })?;
+                Ok((point.1.to_degrees(), point.0.to_degrees()))
+            }
+        }
+    }
+}
+
+/// The standard UTM zone (1…60, 6° wide from 180°W) and hemisphere of a WGS 84 position. The
+/// Norway and Svalbard exceptions of the military grid are not applied.
+///
+/// # Errors
+/// [`GeoError::Conversion`] for a latitude outside ±90° or a non-finite longitude.
+pub fn utm_zone_of(latitude_deg: f64, longitude_deg: f64) -> Result<(u8, Hemisphere), GeoError> {
+    if !(-90.0..=90.0).contains(&latitude_deg) || !longitude_deg.is_finite() {
+        return Err(GeoError::Conversion {
+            x: latitude_deg,
+            y: longitude_deg,
+            message: "latitude or longitude out of range".to_owned(),
+        });
+    }
+    let lon = (longitude_deg + 180.0).rem_euclid(360.0);
+    // 0 ≤ lon < 360, so the quotient is 0…59 (360 itself wraps to 0).
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let zone = ((lon / 6.0).floor() as u8).min(59) + 1;
+    let hemisphere = if latitude_deg >= 0.0 {
+        Hemisphere::North
+    } else {
+        Hemisphere::South
+    };
+    Ok((zone, hemisphere))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -354,5 +535,79 @@ mod tests {
         assert!(ProjectedCrs::from_proj_string("+proj=nonsense").is_err());
         let zone = ProjectedCrs::utm(32, Hemisphere::North).expect("valid");
         assert!(zone.from_lat_lon_deg(95.0, 8.0).is_err());
+    }
+
+    #[test]
+    fn gcp_list_headers() {
+        for wgs in [
+            "WGS84",
+            " wgs 84 ",
+            "EPSG:4326",
+            "+proj=longlat +datum=WGS84 +no_defs",
+        ] {
+            assert!(
+                SourceCrs::from_header(wgs).expect(wgs).is_geographic(),
+                "{wgs}"
+            );
+        }
+        let odm = SourceCrs::from_header("WGS84 UTM 32N").expect("ODM form");
+        assert!(!odm.is_geographic());
+        let zone32 = ProjectedCrs::utm(32, Hemisphere::North).expect("valid");
+        assert_eq!(odm.definition(), zone32.definition());
+        let south = SourceCrs::from_header("WGS84 UTM 17S").expect("ODM form");
+        assert!(south.definition().contains("+south"));
+        assert!(SourceCrs::from_header("EPSG:2056").is_ok());
+        assert!(SourceCrs::from_header("+proj=utm +zone=11 +datum=WGS84").is_ok());
+        assert!(matches!(
+            SourceCrs::from_header("NAD83 / State Plane"),
+            Err(GeoError::UnknownName { .. })
+        ));
+        assert!(SourceCrs::from_header("WGS84 UTM 61N").is_err());
+        assert!(SourceCrs::from_header("WGS84 UTM 32X").is_err());
+        assert!(SourceCrs::from_header("+proj=nonsense").is_err());
+    }
+
+    #[test]
+    fn geographic_to_utm_matches_the_projected_crs_itself() {
+        // 45°N on zone 31's central meridian: the closed form of `utm_on_the_central_meridian`.
+        let wgs = SourceCrs::from_header("WGS84").expect("valid");
+        let zone31 = ProjectedCrs::utm(31, Hemisphere::North).expect("valid");
+        let (e, n) = wgs.to_projected(3.0, 45.0, &zone31).expect("converts");
+        assert!((e - 500_000.0).abs() < UTM_TOL_M);
+        assert!((n - 0.9996 * 4_984_944.378).abs() < 0.01, "{n}");
+        // Projected to projected: zone 31 → zone 32 agrees with going through lat/lon.
+        let source = SourceCrs::Projected(zone31.clone());
+        let zone32 = ProjectedCrs::utm(32, Hemisphere::North).expect("valid");
+        let (e32, n32) = source.to_projected(e, n, &zone32).expect("converts");
+        let (e_ref, n_ref) = zone32.from_lat_lon_deg(45.0, 3.0).expect("converts");
+        assert!((e32 - e_ref).abs() < UTM_TOL_M && (n32 - n_ref).abs() < UTM_TOL_M);
+        // Same CRS: identity.
+        assert_eq!(source.to_projected(e, n, &zone31).expect("same"), (e, n));
+        let (lat, lon) = wgs.to_lat_lon_deg(3.0, 45.0).expect("converts");
+        assert!((lat - 45.0).abs() < 1e-12 && (lon - 3.0).abs() < 1e-12);
+        assert!(wgs.to_projected(3.0, 95.0, &zone31).is_err());
+    }
+
+    #[test]
+    fn utm_zones() {
+        assert_eq!(
+            utm_zone_of(52.5, 13.4).expect("ok"),
+            (33, Hemisphere::North)
+        );
+        assert_eq!(
+            utm_zone_of(-33.9, 18.4).expect("ok"),
+            (34, Hemisphere::South)
+        );
+        assert_eq!(
+            utm_zone_of(0.0, -180.0).expect("ok"),
+            (1, Hemisphere::North)
+        );
+        assert_eq!(
+            utm_zone_of(0.0, 179.999).expect("ok"),
+            (60, Hemisphere::North)
+        );
+        assert_eq!(utm_zone_of(0.0, 180.0).expect("ok"), (1, Hemisphere::North));
+        assert_eq!(utm_zone_of(47.0, 9.0).expect("ok"), (32, Hemisphere::North));
+        assert!(utm_zone_of(91.0, 0.0).is_err());
     }
 }

@@ -168,3 +168,67 @@ fn help_states_the_pixel_convention() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("centre of the top-left pixel"), "{text}");
 }
+
+#[test]
+fn resect_reprojects_a_wgs84_gcp_list() {
+    // The courtyard's LV95 control points written as a WGS 84 gcp_list.txt (lon lat height).
+    let doc = photomontage::site::SiteDocument::load(&courtyard()).unwrap();
+    let lv95 = photomontage::geo::ProjectedCrs::from_name("EPSG:2056").unwrap();
+    let mut text = String::from("WGS84\n");
+    for o in doc.site.observations.iter().filter(|o| o.photo == "P3") {
+        if let Some(c) = doc.site.control_points.iter().find(|c| c.id == o.point) {
+            let (lat, lon) = lv95.to_lat_lon_deg(c.xyz[0], c.xyz[1]).unwrap();
+            text += &format!(
+                "{lon:.12} {lat:.12} {} {} {} P3.jpg {}\n",
+                c.xyz[2], o.x_px, o.y_px, c.id
+            );
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let list = dir.path().join("gcp_list.txt");
+    std::fs::write(&list, text).unwrap();
+    let args = [
+        "--image",
+        "P3.jpg",
+        "--image-size",
+        "1600",
+        "1200",
+        "--focal-px",
+        "1500",
+        "--json",
+    ];
+    // Back into LV95 with --crs: the pose of `resect_csv_reports_pose_and_residuals`.
+    let v = json_of(
+        bin()
+            .arg("resect")
+            .arg(&list)
+            .args(args)
+            .args(["--crs", "EPSG:2056"]),
+    );
+    let c = v["camera_center"].as_array().unwrap();
+    let truth = [2_683_020.0, 1_246_966.0, 410.0];
+    for axis in 0..3 {
+        assert!(
+            (c[axis].as_f64().unwrap() - truth[axis]).abs() < 1.0,
+            "{c:?}"
+        );
+    }
+    let note = v["control_crs"].as_str().unwrap();
+    assert!(note.contains("somerc") && note.contains("--crs"), "{note}");
+    // Without --crs: the UTM zone of the centroid (Zurich area: 32N), stated.
+    let v = json_of(bin().arg("resect").arg(&list).args(args));
+    let note = v["control_crs"].as_str().unwrap();
+    assert!(
+        note.contains("+zone=32") && note.contains("centroid"),
+        "{note}"
+    );
+    // A header proj4rs cannot use is named with its line.
+    std::fs::write(&list, "Gauss-Krüger 4\n1 2 3 4 5 P3.jpg\n").unwrap();
+    let out = bin().arg("resect").arg(&list).args(args).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("line 1") && err.contains("Gauss-Krüger 4"),
+        "{err}"
+    );
+}

@@ -136,3 +136,118 @@ fn image_free_png(path: &std::path::Path) {
     ];
     std::fs::write(path, PNG_1X1).unwrap();
 }
+
+/// What one file of `data/real/exif` must give.
+enum Expect {
+    /// A focal length in pixels, from this source, `focal_mm × long side px / width`.
+    Px(FocalSource, f64),
+    /// An error naming this tag.
+    Missing(&'static str),
+}
+
+/// Diagonal of the 36 × 24 mm frame.
+const DIAGONAL_35MM_MM: f64 = 43.266_615_305_567_87;
+
+/// Same arithmetic on the same inputs; only the rounding of the spec values below (their
+/// stated digits) separates them.
+const FOCAL_TABLE_REL_TOL: f64 = 1e-3;
+
+#[test]
+fn every_sample_gives_a_focal_length_or_names_the_missing_tag() {
+    use Expect::{Missing, Px};
+    use FocalSource::{Equivalent35mm, FocalPlaneResolution, SensorTable};
+    // Focal lengths (mm) from SOURCES.md (exiftool); sensor widths (mm) from the spec sheets
+    // as in `photo::sensor_table`; long sides as stored. A stated 35 mm equivalent comes before
+    // the table (image diagonal over 43.27 mm); the Samsung's model `<Digimax i50 MP3, Samsung
+    // #1 MP3>` and `NIKON CORPORATION` also match the table (`photo::sensor_table`'s tests),
+    // but their 35 mm tag wins.
+    let table: [(&str, Expect); 15] = [
+        ("Canon_40D.jpg", Px(SensorTable, 135.0 * 100.0 / 22.2)),
+        // 8114.29 px/inch on the 2272-px original, rescaled to 480 px.
+        (
+            "Canon_PowerShot_S40.jpg",
+            Px(
+                FocalPlaneResolution,
+                21.3125 * 8114.29 / 25.4 * 480.0 / 2272.0,
+            ),
+        ),
+        (
+            "DSCN0010.jpg",
+            Px(Equivalent35mm, 112.0 * 800.0 / DIAGONAL_35MM_MM),
+        ),
+        // FocalPlaneResolutionUnit cm, but PixelXDimension was rewritten to the 100-px copy:
+        // the implied 0.25 mm sensor is refused and the table used.
+        (
+            "Fujifilm_FinePix_E500.jpg",
+            Px(SensorTable, 4.7 * 100.0 / 5.76),
+        ),
+        (
+            "Kodak_CX7530.jpg",
+            Px(
+                Equivalent35mm,
+                102.0 * 100.0f64.hypot(78.0) / DIAGONAL_35MM_MM,
+            ),
+        ),
+        (
+            "Nikon_D70.jpg",
+            Px(
+                Equivalent35mm,
+                150.0 * 100.0f64.hypot(66.0) / DIAGONAL_35MM_MM,
+            ),
+        ),
+        ("Olympus_C8080WZ.jpg", Px(SensorTable, 15.8 * 100.0 / 8.8)),
+        (
+            "Panasonic_DMC-FZ30.jpg",
+            Px(Equivalent35mm, 82.0 * 125.0 / DIAGONAL_35MM_MM),
+        ),
+        // Make `PENTAX Corporation`, model `PENTAX K10D`: the case of issue 15.
+        ("Pentax_K10D.jpg", Px(SensorTable, 90.0 * 100.0 / 23.5)),
+        // Model `<Digimax i50 MP3, Samsung #1 MP3>`.
+        (
+            "Samsung_Digimax_i50_MP3.jpg",
+            Px(Equivalent35mm, 39.0 * 125.0 / DIAGONAL_35MM_MM),
+        ),
+        // 8427.98 px/inch, 57.02 mm, 2048 px.
+        (
+            "canon_hdr_NO.jpg",
+            Px(FocalPlaneResolution, 57.019 * 8427.98 / 25.4),
+        ),
+        ("landscape_3.jpg", Missing("FocalLength (tag 0x920A)")),
+        ("landscape_6.jpg", Missing("FocalLength (tag 0x920A)")),
+        ("nikon-e950.jpg", Px(SensorTable, 12.8 * 800.0 / 6.4)),
+        ("portrait_6.jpg", Missing("FocalLength (tag 0x920A)")),
+    ];
+    let Some(dir) = shared_file("data/real/exif") else {
+        return;
+    };
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".jpg"))
+        .collect();
+    on_disk.sort();
+    let mut listed: Vec<String> = table.iter().map(|(n, _)| (*n).to_owned()).collect();
+    listed.sort();
+    assert_eq!(on_disk, listed, "the table covers every file");
+    for (name, expect) in &table {
+        let path = dir.join(name);
+        let exif = photo::read_exif(&path).unwrap();
+        let got = photo::focal_px_from_exif(&exif, photo::size_px(&path).unwrap());
+        match (expect, got) {
+            (Px(source, px), Ok(est)) => {
+                assert_eq!(est.source, *source, "{name}");
+                assert!(
+                    (est.focal_px - px).abs() / px < FOCAL_TABLE_REL_TOL,
+                    "{name}: {} px vs {px} px",
+                    est.focal_px
+                );
+                assert!(exif.focal_35mm_equiv_mm().is_some(), "{name}");
+            }
+            (Missing(tag), Err(e)) => {
+                assert!(e.to_string().contains(tag), "{name}: {e}");
+                assert!(exif.focal_35mm_equiv_mm().is_none(), "{name}");
+            }
+            (_, got) => panic!("{name}: {got:?}"),
+        }
+    }
+}

@@ -5,12 +5,16 @@
 //! The initial focal length in pixels is taken, in order of trust, from
 //! 1. the focal-plane resolution (pixels per unit on the sensor), rescaled when the stored image
 //!    is smaller than the size EXIF describes;
-//! 2. a sensor-width table for known camera models;
-//! 3. the 35 mm equivalent focal length (diagonal of 43.27 mm).
+//! 2. the 35 mm equivalent focal length the camera states (diagonal of 43.27 mm), which
+//!    accounts for crop modes and digital zoom;
+//! 3. a sensor-width table for known camera models ([`super::sensor_table`], make and model
+//!    matched robustly), for bodies that state neither.
+//!
+//! When none applies, [`focal_px_from_exif`] says exactly which tags are missing.
 //!
 //! # Known limitations
 //! Maker notes are not read, so lenses that report no focal length give no estimate; the sensor
-//! table holds only a few common bodies.
+//! table holds only the sample data's bodies and a few common ones.
 
 use exif::{In, Tag, Value};
 use serde::Serialize;
@@ -20,18 +24,6 @@ use super::PhotoError;
 
 /// Diagonal of the 36 × 24 mm frame that "35 mm equivalent" focal lengths refer to.
 pub const FULL_FRAME_DIAGONAL_MM: f64 = 43.266_615_305_567_87;
-
-/// Sensor sizes (width × height, mm) of camera bodies whose EXIF lacks a usable focal-plane
-/// resolution. Sources: the manufacturers' specification sheets.
-const SENSOR_SIZES_MM: &[(&str, &str, f64, f64)] = &[
-    ("canon", "canon eos 450d", 22.2, 14.8),
-    ("canon", "canon eos 40d", 22.2, 14.8),
-    ("canon", "canon eos 5d mark ii", 36.0, 24.0),
-    ("nikon", "nikon d70", 23.7, 15.6),
-    ("nikon", "nikon d700", 36.0, 23.9),
-    ("pentax", "pentax k10d", 23.5, 15.7),
-    ("sony", "ilce-7m3", 35.6, 23.8),
-];
 
 /// GPS position from EXIF (WGS 84 unless `GPSMapDatum` says otherwise).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -200,6 +192,99 @@ pub fn read_exif(path: &Path) -> Result<ExifInfo, PhotoError> {
     })
 }
 
+/// Why EXIF gives no focal length in pixels, naming the missing tags (Exif 2.3 tag numbers).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FocalMissing {
+    /// Neither focal-length tag is present.
+    #[error("EXIF has no FocalLength (tag 0x920A) and no FocalLengthIn35mmFilm (tag 0xA405)")]
+    NoFocalLength,
+    /// The focal length in mm is given but nothing converts it to pixels.
+    #[error(
+        "EXIF gives FocalLength {focal_mm} mm but no sensor size: {focal_plane}, camera {camera} \
+         is not in the sensor table, and FocalLengthIn35mmFilm (tag 0xA405) is absent"
+    )]
+    NoSensorSize {
+        /// FocalLength as given.
+        focal_mm: f64,
+        /// What is wrong with FocalPlaneXResolution.
+        focal_plane: String,
+        /// `make model` as EXIF writes them, or "(no Make/Model)".
+        camera: String,
+    },
+}
+
+/// Sensor width range (mm) a focal-plane resolution must imply to be believed: from the
+/// smallest phone sensors to medium format.
+const PLAUSIBLE_SENSOR_WIDTH_MM: std::ops::RangeInclusive<f64> = 2.0..=60.0;
+
+impl ExifInfo {
+    /// Sensor width and height (mm, as stored): from the focal-plane resolution and the image
+    /// size EXIF states when that is plausible, else from the sensor table.
+    #[must_use]
+    pub fn sensor_size_mm(&self) -> Option<[f64; 2]> {
+        if let (Some(res), Some([w, h])) = (self.focal_plane_px_per_mm, self.exif_image_size_px) {
+            let size = [f64::from(w) / res[0], f64::from(h) / res[1]];
+            if PLAUSIBLE_SENSOR_WIDTH_MM.contains(&size[0].max(size[1])) {
+                return Some(size);
+            }
+        }
+        super::sensor_table::sensor_size_mm(self.make.as_deref(), self.model.as_deref())
+    }
+
+    /// The 35 mm-equivalent focal length (mm): EXIF's FocalLengthIn35mmFilm when given, else
+    /// FocalLength × 43.27 mm / sensor diagonal (the diagonal convention of
+    /// [`FULL_FRAME_DIAGONAL_MM`]).
+    #[must_use]
+    pub fn focal_35mm_equiv_mm(&self) -> Option<f64> {
+        if let Some(f35) = self.focal_length_35mm {
+            return Some(f35);
+        }
+        let f_mm = self.focal_length_mm?;
+        let [w, h] = self.sensor_size_mm()?;
+        Some(f_mm * FULL_FRAME_DIAGONAL_MM / w.hypot(h))
+    }
+}
+
+/// The focal length in pixels for a photo of `image_size_px` (as displayed), as
+/// [`initial_focal_px`] finds it.
+///
+/// # Errors
+/// [`FocalMissing`] naming the missing EXIF tags.
+pub fn focal_px_from_exif(
+    exif: &ExifInfo,
+    image_size_px: [u32; 2],
+) -> Result<FocalEstimate, FocalMissing> {
+    if let Some(estimate) = initial_focal_px(exif, image_size_px) {
+        return Ok(estimate);
+    }
+    let Some(focal_mm) = exif.focal_length_mm else {
+        return Err(FocalMissing::NoFocalLength);
+    };
+    let focal_plane = match (exif.focal_plane_px_per_mm, exif.exif_image_size_px) {
+        (None, _) => "FocalPlaneXResolution (tag 0xA20E) is absent".to_owned(),
+        (Some(res), size) => {
+            let long = size.map_or(image_size_px[0].max(image_size_px[1]), |[w, h]| w.max(h));
+            format!(
+                "FocalPlaneXResolution {:.1} px/mm implies a {:.2} mm wide sensor for {long} px{}",
+                res[0],
+                f64::from(long) / res[0],
+                if size.is_none() {
+                    " (PixelXDimension, tag 0xA002, is absent, so the image may be a downscaled copy)"
+                } else {
+                    ""
+                }
+            )
+        }
+    };
+    Err(FocalMissing::NoSensorSize {
+        focal_mm,
+        focal_plane,
+        camera: exif
+            .camera_name()
+            .map_or_else(|| "(no Make/Model)".to_owned(), |c| format!("`{c}`")),
+    })
+}
+
 /// Where an initial focal length came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -229,25 +314,29 @@ pub fn initial_focal_px(exif: &ExifInfo, image_size_px: [u32; 2]) -> Option<Foca
             .map_or(1.0, |[w, h]| long_side / f64::from(w.max(h)));
         // Plausibility: the implied sensor must be 2–60 mm wide, else the tag is bogus.
         let sensor_mm = long_side / (res[0] * scale);
-        if (2.0..=60.0).contains(&sensor_mm) {
+        if PLAUSIBLE_SENSOR_WIDTH_MM.contains(&sensor_mm) {
             return Some(FocalEstimate {
                 focal_px: f_mm * res[0] * scale,
                 source: FocalSource::FocalPlaneResolution,
             });
         }
     }
-    if let (Some(f_mm), Some(model)) = (exif.focal_length_mm, exif.camera_name()) {
-        let name = model.to_lowercase();
-        if let Some(&(_, _, width_mm, _)) = SENSOR_SIZES_MM.iter().find(|(_, m, _, _)| name == *m) {
-            return Some(FocalEstimate {
-                focal_px: f_mm * long_side / width_mm,
-                source: FocalSource::SensorTable,
-            });
-        }
+    // The camera's own 35 mm statement before the nominal sensor table: it accounts for crop
+    // modes and digital zoom (the Panasonic FZ30 sample's tag is 17 % longer than its
+    // FocalLength on the full nominal sensor).
+    if let Some(f35) = exif.focal_length_35mm {
+        return Some(FocalEstimate {
+            focal_px: f35 * long_side.hypot(short_side) / FULL_FRAME_DIAGONAL_MM,
+            source: FocalSource::Equivalent35mm,
+        });
     }
-    exif.focal_length_35mm.map(|f35| FocalEstimate {
-        focal_px: f35 * long_side.hypot(short_side) / FULL_FRAME_DIAGONAL_MM,
-        source: FocalSource::Equivalent35mm,
+    let (f_mm, [w_mm, h_mm]) = (
+        exif.focal_length_mm?,
+        super::sensor_table::sensor_size_mm(exif.make.as_deref(), exif.model.as_deref())?,
+    );
+    Some(FocalEstimate {
+        focal_px: f_mm * long_side / w_mm.max(h_mm),
+        source: FocalSource::SensorTable,
     })
 }
 
@@ -301,5 +390,54 @@ mod tests {
             exif.taken_at_rfc3339().as_deref(),
             Some("2008-05-30T15:56:01+02:00")
         );
+    }
+
+    #[test]
+    fn missing_tags_are_named() {
+        assert_eq!(
+            focal_px_from_exif(&ExifInfo::default(), [100, 100]),
+            Err(FocalMissing::NoFocalLength)
+        );
+        let unknown = ExifInfo {
+            make: Some("ACME".into()),
+            model: Some("Cam 1".into()),
+            focal_length_mm: Some(7.0),
+            ..ExifInfo::default()
+        };
+        let e = focal_px_from_exif(&unknown, [100, 100])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("FocalPlaneXResolution (tag 0xA20E) is absent"),
+            "{e}"
+        );
+        assert!(e.contains("`ACME Cam 1`") && e.contains("0xA405"), "{e}");
+        // A focal-plane resolution implying a 0.25 mm sensor is named with its numbers.
+        let bogus = ExifInfo {
+            focal_plane_px_per_mm: Some([400.0, 400.0]),
+            ..unknown
+        };
+        let e = focal_px_from_exif(&bogus, [100, 60])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("0.25 mm wide sensor") && e.contains("0xA002"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn equivalent_35mm_from_the_sensor_diagonal() {
+        // 50 mm on a 36 × 24 mm sensor is 50 mm equivalent; the tag wins when present.
+        let mut exif = ExifInfo {
+            focal_length_mm: Some(50.0),
+            focal_plane_px_per_mm: Some([100.0, 100.0]),
+            exif_image_size_px: Some([3600, 2400]),
+            ..ExifInfo::default()
+        };
+        let eq = exif.focal_35mm_equiv_mm().unwrap();
+        assert!((eq - 50.0).abs() < 1e-9, "{eq}");
+        exif.focal_length_35mm = Some(52.0);
+        assert_eq!(exif.focal_35mm_equiv_mm(), Some(52.0));
     }
 }

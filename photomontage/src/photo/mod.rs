@@ -9,8 +9,12 @@
 //! from JPEG, TIFF and PNG containers (kamadak-exif); HEIC is not supported.
 
 pub mod exif;
+pub mod sensor_table;
 
-pub use exif::{ExifInfo, FocalEstimate, FocalSource, initial_focal_px, read_exif};
+pub use exif::{
+    ExifInfo, FocalEstimate, FocalMissing, FocalSource, focal_px_from_exif, initial_focal_px,
+    read_exif,
+};
 
 use image::{DynamicImage, ImageDecoder, ImageReader, Rgb32FImage};
 use std::path::{Path, PathBuf};

@@ -7,7 +7,7 @@
 //! All three report the 1-based line of any error, never panic, and cap the number of rows.
 //!
 //! # Known limitations
-//! The CRS header is kept as text; no reprojection is done. ODM pixel coordinates are taken as
+//! The CRS header is parsed and the list reprojected in [`super::control_crs`]. ODM pixel coordinates are taken as
 //! given (ODM uses the same top-left-pixel-centre convention as ours to within its own
 //! rounding). Rows without a gcp name get an id made from their coordinates, so rows with
 //! identical coordinates are one point, as in ODM.
@@ -40,6 +40,22 @@ pub enum ControlIoError {
         "line {line}: {reason}; an OpenDroneMap GCP list starts with a line naming the coordinate system (e.g. EPSG:32632)"
     )]
     NotOdmHeader { line: usize, reason: String },
+    #[error(
+        "line {line}: the coordinate system `{header}` cannot be used: {source} (give WGS84, EPSG:4326, `WGS84 UTM 32N`, a supported EPSG code or a PROJ.4 string)"
+    )]
+    Crs {
+        line: usize,
+        header: String,
+        source: crate::geo::GeoError,
+    },
+    #[error("line {line}: cannot reproject ({x}, {y}) into {target}: {source}")]
+    Reprojection {
+        line: usize,
+        x: f64,
+        y: f64,
+        target: String,
+        source: crate::geo::GeoError,
+    },
 }
 
 /// Refuses a first line that cannot be an ODM CRS header: a GCP row (the header was left out,
@@ -86,6 +102,8 @@ pub struct OdmGcpRow {
 pub struct OdmGcpList {
     /// The header line (proj string, `EPSG:…` or `WGS84 UTM 17N`), trimmed.
     pub crs: String,
+    /// 1-based line of the header.
+    pub crs_line: usize,
     pub rows: Vec<OdmGcpRow>,
 }
 
@@ -155,6 +173,7 @@ pub fn parse_odm_gcp_list(text: &str) -> Result<OdmGcpList, ControlIoError> {
     }
     Ok(OdmGcpList {
         crs: header.trim().to_owned(),
+        crs_line: header_index + 1,
         rows,
     })
 }

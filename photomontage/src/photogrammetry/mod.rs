@@ -46,6 +46,7 @@
 //! which is returned (see [`resection`]).
 
 pub mod bundle;
+pub mod control_crs;
 pub mod control_io;
 pub mod illumination;
 pub mod intersection;

@@ -23,6 +23,9 @@ pub struct PhotoRecord<'a> {
     pub warnings: &'a [String],
     pub residuals: &'a [ObservationResidual],
     pub solved_by: &'a str,
+    /// How the control coordinates reached the CRS of `camera_center` (reprojected lists only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub control_crs: Option<String>,
 }
 
 pub fn rotation_rows(camera: &Camera) -> [[f64; 3]; 3] {
@@ -40,6 +43,9 @@ pub fn print_photo(r: &PhotoRecord<'_>) {
         "photo {}  ({}; redundancy {})",
         r.id, r.solved_by, r.redundancy
     );
+    if let Some(crs) = &r.control_crs {
+        println!("  control    {crs}");
+    }
     println!(
         "  centre     X {:.4}  Y {:.4}  Z {:.4}   σ {:.4} {:.4} {:.4} m",
         r.camera_center[0],

@@ -3,6 +3,7 @@
 use crate::report::{PhotoRecord, print_photo, rotation_rows};
 use anyhow::{Context, bail};
 use photomontage::camera::Intrinsics;
+use photomontage::geo::ProjectedCrs;
 use photomontage::photo;
 use photomontage::photogrammetry::control_io::{parse_odm_gcp_list, parse_points_csv};
 use photomontage::photogrammetry::{ResectionOptions, SelfCalibration, resect};
@@ -37,6 +38,11 @@ pub struct Args {
     /// Seed of the robust start.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Projected CRS to solve in when the GCP list's header names another one (WGS84,
+    /// EPSG:4326, a PROJ.4 string, an EPSG code): `EPSG:326NN`, `EPSG:2056`, a PROJ.4 string…
+    /// Default: the list's own CRS when projected, else the UTM zone of the points' centroid.
+    #[arg(long)]
+    crs: Option<String>,
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
@@ -47,13 +53,34 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .with_context(|| format!("reading {}", args.points.display()))?;
     let first_line = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
     let looks_odm = !first_line.contains(',');
+    let target = args
+        .crs
+        .as_deref()
+        .map(ProjectedCrs::from_name)
+        .transpose()
+        .context("--crs")?;
+    let mut control_crs = None;
     let (control, observations, photo_id) = if looks_odm {
-        let list = parse_odm_gcp_list(&text).with_context(|| {
+        let context = || {
             format!(
                 "reading {} as an OpenDroneMap GCP list",
                 args.points.display()
             )
-        })?;
+        };
+        let source = parse_odm_gcp_list(&text).with_context(context)?;
+        let (list, crs) = source.reprojected(target.as_ref()).with_context(context)?;
+        if list.crs != source.crs {
+            control_crs = Some(format!(
+                "reprojected from `{}` to `{}` ({}); heights as given (datum of the list, no geoid model)",
+                source.crs,
+                crs.definition(),
+                if target.is_some() {
+                    "--crs"
+                } else {
+                    "UTM zone of the points' centroid"
+                }
+            ));
+        }
         let Some(image) = args.image.clone() else {
             bail!(
                 "{} is a GCP list for several images: choose one with --image (one of: {})",
@@ -71,6 +98,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         (list.control_points(DEFAULT_CONTROL_SIGMA_M)?, obs, image)
     } else {
+        if target.is_some() {
+            bail!("--crs applies to a gcp_list.txt whose header names its CRS; a CSV has none");
+        }
         let csv = parse_points_csv(&text)
             .with_context(|| format!("reading {} as CSV", args.points.display()))?;
         let (c, o) = csv.split(DEFAULT_CONTROL_SIGMA_M, args.sigma_px);
@@ -107,10 +137,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     p.display()
                 )
             })?;
-            photo::initial_focal_px(&exif, size)
+            photo::focal_px_from_exif(&exif, size)
                 .with_context(|| {
                     format!(
-                        "no --focal-px given and {} has no focal length in EXIF",
+                        "no --focal-px given and {} gives no focal length in pixels",
                         p.display()
                     )
                 })?
@@ -150,6 +180,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         warnings: &r.warnings,
         residuals: &r.residuals,
         solved_by: "resection",
+        control_crs,
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&record)?);

@@ -64,6 +64,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 outliers: &s.outliers,
                 warnings: &s.warnings,
                 residuals: &s.residuals,
+                control_crs: None,
                 solved_by: s.solved_by,
             }
         })
