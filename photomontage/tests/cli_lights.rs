@@ -8,8 +8,9 @@
 //! beyond the 60° cut-off is the photo bit for bit.
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
+mod common;
+
 use std::f64::consts::PI;
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -222,7 +223,7 @@ fn ctrl_c_cancels_a_render_without_writing_a_file() {
     let photos = photo_toml("below", 0.0, 800.0, big, "big.png");
     std::fs::write(&site, site_toml("downlight.ies", &photos)).unwrap();
     let out = dir.path().join("big.exr");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_photomontage"))
+    let child = Command::new(env!("CARGO_BIN_EXE_photomontage"))
         .arg("render")
         .arg(&site)
         .args([
@@ -239,27 +240,7 @@ fn ctrl_c_cancels_a_render_without_writing_a_file() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
-    let mut seen = Vec::new();
-    for line in lines.by_ref() {
-        let line = line.unwrap();
-        let started = line.contains("Ctrl-C cancels");
-        seen.push(line);
-        if started {
-            break;
-        }
-    }
-    assert!(
-        seen.last().is_some_and(|l| l.contains("Ctrl-C cancels")),
-        "{seen:?}"
-    );
-    let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let rest: Vec<String> = lines.map(Result::unwrap).collect();
-    let status = child.wait().unwrap();
+    let (status, rest) = common::interrupt_once_started(child);
     assert!(!status.success(), "{rest:?}");
     assert!(rest.iter().any(|l| l.contains("cancelled")), "{rest:?}");
     assert!(!out.exists(), "a cancelled render wrote {}", out.display());

@@ -5,7 +5,6 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 
 fn photomontage(args: &[&std::ffi::OsStr]) -> std::process::Output {
@@ -103,7 +102,7 @@ fn ctrl_c_cancels_without_writing() {
     let site = common::make_site(dir.path());
     let ply = dir.path().join("mesh.ply");
     let csv = dir.path().join("convergence.csv");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_photomontage"))
+    let child = Command::new(env!("CARGO_BIN_EXE_photomontage"))
         .arg("radiosity")
         .arg(&site)
         .args([
@@ -120,27 +119,7 @@ fn ctrl_c_cancels_without_writing() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
-    let mut seen = Vec::new();
-    for line in lines.by_ref() {
-        let line = line.unwrap();
-        let started = line.contains("Ctrl-C cancels");
-        seen.push(line);
-        if started {
-            break;
-        }
-    }
-    assert!(
-        seen.last().is_some_and(|l| l.contains("Ctrl-C cancels")),
-        "{seen:?}"
-    );
-    let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let rest: Vec<String> = lines.map(Result::unwrap).collect();
-    let status = child.wait().unwrap();
+    let (status, rest) = common::interrupt_once_started(child);
     assert!(!status.success(), "{rest:?}");
     assert!(rest.iter().any(|l| l.contains("cancelled")), "{rest:?}");
     assert!(!ply.exists() && !csv.exists());

@@ -107,3 +107,32 @@ pub fn make_site_sized(dir: &Path, size_px: [u32; 2]) -> PathBuf {
     std::fs::write(&site, site_toml_sized("box.obj", 1.0, size_px)).unwrap();
     site
 }
+
+/// Waits until `child` (stderr piped) prints its "Ctrl-C cancels" line, sends it SIGINT, and
+/// returns its exit status with the stderr lines that came after the signal.
+pub fn interrupt_once_started(
+    mut child: std::process::Child,
+) -> (std::process::ExitStatus, Vec<String>) {
+    use std::io::{BufRead, BufReader};
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut seen = Vec::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        let started = line.contains("Ctrl-C cancels");
+        seen.push(line);
+        if started {
+            break;
+        }
+    }
+    assert!(
+        seen.last().is_some_and(|l| l.contains("Ctrl-C cancels")),
+        "{seen:?}"
+    );
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let rest: Vec<String> = lines.map(Result::unwrap).collect();
+    (child.wait().unwrap(), rest)
+}
