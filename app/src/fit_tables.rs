@@ -11,6 +11,7 @@ use photomontage::site::{FitSettings, SamplePurpose, Site};
 
 use crate::commands::Command;
 use crate::fit_commands::FitCommand;
+use crate::table_sort::{self, SortKey, SortState, sorted_rows};
 use crate::widgets::name_widget;
 
 /// Name of a sample purpose as the tables show it.
@@ -52,6 +53,17 @@ pub(crate) fn samples_table_ui(
         ui.label("none: click the photo to add one");
         return;
     }
+    let sort_id = egui::Id::unique("fit samples sort");
+    let mut sort = SortState::load(ui, sort_id);
+    let order = sorted_rows(&site.samples, sort, |s, column| match column {
+        0 => SortKey::Text(s.id.clone()),
+        1 => SortKey::Text(s.photo.clone()),
+        2 => SortKey::Text(s.material.clone()),
+        3 => SortKey::Number(s.x_px.unwrap_or(f64::NAN)),
+        4 => SortKey::Text(purpose_name(s.purpose).to_owned()),
+        5 => SortKey::Number(f64::from(s.window_px)),
+        _ => SortKey::Number(f64::from(u8::from(s.enabled))),
+    });
     TableBuilder::new(ui)
         .id_salt("fit samples")
         .striped(true)
@@ -65,16 +77,20 @@ pub(crate) fn samples_table_ui(
         .column(Column::remainder().at_least(30.0))
         .max_scroll_height(220.0)
         .header(20.0, |mut h| {
-            for t in [
-                "id", "photo", "material", "at", "purpose", "window", "on", "",
-            ] {
+            for (column, t) in ["id", "photo", "material", "at", "purpose", "window", "on"]
+                .into_iter()
+                .enumerate()
+            {
                 h.col(|ui| {
-                    ui.strong(t);
+                    if let Some(next) = table_sort::header(ui, "samples", sort, column, t) {
+                        sort = next;
+                    }
                 });
             }
+            h.col(|_| {});
         })
         .body(|mut body| {
-            for s in &site.samples {
+            for s in order.iter().map(|&i| &site.samples[i]) {
                 body.row(22.0, |mut row| {
                     row.col(|ui| {
                         ui.label(&s.id);
@@ -139,6 +155,7 @@ pub(crate) fn samples_table_ui(
                 });
             }
         });
+    sort.store(ui, sort_id);
 }
 
 fn put(sample: photomontage::site::Sample) -> Command {
@@ -154,6 +171,15 @@ pub(crate) fn horizons_table_ui(
         ui.label("none: Shift-drag a rectangle of sky at the horizon on the photo");
         return;
     }
+    let sort_id = egui::Id::unique("fit horizon samples sort");
+    let mut sort = SortState::load(ui, sort_id);
+    let order = sorted_rows(&site.horizon_samples, sort, |s, column| match column {
+        0 => SortKey::Text(s.id.clone()),
+        1 => SortKey::Text(s.photo.clone()),
+        2 => SortKey::Number(f64::from(s.origin_px[1]) * 1e6 + f64::from(s.origin_px[0])),
+        3 => SortKey::Number(f64::from(s.size_px[0]) * f64::from(s.size_px[1])),
+        _ => SortKey::Number(f64::from(u8::from(s.enabled))),
+    });
     TableBuilder::new(ui)
         .id_salt("fit horizon samples")
         .striped(true)
@@ -165,14 +191,20 @@ pub(crate) fn horizons_table_ui(
         .column(Column::remainder().at_least(30.0))
         .max_scroll_height(140.0)
         .header(20.0, |mut h| {
-            for t in ["id", "photo", "origin px", "size px", "on", ""] {
+            for (column, t) in ["id", "photo", "origin px", "size px", "on"]
+                .into_iter()
+                .enumerate()
+            {
                 h.col(|ui| {
-                    ui.strong(t);
+                    if let Some(next) = table_sort::header(ui, "horizon samples", sort, column, t) {
+                        sort = next;
+                    }
                 });
             }
+            h.col(|_| {});
         })
         .body(|mut body| {
-            for s in &site.horizon_samples {
+            for s in order.iter().map(|&i| &site.horizon_samples[i]) {
                 body.row(22.0, |mut row| {
                     row.col(|ui| {
                         ui.label(&s.id);
@@ -215,4 +247,5 @@ pub(crate) fn horizons_table_ui(
                 });
             }
         });
+    sort.store(ui, sort_id);
 }

@@ -46,6 +46,7 @@ pub mod new_site;
 pub mod panel;
 pub mod photo_settings;
 mod photo_view;
+pub mod placing;
 pub mod points;
 pub mod render_display;
 pub mod render_job;
@@ -55,6 +56,7 @@ pub mod scene_panel;
 pub mod scene_pick;
 pub mod solve;
 pub mod state;
+pub mod table_sort;
 pub mod viewport;
 pub mod widgets;
 pub mod window;
@@ -78,6 +80,7 @@ macro_rules! panel_context {
             doc: $s.doc.as_ref(),
             current_photo: $s.current_photo.as_deref(),
             selected_point: $s.selected_point.as_deref(),
+            armed_point: $s.armed_point.as_deref(),
             solution: $s.solution.as_ref(),
             residuals: panel::ResidualDisplay {
                 show: $s.ui_state.show_residuals,
@@ -161,6 +164,9 @@ pub struct Studio {
     viewport: Viewport,
     last_transform: Option<ViewTransform>,
     selected_point: Option<String>,
+    /// The point the next click on the photo places ([`placing`]); cleared by placing it, by
+    /// Escape and by clicking a mark.
+    armed_point: Option<String>,
     dragging: Option<(String, [f64; 2])>,
     solver: solve::SolveWorker,
     solution: Option<SiteSolution>,
@@ -209,6 +215,7 @@ impl Studio {
             viewport: Viewport::default(),
             last_transform: None,
             selected_point: None,
+            armed_point: None,
             dragging: None,
             solver: solve::solve_worker(),
             solution: None,
@@ -267,6 +274,7 @@ impl Studio {
                 self.photos.clear();
                 self.solution = None;
                 self.selected_point = None;
+                self.armed_point = None;
                 self.photo_settings = photo_settings::PhotoSettings::default();
                 self.viewport = Viewport::default();
                 self.fit.worker.cancel();
@@ -315,6 +323,12 @@ impl Studio {
     #[must_use]
     pub fn selected_point(&self) -> Option<&str> {
         self.selected_point.as_deref()
+    }
+
+    /// The point the next click on the photo places, if any ([`placing`]).
+    #[must_use]
+    pub fn armed_point(&self) -> Option<&str> {
+        self.armed_point.as_deref()
     }
 
     /// Screen position of a photo pixel position in the last frame's view (tests use it to
@@ -443,7 +457,7 @@ impl Studio {
 
     fn shortcuts(&mut self, ctx: &egui::Context) {
         let typing = ctx.text_edit_focused();
-        let (undo, redo, save, delete) = ctx.input_mut(|i| {
+        let (undo, redo, save, delete, escape) = ctx.input_mut(|i| {
             let cmd = egui::Modifiers::COMMAND;
             let shift_cmd = egui::Modifiers::COMMAND | egui::Modifiers::SHIFT;
             (
@@ -451,8 +465,12 @@ impl Studio {
                 i.consume_key(shift_cmd, Key::Z) || i.consume_key(cmd, Key::Y),
                 i.consume_key(cmd, Key::S),
                 !typing && i.key_pressed(Key::Delete),
+                !typing && i.key_pressed(Key::Escape),
             )
         });
+        if escape && self.armed_point.take().is_some() {
+            self.say("placing cancelled".to_owned(), false);
+        }
         if undo && !typing {
             self.undo();
         }
@@ -594,7 +612,10 @@ impl Studio {
                 self.ui_state.show_residuals = r.show;
                 self.ui_state.residual_exaggeration = r.exaggeration;
             }
-            Action::SelectPoint(id) => self.selected_point = Some(id),
+            Action::SelectPoint(id) => {
+                self.armed_point = Some(id.clone());
+                self.selected_point = Some(id);
+            }
             Action::ImportModel(path) => self.import_model(&path),
             Action::IntersectTiePoint(id) => self.intersect_tie_point(&id),
             Action::CreatePolygon => self.create_polygon(),

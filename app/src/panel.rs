@@ -25,6 +25,8 @@ pub struct PanelContext<'a> {
     pub current_photo: Option<&'a str>,
     /// The point selected for placing on the photo.
     pub selected_point: Option<&'a str>,
+    /// The point the next click on the photo places ([`crate::placing`]).
+    pub armed_point: Option<&'a str>,
     /// The last solve's result.
     pub solution: Option<&'a SiteSolution>,
     /// How residual vectors are drawn on the photo (persisted UI state).

@@ -115,7 +115,8 @@ impl Studio {
         self.paint_wireframes(&painter, &t, &id);
         // The Fit tab shows its samples only (the observation marks would hide them).
         let fit_tab = self.tab == crate::SideTab::Fit;
-        if !fit_tab {
+        let marks_hidden = self.tab == crate::SideTab::Render && !self.render.show_marks;
+        if !fit_tab && !marks_hidden {
             self.paint_marks(&painter, &t, &id);
         }
         if self.tab == crate::SideTab::Scene {
@@ -223,27 +224,63 @@ impl Studio {
                 None,
             ));
         }
-        if response.clicked_by(PointerButton::Primary)
-            && let (Some(point), Some(p)) =
-                (self.selected_point.clone(), response.interact_pointer_pos())
+        if self.armed_point.is_some()
+            && let Some(hover) = response.hover_pos()
         {
-            let [x_px, y_px] = t.photo_from_screen(p);
-            let old = self.observation(photo, &point);
-            let observation = Observation {
-                photo: photo.to_owned(),
-                point,
-                x_px,
-                y_px,
-                sigma_px: old.map_or(points::DEFAULT_SIGMA_PX, |o| o.sigma_px),
-                enabled: old.is_none_or(|o| o.enabled),
-            };
-            self.pending.push((
-                Command::PutObservation {
-                    observation,
-                    at: None,
-                },
-                None,
-            ));
+            response.ctx.set_cursor_icon(egui::CursorIcon::Crosshair);
+            if let Some(point) = self.armed_point.as_deref() {
+                let painter = response.ctx.layer_painter(response.layer_id);
+                painter.text(
+                    hover + egui::vec2(12.0, 12.0),
+                    egui::Align2::LEFT_TOP,
+                    format!("place {point}"),
+                    egui::FontId::proportional(13.0),
+                    Color32::from_rgb(255, 230, 0),
+                );
+            }
+        }
+        if !response.clicked_by(PointerButton::Primary) {
+            return;
+        }
+        let Some(p) = response.interact_pointer_pos() else {
+            return;
+        };
+        let under_cursor = self.doc.as_ref().and_then(|doc| {
+            doc.site
+                .observations
+                .iter()
+                .filter(|o| o.photo == photo)
+                .map(|o| (o, t.screen_from_photo([o.x_px, o.y_px]).distance(p)))
+                .filter(|(_, d)| *d <= GRAB_RADIUS_POINTS)
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(o, _)| o.point.clone())
+        });
+        match crate::placing::photo_click(self.armed_point.as_deref(), under_cursor.as_deref()) {
+            crate::placing::PhotoClick::Ignore => {}
+            crate::placing::PhotoClick::Select(point) => {
+                self.armed_point = None;
+                self.selected_point = Some(point);
+            }
+            crate::placing::PhotoClick::Place(point) => {
+                self.armed_point = None;
+                let [x_px, y_px] = t.photo_from_screen(p);
+                let old = self.observation(photo, &point);
+                let observation = Observation {
+                    photo: photo.to_owned(),
+                    point,
+                    x_px,
+                    y_px,
+                    sigma_px: old.map_or(points::DEFAULT_SIGMA_PX, |o| o.sigma_px),
+                    enabled: old.is_none_or(|o| o.enabled),
+                };
+                self.pending.push((
+                    Command::PutObservation {
+                        observation,
+                        at: None,
+                    },
+                    None,
+                ));
+            }
         }
     }
 

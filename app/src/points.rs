@@ -164,12 +164,15 @@ pub fn import_file(
     Ok(Command::Batch(batch))
 }
 
-/// The table. `selected` is the selected point id; edits come back as commands.
+/// The table. `selected` is the selected point id (highlighted); a click on a point's id sets
+/// `chosen` (even when it is already selected: choosing arms it again for placing); edits come back
+/// as commands.
 pub fn table_ui(
     ui: &mut egui::Ui,
     site: &Site,
     current_photo: Option<&str>,
-    selected: &mut Option<String>,
+    selected: Option<&str>,
+    chosen: &mut Option<String>,
     commands: &mut Vec<(Command, Option<String>)>,
 ) {
     let observation_of = |id: &str| {
@@ -199,10 +202,10 @@ pub fn table_ui(
             for cp in &site.control_points {
                 body.row(22.0, |mut row| {
                     row.col(|ui| {
-                        let is_sel = selected.as_deref() == Some(cp.id.as_str());
+                        let is_sel = selected == Some(cp.id.as_str());
                         let r = ui.selectable_label(is_sel, &cp.id);
                         if r.clicked() {
-                            *selected = Some(cp.id.clone());
+                            *chosen = Some(cp.id.clone());
                         }
                     });
                     for axis in 0..3 {
@@ -416,27 +419,45 @@ impl Panel for PointsPanel {
                 }
             }
         });
-        let sel = ctx.selected_point.unwrap_or("none");
-        ui.label(format!(
-            "selected: {sel} — click the photo to place it, drag a mark to move, Delete removes"
-        ));
+        match (ctx.armed_point, ctx.selected_point) {
+            (Some(armed), _) => {
+                ui.colored_label(
+                    crate::widgets::WARNING,
+                    format!("placing {armed}: click the photo to put it there (Esc cancels)"),
+                );
+            }
+            (None, Some(sel)) => {
+                ui.horizontal(|ui| {
+                    ui.label(format!(
+                        "selected: {sel} — drag its mark to move it, Delete removes it"
+                    ));
+                    let r = ui.button("Place again");
+                    name_widget(ui, &r, "place selected point");
+                    if r.clicked() {
+                        actions.push(Action::SelectPoint(sel.to_owned()));
+                    }
+                });
+            }
+            (None, None) => {
+                ui.label("choose a point in the table to place it on the photo");
+            }
+        }
         let Some(doc) = ctx.doc else {
             return actions;
         };
         let mut commands = Vec::new();
-        let mut selected = ctx.selected_point.map(str::to_owned);
+        let mut chosen = None;
         egui::ScrollArea::horizontal().show(ui, |ui| {
             table_ui(
                 ui,
                 &doc.site,
                 ctx.current_photo,
-                &mut selected,
+                ctx.selected_point,
+                &mut chosen,
                 &mut commands,
             );
         });
-        if let Some(id) = selected
-            && ctx.selected_point != Some(id.as_str())
-        {
+        if let Some(id) = chosen {
             actions.push(Action::SelectPoint(id));
         }
         actions.extend(

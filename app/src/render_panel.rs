@@ -79,6 +79,10 @@ pub struct RenderPanel {
     pub sheet_path: String,
     /// The last view geometry report (Report button).
     pub report: Option<photomontage::verified::ViewGeometry>,
+    /// Draw the observation marks over the photo on this tab.
+    pub show_marks: bool,
+    /// Outline the finished tiles of a running render.
+    pub show_tiles: bool,
     worker: RenderWorker,
     /// Photo and AVR level of the running render.
     running: Option<(String, AvrLevel)>,
@@ -97,6 +101,8 @@ impl Default for RenderPanel {
             export_path: String::new(),
             sheet_path: String::new(),
             report: None,
+            show_marks: true,
+            show_tiles: true,
             worker: Worker::new("render"),
             running: None,
             tiles_done: Vec::new(),
@@ -306,7 +312,12 @@ impl RenderPanel {
                 painter.image(p.texture(ctx).id(), rect, uv, Color32::WHITE);
             }
             let stroke = egui::Stroke::new(1.0, Color32::from_rgb(80, 200, 255));
-            for tile in &self.tiles_done {
+            let outlined = if self.show_tiles {
+                self.tiles_done.as_slice()
+            } else {
+                &[]
+            };
+            for tile in outlined {
                 let [x, y] = tile.origin_px.map(f64::from);
                 let [w, h] = tile.size_px.map(f64::from);
                 let r = t.screen_rect([x, y], [x + w, y + h]);
@@ -466,6 +477,12 @@ impl Panel for RenderPanel {
         let r = ui.add(egui::Slider::new(&mut self.ab_split, 0.0..=1.0).text("A/B"));
         name_widget(ui, &r, "A/B split");
         ui.label("photo left of the split, montage right");
+        ui.horizontal(|ui| {
+            let r = ui.checkbox(&mut self.show_marks, "control marks");
+            name_widget(ui, &r, "show control marks");
+            let r = ui.checkbox(&mut self.show_tiles, "tile outlines");
+            name_widget(ui, &r, "show tile outlines");
+        });
         ui.horizontal(|ui| {
             let r = ui.add(
                 egui::TextEdit::singleline(&mut self.export_path)

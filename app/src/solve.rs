@@ -16,6 +16,7 @@ use egui_extras::{Column, TableBuilder};
 use photomontage::site::{SiteDocument, SiteSolution, solve::PhotoSolution};
 
 use crate::panel::{Action, Panel, PanelContext};
+use crate::table_sort::{self, SortKey, SortState, sorted_rows};
 use crate::viewport::ViewTransform;
 use crate::widgets::{ERROR, WARNING, name_widget};
 use crate::worker::Worker;
@@ -71,6 +72,13 @@ pub fn photo_solution_ui(ui: &mut egui::Ui, s: &PhotoSolution) {
     for w in &s.warnings {
         ui.colored_label(crate::widgets::WARNING, format!("warning: {w}"));
     }
+    let sort_id = egui::Id::unique(("residuals sort", &s.id));
+    let mut sort = SortState::load(ui, sort_id);
+    let order = sorted_rows(&s.residuals, sort, |r, column| match column {
+        0 => SortKey::Text(r.point_id.clone()),
+        1..=4 => SortKey::Number(row_numbers(r)[column - 1]),
+        _ => SortKey::Number(f64::from(u8::from(r.outlier))),
+    });
     TableBuilder::new(ui)
         .id_salt(("residuals", &s.id))
         .striped(true)
@@ -79,14 +87,21 @@ pub fn photo_solution_ui(ui: &mut egui::Ui, s: &PhotoSolution) {
         .column(Column::remainder())
         .max_scroll_height(260.0)
         .header(18.0, |mut h| {
-            for t in ["point", "vx px", "vy px", "|v| px", "|v|/σ", "flag"] {
+            for (column, t) in ["point", "vx px", "vy px", "|v| px", "|v|/σ", "flag"]
+                .into_iter()
+                .enumerate()
+            {
                 h.col(|ui| {
-                    ui.strong(t);
+                    if let Some(next) =
+                        table_sort::header(ui, &format!("residuals {}", s.id), sort, column, t)
+                    {
+                        sort = next;
+                    }
                 });
             }
         })
         .body(|mut body| {
-            for r in &s.residuals {
+            for r in order.iter().map(|&i| &s.residuals[i]) {
                 body.row(18.0, |mut row| {
                     let colour = if r.outlier {
                         Color32::from_rgb(230, 60, 60)
@@ -109,6 +124,7 @@ pub fn photo_solution_ui(ui: &mut egui::Ui, s: &PhotoSolution) {
                 });
             }
         });
+    sort.store(ui, sort_id);
 }
 
 fn ui_text_colour() -> Color32 {

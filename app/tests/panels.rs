@@ -42,6 +42,7 @@ fn harness<P: Panel + 'static>(panel: P, can_undo: bool, row: bool) -> Harness<'
                     doc: Some(&s.doc),
                     current_photo: Some("P1"),
                     selected_point: None,
+                    armed_point: None,
                     solution: None,
                     residuals: ResidualDisplay {
                         show: true,
