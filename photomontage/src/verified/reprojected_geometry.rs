@@ -88,6 +88,24 @@ pub fn cylinder_viewing_distance_mm(printed_width_mm: f64, hfov_deg: f64) -> f64
     printed_width_mm / hfov_deg.to_radians()
 }
 
+/// `r` for a sheet on `paper`: the printed width and the viewing distance (flat for a photo or
+/// planar view, the cylinder's radius for a cylindrical one) recomputed.
+#[must_use]
+pub fn with_paper(r: &ViewGeometry, paper: super::paper::PaperSize) -> ViewGeometry {
+    let mut r = r.clone();
+    r.paper = paper;
+    r.printed_image_width_mm = paper.layout().printed_image_size_mm(r.image_size_px)[0];
+    r.viewing_distance_mm = match r.projection {
+        ViewProjection::Cylindrical => {
+            cylinder_viewing_distance_mm(r.printed_image_width_mm, r.hfov_deg)
+        }
+        ViewProjection::Photo | ViewProjection::Planar => {
+            viewing_distance_mm(r.printed_image_width_mm, r.hfov_deg)
+        }
+    };
+    r
+}
+
 /// The report of the cylindrical view `cylinder` composed from `photo_ids`.
 ///
 /// # Errors
