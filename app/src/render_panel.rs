@@ -6,7 +6,8 @@
 //! which the library's tile callback delivers, are blitted into the preview texture with a
 //! partial texture update, over the photo as the renderer sees it), the finished montage with an
 //! A/B split (photo left, montage right), and exports it through
-//! `photomontage::render::output::write_output` (EXR or 8-bit by extension).
+//! `photomontage::verified::image_metadata::write_render` (EXR or 8-bit by extension, carrying
+//! the view's geometry).
 //!
 //! Tone mapping for display and 8-bit export is the site's `render.exposure` with a clamp, as in
 //! the CLI.
@@ -25,10 +26,11 @@
 use eframe::egui::{self, Color32};
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::ToneCurve;
-use photomontage::render::{OutputLayers, RenderedImage, TileProgress, output};
+use photomontage::render::{OutputLayers, RenderedImage, TileProgress};
 use photomontage::site::SiteDocument;
+use photomontage::verified::image_metadata::{view_metadata, write_render};
 use photomontage::verified::standard_view::StandardView;
-use photomontage::verified::{AvrLevel, PaperSize, ViewGeometry};
+use photomontage::verified::{AvrLevel, PaperSize, ViewGeometry, ViewMetadata};
 use std::path::Path;
 
 use crate::panel::{Action, Panel, PanelContext};
@@ -294,17 +296,37 @@ impl RenderPanel {
         }))
     }
 
-    /// Writes the montage to `path` (format by extension: .exr, .png, .jpg, .tif).
+    /// Writes the montage to `path` (format by extension: .exr, .png, .jpg, .tif) carrying the
+    /// view's geometry (EXIF and XMP, or EXR attributes) as `photomontage render` and `view`
+    /// write it; without it when the photo's report cannot be made.
     ///
     /// # Errors
-    /// `NothingToExport` or the output module's error.
-    pub fn export(&self, path: &Path, tone_map: &ToneMap) -> Result<(), RenderPanelError> {
+    /// `NothingToExport` or the writer's error.
+    pub fn export(
+        &self,
+        doc: &SiteDocument,
+        path: &Path,
+        tone_map: &ToneMap,
+    ) -> Result<(), RenderPanelError> {
         let m = self
             .montage
             .as_ref()
             .ok_or(RenderPanelError::NothingToExport)?;
-        output::write_output(path, &m.image, &OutputLayers::default(), tone_map)?;
-        Ok(())
+        let metadata = match &m.geometry {
+            Some(g) => Some(ViewMetadata::from(g)),
+            None => view_metadata(doc, &m.photo_id).ok(),
+        };
+        write_render(
+            path,
+            &m.image,
+            &OutputLayers::default(),
+            tone_map,
+            metadata.as_ref(),
+        )
+        .map_err(|e| RenderPanelError::Render {
+            photo: m.photo_id.clone(),
+            message: e.to_string(),
+        })
     }
 
     /// Screen x of the A/B split line for a photo of width `width_px` under `t`.
@@ -409,7 +431,7 @@ impl crate::Studio {
             self.say("type an export path (.exr, .png, .jpg, .tif) first", true);
             return;
         }
-        match self.render.export(&path, &site_tone_map(doc)) {
+        match self.render.export(doc, &path, &site_tone_map(doc)) {
             Ok(()) => self.say(format!("exported {}", path.display()), false),
             Err(e) => self.say(e.to_string(), true),
         }

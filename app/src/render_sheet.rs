@@ -37,7 +37,9 @@ impl RenderPanel {
         let paper = self.view_choice.paper;
         let pdf = match &m.geometry {
             // A re-projected view: its own geometry, on the chosen paper.
-            Some(g) => sheet_for_geometry(doc, &with_paper(g, paper), &rgb, m.avr, SheetFormat::Pdf),
+            Some(g) => {
+                sheet_for_geometry(doc, &with_paper(g, paper), &rgb, m.avr, SheetFormat::Pdf)
+            }
             None => sheet_for_view(
                 doc,
                 &m.photo_id,

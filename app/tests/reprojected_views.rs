@@ -81,7 +81,10 @@ fn planar_and_cylindrical_views_and_the_sheet_paper_from_the_studio() {
     )
     .unwrap();
     let montage = h.state().render_panel().montage().expect("a planar view");
-    assert!(bits(&montage.image) == bits(&library.image), "studio planar view differs");
+    assert!(
+        bits(&montage.image) == bits(&library.image),
+        "studio planar view differs"
+    );
     let geometry = montage.geometry.clone().expect("the view's geometry");
     assert_eq!(geometry, library.geometry);
     assert_eq!(geometry.projection, ViewProjection::Planar);
@@ -100,8 +103,14 @@ fn planar_and_cylindrical_views_and_the_sheet_paper_from_the_studio() {
     let text = String::from_utf8_lossy(&pdf);
     let media = numbers_after(&text, "/MediaBox [");
     let [w_mm, h_mm] = PaperSize::A2.size_mm();
-    assert!((media[2] - w_mm * 72.0 / 25.4).abs() < PAGE_SIZE_TOL_PT, "{media:?}");
-    assert!((media[3] - h_mm * 72.0 / 25.4).abs() < PAGE_SIZE_TOL_PT, "{media:?}");
+    assert!(
+        (media[2] - w_mm * 72.0 / 25.4).abs() < PAGE_SIZE_TOL_PT,
+        "{media:?}"
+    );
+    assert!(
+        (media[3] - h_mm * 72.0 / 25.4).abs() < PAGE_SIZE_TOL_PT,
+        "{media:?}"
+    );
     let a2 = with_paper(&geometry, PaperSize::A2);
     let at = text.find("/Im0 Do").unwrap();
     let before = &text[..at];
@@ -143,7 +152,10 @@ fn planar_and_cylindrical_views_and_the_sheet_paper_from_the_studio() {
     )
     .unwrap();
     let montage = h.state().render_panel().montage().expect("a panorama");
-    assert!(bits(&montage.image) == bits(&library.image), "studio panorama differs");
+    assert!(
+        bits(&montage.image) == bits(&library.image),
+        "studio panorama differs"
+    );
     assert_eq!(montage.geometry.as_ref(), Some(&library.geometry));
 
     // P1 and P2 stand metres apart: refused, naming the rule, and the panorama stays.
@@ -157,6 +169,10 @@ fn planar_and_cylindrical_views_and_the_sheet_paper_from_the_studio() {
         "{}",
         last.text
     );
-    let montage = h.state().render_panel().montage().expect("the panorama stays");
+    let montage = h
+        .state()
+        .render_panel()
+        .montage()
+        .expect("the panorama stays");
     assert_eq!(montage.geometry.as_ref(), Some(&library.geometry));
 }

@@ -97,7 +97,10 @@ fn tiles_rendered_alone_and_merged_equal_the_whole_render_byte_for_byte() {
             match ext {
                 "png" => assert!(has(b"eXIf") && has(b"XML:com.adobe.xmp"), "PNG EXIF, XMP"),
                 "tif" => assert!(has(b"urn:photomontage:view:1.0/"), "TIFF XMP"),
-                _ => assert!(has(b"photomontage.view") && has(b"software"), "EXR attributes"),
+                _ => assert!(
+                    has(b"photomontage.view") && has(b"software"),
+                    "EXR attributes"
+                ),
             }
             if ext == "exr" {
                 let table = |p: &Path| std::fs::read(p.with_extension("objects.json")).unwrap();

@@ -8,7 +8,9 @@ use std::collections::BTreeMap;
 
 use exif::{Context, In, Tag, Value};
 use photomontage::render::{OutputLayers, RenderedImage};
-use photomontage::verified::image_metadata::{encode_8bit_with_view, write_8bit_with_view, write_render};
+use photomontage::verified::image_metadata::{
+    encode_8bit_with_view, write_8bit_with_view, write_render,
+};
 use photomontage::verified::view_metadata::EXR_VIEW_ATTRIBUTE;
 use photomontage::verified::xmp::{JPEG_XMP_SIGNATURE, NAMESPACE, PNG_XMP_KEYWORD};
 use photomontage::verified::{ViewGeometryOptions, ViewMetadata, view_geometry};
@@ -72,7 +74,9 @@ fn xmp_of(bytes: &[u8], ext: &str) -> String {
         }
         "tif" => {
             let exif = exif::Reader::new().read_raw(bytes.to_vec()).unwrap();
-            let field = exif.get_field(Tag(Context::Tiff, 700), In::PRIMARY).unwrap();
+            let field = exif
+                .get_field(Tag(Context::Tiff, 700), In::PRIMARY)
+                .unwrap();
             let Value::Byte(packet) = &field.value else {
                 panic!("tag 700 is {:?}", field.value);
             };
@@ -98,7 +102,10 @@ fn xmp_properties(packet: &str) -> BTreeMap<String, String> {
                     for a in e.attributes() {
                         let a = a.unwrap();
                         let key = String::from_utf8(a.key.as_ref().to_vec()).unwrap();
-                        let value = a.unescape_value().unwrap().into_owned();
+                        let value = a
+                            .normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                            .unwrap()
+                            .into_owned();
                         if key == "xmlns:photomontage" {
                             saw_namespace = value == NAMESPACE;
                         }
@@ -141,7 +148,11 @@ fn xmp_gps(text: &str) -> f64 {
     let (deg, rest) = text.split_once(',').unwrap();
     let (minutes, hemisphere) = rest.split_at(rest.len() - 1);
     let v = deg.parse::<f64>().unwrap() + minutes.parse::<f64>().unwrap() / 60.0;
-    if matches!(hemisphere, "S" | "W") { -v } else { v }
+    if matches!(hemisphere, "S" | "W") {
+        -v
+    } else {
+        v
+    }
 }
 
 /// Every number of the metadata equals the packet's (exactly: shortest round-trip decimals).
@@ -304,7 +315,14 @@ fn exr_renders_carry_the_view_geometry_as_header_attributes() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("v2.exr");
     let tone = photomontage::colour::ToneMap::clamp_with_exposure(0.0);
-    write_render(&path, &image, &OutputLayers::default(), &tone, Some(&metadata)).unwrap();
+    write_render(
+        &path,
+        &image,
+        &OutputLayers::default(),
+        &tone,
+        Some(&metadata),
+    )
+    .unwrap();
     let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
     let a = &meta.headers[0].own_attributes;
     let Some(AttributeValue::Text(json)) = a.other.get(&Text::from(EXR_VIEW_ATTRIBUTE)) else {

@@ -14,8 +14,8 @@ use photomontage::verified::cylindrical_view::CylindricalOptions;
 use photomontage::verified::sheet::{SheetFormat, sheet_for_geometry, sheet_for_view, write_sheet};
 use photomontage::verified::standard_view::{StandardView, make_view};
 use photomontage::verified::{PaperSize, ViewGeometryOptions, ViewProjection, view_geometry};
-use std::sync::atomic::AtomicBool;
 use photomontage_tests::truth::site_with_true_cameras;
+use std::sync::atomic::AtomicBool;
 
 /// The bound on the printed image width against the viewing-distance formula.
 const PRINTED_WIDTH_TOL_MM: f64 = 0.5;
@@ -350,7 +350,10 @@ fn check_reprojected_sheet(view: StandardView, paper: PaperSize, page_pt: [f64; 
         report.viewing_distance_mm
     );
     assert!((printed_mm - want_mm).abs() < PRINTED_WIDTH_TOL_MM);
-    assert!((h_pt / w_pt - f64::from(h) / f64::from(w)).abs() < 1e-4, "aspect kept");
+    assert!(
+        (h_pt / w_pt - f64::from(h) / f64::from(w)).abs() < 1e-4,
+        "aspect kept"
+    );
 
     let p = path.to_str().unwrap();
     let Some(info) = poppler("pdfinfo", &[p]) else {
@@ -435,7 +438,8 @@ fn reprojected_views_refuse_bad_input_by_photo() {
         options: CylindricalOptions::default(),
     });
     assert!(
-        err.contains("was not taken from the same point") && (err.contains("V1") || err.contains("V3")),
+        err.contains("was not taken from the same point")
+            && (err.contains("V1") || err.contains("V3")),
         "{err}"
     );
     // A focal length that cannot be converted.
@@ -485,5 +489,8 @@ fn reprojected_views_refuse_bad_input_by_photo() {
     .map(|_| ())
     .unwrap_err()
     .to_string();
-    assert!(err.contains("V1") && err.contains("no visible model"), "{err}");
+    assert!(
+        err.contains("V1") && err.contains("no visible model"),
+        "{err}"
+    );
 }

@@ -16,9 +16,7 @@ use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use crate::render::output::{LayerSet, OutputFormat, write_object_table};
-use crate::render::partial::{
-    PartError, merge_parts, read_part_info, write_part,
-};
+use crate::render::partial::{PartError, merge_parts, read_part_info, write_part};
 use crate::render::{Band, TileProgress};
 use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
@@ -518,13 +516,7 @@ pub fn merge_to_file(
         .as_deref()
         .and_then(|j| serde_json::from_str(j).ok());
     if format == OutputFormat::Exr {
-        write_render(
-            out,
-            &merged.image,
-            &merged.layers,
-            &tone_map,
-            view.as_ref(),
-        )?;
+        write_render(out, &merged.image, &merged.layers, &tone_map, view.as_ref())?;
         if let (Some(names), Some(_)) = (&merged.info.object_names, &merged.layers.object_id) {
             write_object_table(out, names)?;
         }

@@ -227,7 +227,12 @@ pub fn write_exr(
     image: &RenderedImage,
     layers: &OutputLayers,
 ) -> Result<(), OutputError> {
-    write_exr_with(path, image, layers, exr::prelude::LayerAttributes::default())
+    write_exr_with(
+        path,
+        image,
+        layers,
+        exr::prelude::LayerAttributes::default(),
+    )
 }
 
 /// [`write_exr`] with the layer's header `attributes` (owner, comments, capture date, position,

@@ -59,7 +59,7 @@ pub struct PartInfo {
     pub view_json: Option<String>,
 }
 
-/// Lower-case hex of `bytes` (for [`PartInfo::exif_hex`]).
+/// Lower-case hex of `bytes` (content hashes in the job identity).
 #[must_use]
 pub fn to_hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use image::ImageEncoder;
 
-use super::tiff_ifd::{RgbStrip, XMP_TAG, bytes, tiff_bytes, BYTE};
+use super::tiff_ifd::{BYTE, RgbStrip, XMP_TAG, bytes, tiff_bytes};
 use super::view_metadata::{ViewMetadata, exif_block, exif_ifds, exr_attributes};
 use super::xmp::{insert_into_jpeg, insert_into_png, xmp_packet};
 
@@ -57,7 +57,8 @@ pub fn write_render(
     let format = OutputFormat::from_path(path).map_err(|e| fail(e.to_string()))?;
     match (format, view) {
         (OutputFormat::Exr, Some(view)) => {
-            write_exr_with(path, image, layers, exr_attributes(view)).map_err(|e| fail(e.to_string()))
+            write_exr_with(path, image, layers, exr_attributes(view))
+                .map_err(|e| fail(e.to_string()))
         }
         (OutputFormat::Jpeg | OutputFormat::Png | OutputFormat::Tiff, Some(view)) => {
             let [w, h] = image.size_px;

@@ -41,6 +41,8 @@ pub mod wireline;
 pub mod xmp;
 
 pub use avr::{AvrLevel, AvrOverlay, apply_massing, avr_overlay};
-pub use geometry::{ViewProjection, ViewGeometry, ViewGeometryError, ViewGeometryOptions, view_geometry};
+pub use geometry::{
+    ViewGeometry, ViewGeometryError, ViewGeometryOptions, ViewProjection, view_geometry,
+};
 pub use paper::PaperSize;
 pub use view_metadata::ViewMetadata;

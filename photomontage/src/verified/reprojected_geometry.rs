@@ -71,7 +71,10 @@ pub fn planar_view_geometry(
     r.image_size_px = intr.image_size_px;
     r.principal_point_px = intr.principal_point_px;
     r.distortion = intr.distortion;
-    r.printed_image_width_mm = options.paper.layout().printed_image_size_mm(intr.image_size_px)[0];
+    r.printed_image_width_mm = options
+        .paper
+        .layout()
+        .printed_image_size_mm(intr.image_size_px)[0];
     r.viewing_distance_mm = viewing_distance_mm(r.printed_image_width_mm, hfov_deg);
     r.notes.push(format!(
         "planar view re-projected from photo {photo_id} at {:.2} mm equivalent; the residuals \
@@ -133,7 +136,10 @@ pub fn cylindrical_view_geometry(
     r.camera_position_m = cylinder.centre_in_world_m;
     r.height_above_datum_m = centre.z;
     r.height_above_ground_m = r.ground_level_m.map(|g| centre.z - g);
-    if let Some(crs) = r.crs.as_deref().and_then(|n| ProjectedCrs::from_name(n).ok())
+    if let Some(crs) = r
+        .crs
+        .as_deref()
+        .and_then(|n| ProjectedCrs::from_name(n).ok())
         && let Ok((lat, lon)) = crs.to_lat_lon_deg(centre.x, centre.y)
     {
         r.latitude_deg = Some(lat);
@@ -175,7 +181,10 @@ pub fn cylindrical_view_geometry(
             })
         })
         .collect();
-    r.printed_image_width_mm = options.paper.layout().printed_image_size_mm(cylinder.size_px)[0];
+    r.printed_image_width_mm = options
+        .paper
+        .layout()
+        .printed_image_size_mm(cylinder.size_px)[0];
     r.viewing_distance_mm = cylinder_viewing_distance_mm(r.printed_image_width_mm, r.hfov_deg);
     r.notes.push(format!(
         "cylindrical view of photos {}: viewing distance = printed width / HFoV (radians), the \

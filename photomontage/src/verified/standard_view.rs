@@ -24,9 +24,7 @@ use super::cylindrical_view::{
     CylindricalError, CylindricalOptions, PanoramaPhoto, common_centre, cylindrical_view,
 };
 use super::geometry::{ViewGeometry, ViewGeometryError, ViewGeometryOptions, view_geometry};
-use super::planar_view::{
-    PlanarViewError, planar_view, planar_view_job, reproject, solved_photo,
-};
+use super::planar_view::{PlanarViewError, planar_view, planar_view_job, reproject, solved_photo};
 use super::reprojected_geometry::{cylindrical_view_geometry, planar_view_geometry};
 use crate::render::{DifferentialTracer, RenderError, RenderedImage, TileProgress, render_view};
 use crate::site::SiteDocument;
@@ -233,7 +231,10 @@ pub fn make_view(
                 warnings,
             })
         }
-        StandardView::Cylindrical { photos, options: cyl } => {
+        StandardView::Cylindrical {
+            photos,
+            options: cyl,
+        } => {
             let ids: Vec<&str> = photos.iter().map(String::as_str).collect();
             let mut loaded = ids
                 .iter()

@@ -159,16 +159,16 @@ pub fn tiff_bytes(ifds: &MetadataIfds, image: Option<RgbStrip<'_>>) -> Vec<u8> {
         if let Some(img) = image {
             let [w, h] = img.size_px;
             ifd0.extend([
-                long(256, w),                 // ImageWidth
-                long(257, h),                 // ImageLength
-                shorts(258, &[8, 8, 8]),      // BitsPerSample
-                shorts(259, &[1]),            // Compression: none
-                shorts(262, &[2]),            // PhotometricInterpretation: RGB
-                long(273, strip_at),          // StripOffsets
-                shorts(277, &[3]),            // SamplesPerPixel
-                long(278, h),                 // RowsPerStrip
+                long(256, w),                           // ImageWidth
+                long(257, h),                           // ImageLength
+                shorts(258, &[8, 8, 8]),                // BitsPerSample
+                shorts(259, &[1]),                      // Compression: none
+                shorts(262, &[2]),                      // PhotometricInterpretation: RGB
+                long(273, strip_at),                    // StripOffsets
+                shorts(277, &[3]),                      // SamplesPerPixel
+                long(278, h),                           // RowsPerStrip
                 long(279, count_of(img.samples.len())), // StripByteCounts
-                shorts(284, &[1]),            // PlanarConfiguration: chunky
+                shorts(284, &[1]),                      // PlanarConfiguration: chunky
             ]);
         }
         let mut out = b"II\x2a\x00\x08\x00\x00\x00".to_vec();

@@ -197,10 +197,7 @@ pub fn exif_ifds(m: &ViewMetadata) -> MetadataIfds {
             rationals(0x0011, &[m.bearing_true_deg], 1000),
         ]);
     }
-    let ifd0: Vec<Entry> = vec![
-        ascii(0x010E, &m.description()),
-        ascii(0x0131, &m.software),
-    ];
+    let ifd0: Vec<Entry> = vec![ascii(0x010E, &m.description()), ascii(0x0131, &m.software)];
     MetadataIfds { ifd0, exif, gps }
 }
 

@@ -157,7 +157,10 @@ pub fn xmp_packet(m: &ViewMetadata) -> String {
     let seqs: [(&str, Vec<String>); 4] = [
         (
             "camera_position_m",
-            m.camera_position_m.iter().map(|v| format!("{v:?}")).collect(),
+            m.camera_position_m
+                .iter()
+                .map(|v| format!("{v:?}"))
+                .collect(),
         ),
         (
             "sigma_center_m",

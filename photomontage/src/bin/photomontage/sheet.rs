@@ -118,7 +118,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if level.is_some_and(|l| matches!(l, AvrLevel::Avr2 | AvrLevel::Avr3)) {
         eprintln!("rendering the {} view of {}", avr.name(), args.view);
     }
-    let made = make_view(&doc, &view, level, &options, &|_| {}, &AtomicBool::new(false))?;
+    let made = make_view(
+        &doc,
+        &view,
+        level,
+        &options,
+        &|_| {},
+        &AtomicBool::new(false),
+    )?;
     for w in &made.warnings {
         eprintln!("warning: {w}");
     }
