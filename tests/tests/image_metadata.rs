@@ -285,7 +285,7 @@ fn jpeg_png_and_tiff_carry_the_view_geometry_as_exif_and_xmp() {
             report.hfov_deg.to_bits()
         );
         assert_eq!(
-            number(&props, "photomontage:camera_position_m[2]").to_bits(),
+            number(&props, "camera_position_m[2]").to_bits(),
             report.camera_position_m[2].to_bits()
         );
     }
