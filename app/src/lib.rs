@@ -52,6 +52,7 @@ pub mod render_display;
 pub mod render_job;
 pub mod render_panel;
 pub mod render_sheet;
+pub mod render_views;
 pub mod scene_panel;
 pub mod scene_pick;
 pub mod solve;

@@ -6,7 +6,8 @@
 //! which the library's tile callback delivers, are blitted into the preview texture with a
 //! partial texture update, over the photo as the renderer sees it), the finished montage with an
 //! A/B split (photo left, montage right), and exports it through
-//! `photomontage::render::output::write_output` (EXR or 8-bit by extension).
+//! `photomontage::verified::image_metadata::write_render` (EXR or 8-bit by extension, carrying
+//! the view's geometry).
 //!
 //! Tone mapping for display and 8-bit export is the site's `render.exposure` with a clamp, as in
 //! the CLI.
@@ -25,9 +26,11 @@
 use eframe::egui::{self, Color32};
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::ToneCurve;
-use photomontage::render::{OutputLayers, RenderedImage, TileProgress, output};
+use photomontage::render::{OutputLayers, RenderedImage, TileProgress};
 use photomontage::site::SiteDocument;
-use photomontage::verified::AvrLevel;
+use photomontage::verified::image_metadata::{view_metadata, write_render};
+use photomontage::verified::standard_view::StandardView;
+use photomontage::verified::{AvrLevel, PaperSize, ViewGeometry, ViewMetadata};
 use std::path::Path;
 
 use crate::panel::{Action, Panel, PanelContext};
@@ -38,6 +41,7 @@ pub use crate::render_job::{
     Quality, RenderPanelError, overlay_photo, prepare_photo, render_photo, site_tone_map,
     trace_photo,
 };
+use crate::render_views::{ViewChoice, fitted_rect, make_reprojected};
 use crate::viewport::ViewTransform;
 use crate::widgets::name_widget;
 use crate::worker::{Poll, Progress, Worker};
@@ -53,8 +57,10 @@ pub enum RenderUpdate {
     Tile(TileProgress),
 }
 
-/// The render's worker: the montage (or why not) with the tiles streamed on the way.
-pub type RenderWorker = Worker<Result<RenderedImage, RenderPanelError>, RenderUpdate>;
+/// The render's worker: the montage (with the geometry of a re-projected view), or why not, with
+/// the tiles streamed on the way.
+pub type RenderWorker =
+    Worker<Result<(RenderedImage, Option<ViewGeometry>), RenderPanelError>, RenderUpdate>;
 
 /// A finished montage.
 pub struct Montage {
@@ -64,6 +70,8 @@ pub struct Montage {
     pub image: RenderedImage,
     /// The AVR level it shows.
     pub avr: AvrLevel,
+    /// The geometry of a re-projected view (planar or cylindrical); `None` for the photo itself.
+    pub geometry: Option<ViewGeometry>,
     texture: Option<egui::TextureHandle>,
 }
 
@@ -83,6 +91,8 @@ pub struct RenderPanel {
     pub show_marks: bool,
     /// Outline the finished tiles of a running render.
     pub show_tiles: bool,
+    /// The view (photo, planar 50/75 mm, cylindrical) and the sheet's paper.
+    pub view_choice: ViewChoice,
     worker: RenderWorker,
     /// Photo and AVR level of the running render.
     running: Option<(String, AvrLevel)>,
@@ -103,6 +113,7 @@ impl Default for RenderPanel {
             report: None,
             show_marks: true,
             show_tiles: true,
+            view_choice: ViewChoice::default(),
             worker: Worker::new("render"),
             running: None,
             tiles_done: Vec::new(),
@@ -118,16 +129,22 @@ impl Default for RenderPanel {
 }
 
 /// The render job: the photo for the preview, then the tiles, then the montage (AVR0/AVR1: the
-/// overlay, no tiles).
+/// overlay, no tiles); a re-projected view ([`crate::render_views`]) in one piece.
 fn render_job(
     doc: &SiteDocument,
     id: &str,
     quality: Quality,
     tone_map: ToneMap,
+    view: Option<(StandardView, PaperSize)>,
     progress: &Progress<RenderUpdate>,
-) -> Result<RenderedImage, RenderPanelError> {
+) -> Result<(RenderedImage, Option<ViewGeometry>), RenderPanelError> {
+    if let Some((view, paper)) = view {
+        let (image, geometry) =
+            make_reprojected(doc, id, &view, quality.avr, paper, progress.cancel_flag())?;
+        return Ok((image, Some(geometry)));
+    }
     if matches!(quality.avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
-        return overlay_photo(doc, id, quality.avr);
+        return overlay_photo(doc, id, quality.avr).map(|image| (image, None));
     }
     let job = prepare_photo(doc, id, quality)?;
     let photo = &job.photo_linear;
@@ -137,7 +154,7 @@ fn render_job(
     });
     let tiles = progress.clone();
     let on_tile = move |t: TileProgress| tiles.send(RenderUpdate::Tile(t));
-    trace_photo(&job, id, &on_tile, progress.cancel_flag())
+    trace_photo(&job, id, &on_tile, progress.cancel_flag()).map(|image| (image, None))
 }
 
 impl RenderPanel {
@@ -202,8 +219,12 @@ impl RenderPanel {
         self.tone_map = site_tone_map(doc);
         let tone_map = self.tone_map;
         let (doc, id, quality) = (doc.clone(), photo_id.to_owned(), self.quality);
+        let view = self
+            .view_choice
+            .standard_view(photo_id)
+            .map(|v| (v, self.view_choice.paper));
         let started = self.worker.spawn(ctx, move |progress| {
-            render_job(&doc, &id, quality, tone_map, progress)
+            render_job(&doc, &id, quality, tone_map, view, progress)
         });
         if !started {
             return Err(busy());
@@ -252,34 +273,66 @@ impl RenderPanel {
             }),
         };
         self.running = None;
-        Some(result.map(|image| {
-            let text = format!(
-                "rendered {photo_id} ({}): {} changed pixels, {} primary rays",
-                avr.name(),
-                image.changed_pixels,
-                image.primary_rays
-            );
+        Some(result.map(|(image, geometry)| {
+            let text = match &geometry {
+                Some(g) => format!(
+                    "made the {} view {} ({}): {} × {} px, HFoV {:.3}°",
+                    format!("{:?}", g.projection).to_lowercase(),
+                    g.photo_id,
+                    avr.name(),
+                    g.image_size_px[0],
+                    g.image_size_px[1],
+                    g.hfov_deg
+                ),
+                None => format!(
+                    "rendered {photo_id} ({}): {} changed pixels, {} primary rays",
+                    avr.name(),
+                    image.changed_pixels,
+                    image.primary_rays
+                ),
+            };
             self.montage = Some(Montage {
                 photo_id,
                 image,
                 avr,
+                geometry,
                 texture: None,
             });
             text
         }))
     }
 
-    /// Writes the montage to `path` (format by extension: .exr, .png, .jpg, .tif).
+    /// Writes the montage to `path` (format by extension: .exr, .png, .jpg, .tif) carrying the
+    /// view's geometry (EXIF and XMP, or EXR attributes) as `photomontage render` and `view`
+    /// write it; without it when the photo's report cannot be made.
     ///
     /// # Errors
-    /// `NothingToExport` or the output module's error.
-    pub fn export(&self, path: &Path, tone_map: &ToneMap) -> Result<(), RenderPanelError> {
+    /// `NothingToExport` or the writer's error.
+    pub fn export(
+        &self,
+        doc: &SiteDocument,
+        path: &Path,
+        tone_map: &ToneMap,
+    ) -> Result<(), RenderPanelError> {
         let m = self
             .montage
             .as_ref()
             .ok_or(RenderPanelError::NothingToExport)?;
-        output::write_output(path, &m.image, &OutputLayers::default(), tone_map)?;
-        Ok(())
+        let metadata = match &m.geometry {
+            Some(g) => Some(ViewMetadata::from(g)),
+            None => view_metadata(doc, &m.photo_id).ok(),
+        };
+        write_render(
+            path,
+            &m.image,
+            &OutputLayers::default(),
+            tone_map,
+            metadata.as_ref(),
+        )
+        .map_err(|e| RenderPanelError::Render {
+            photo: m.photo_id.clone(),
+            message: e.to_string(),
+        })
     }
 
     /// Screen x of the A/B split line for a photo of width `width_px` under `t`.
@@ -328,7 +381,8 @@ impl RenderPanel {
         let Some(m) = self.montage.as_mut().filter(|m| m.photo_id == photo_id) else {
             return;
         };
-        if m.image.size_px != size_px {
+        let reprojected = m.geometry.is_some();
+        if m.image.size_px != size_px && !reprojected {
             return;
         }
         let texture = m.texture.get_or_insert_with(|| {
@@ -338,6 +392,20 @@ impl RenderPanel {
                 egui::TextureOptions::LINEAR,
             )
         });
+        if reprojected {
+            // A re-projected view is another image: shown whole, fitted over the photo's frame.
+            let [w, h] = size_px.map(f64::from);
+            let frame = t.screen_rect([0.0, 0.0], [w, h]);
+            let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+            painter.rect_filled(frame, 0.0, Color32::from_gray(30));
+            painter.image(
+                texture.id(),
+                fitted_rect(frame, m.image.size_px),
+                uv,
+                Color32::WHITE,
+            );
+            return;
+        }
         let split = self.ab_split.clamp(0.0, 1.0);
         let [w, h] = size_px.map(f64::from);
         let rect = t.screen_rect([f64::from(split) * w, 0.0], [w, h]);
@@ -374,7 +442,7 @@ impl crate::Studio {
             self.say("type an export path (.exr, .png, .jpg, .tif) first", true);
             return;
         }
-        match self.render.export(&path, &site_tone_map(doc)) {
+        match self.render.export(doc, &path, &site_tone_map(doc)) {
             Ok(()) => self.say(format!("exported {}", path.display()), false),
             Err(e) => self.say(e.to_string(), true),
         }
@@ -455,6 +523,7 @@ impl Panel for RenderPanel {
                 .response;
             name_widget(ui, &r, "AVR level");
         });
+        self.view_choice.ui(ui);
         ui.horizontal(|ui| {
             let busy = self.busy();
             if ui.add_enabled(!busy, egui::Button::new("Start")).clicked() {

@@ -1,6 +1,7 @@
 //! The Render panel's verified-view controls: the Sheet button (the verified-view PDF,
-//! `photomontage::verified::sheet`, of the finished view at the AVR level it was made with, on
-//! A3, the library's default paper) and the Report button (the view geometry report of the
+//! `photomontage::verified::sheet`, of the finished view — the photo, or a planar or cylindrical
+//! view with its own geometry — at the AVR level it was made with, on the paper chosen in the
+//! panel, A3 by default) and the Report button (the view geometry report of the
 //! current photo, `photomontage::verified::view_geometry`, shown as the sheet's table).
 
 use std::path::Path;
@@ -9,7 +10,8 @@ use eframe::egui;
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::encode_srgb8;
 use photomontage::site::SiteDocument;
-use photomontage::verified::sheet::{sheet_for_view, write_sheet};
+use photomontage::verified::reprojected_geometry::with_paper;
+use photomontage::verified::sheet::{SheetFormat, sheet_for_geometry, sheet_for_view, write_sheet};
 use photomontage::verified::sheet_content::geometry_rows;
 use photomontage::verified::{ViewGeometryOptions, view_geometry};
 
@@ -32,13 +34,23 @@ impl RenderPanel {
             let p = m.image.rgba[(y * w + x) as usize];
             image::Rgb(encode_srgb8([p[0], p[1], p[2]], tone_map))
         });
-        let pdf = sheet_for_view(
-            doc,
-            &m.photo_id,
-            &rgb,
-            m.avr,
-            &ViewGeometryOptions::default(),
-        )
+        let paper = self.view_choice.paper;
+        let pdf = match &m.geometry {
+            // A re-projected view: its own geometry, on the chosen paper.
+            Some(g) => {
+                sheet_for_geometry(doc, &with_paper(g, paper), &rgb, m.avr, SheetFormat::Pdf)
+            }
+            None => sheet_for_view(
+                doc,
+                &m.photo_id,
+                &rgb,
+                m.avr,
+                &ViewGeometryOptions {
+                    paper,
+                    ground_level_m: None,
+                },
+            ),
+        }
         .map_err(Box::new)?;
         write_sheet(path, &pdf).map_err(Box::new)?;
         Ok(())

@@ -47,7 +47,11 @@ fn tiles_rendered_alone_and_merged_equal_the_whole_render_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let site = tall_site(dir.path());
     let d = |name: &str| dir.path().join(name);
-    for (ext, layers) in [("exr", "depth,object_id,shadow_change"), ("png", "")] {
+    for (ext, layers) in [
+        ("exr", "depth,object_id,shadow_change"),
+        ("png", ""),
+        ("tif", ""),
+    ] {
         let whole = d(&format!("whole.{ext}"));
         let mut args = vec!["render", s(&site), "--view", "p1", "--out", s(&whole)];
         if !layers.is_empty() {
@@ -86,13 +90,17 @@ fn tiles_rendered_alone_and_merged_equal_the_whole_render_byte_for_byte() {
                 std::fs::read(&whole).unwrap(),
                 "{count} tiles merged into .{ext}"
             );
-            if ext == "png" {
-                // The view geometry travels through the parts into the merged PNG's EXIF.
-                let bytes = std::fs::read(&merged).unwrap();
-                assert!(
-                    bytes.windows(4).any(|w| w == b"eXIf"),
-                    "merged PNG has EXIF"
-                );
+            // The view geometry travels through the parts into the merged file: EXIF and XMP
+            // in PNG and TIFF, header attributes in EXR.
+            let bytes = std::fs::read(&merged).unwrap();
+            let has = |needle: &[u8]| bytes.windows(needle.len()).any(|w| w == needle);
+            match ext {
+                "png" => assert!(has(b"eXIf") && has(b"XML:com.adobe.xmp"), "PNG EXIF, XMP"),
+                "tif" => assert!(has(b"urn:photomontage:view:1.0/"), "TIFF XMP"),
+                _ => assert!(
+                    has(b"photomontage.view") && has(b"software"),
+                    "EXR attributes"
+                ),
             }
             if ext == "exr" {
                 let table = |p: &Path| std::fs::read(p.with_extension("objects.json")).unwrap();

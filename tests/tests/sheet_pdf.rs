@@ -10,9 +10,12 @@ use std::process::Command;
 
 use photomontage::colour::{ToneCurve, ToneMap, encode_srgb8};
 use photomontage::verified::avr::{AvrLevel, avr_overlay};
-use photomontage::verified::sheet::{sheet_for_view, write_sheet};
-use photomontage::verified::{PaperSize, ViewGeometryOptions, view_geometry};
+use photomontage::verified::cylindrical_view::CylindricalOptions;
+use photomontage::verified::sheet::{SheetFormat, sheet_for_geometry, sheet_for_view, write_sheet};
+use photomontage::verified::standard_view::{StandardView, make_view};
+use photomontage::verified::{PaperSize, ViewGeometryOptions, ViewProjection, view_geometry};
 use photomontage_tests::truth::site_with_true_cameras;
+use std::sync::atomic::AtomicBool;
 
 /// The issue's bound on the printed image width against the viewing-distance formula.
 const PRINTED_WIDTH_TOL_MM: f64 = 0.5;
@@ -296,4 +299,198 @@ fn html_sheet_of_the_street() {
         "numbers missing from the HTML: {missing:?}"
     );
     assert!(html.contains("TGN 06/19 Type 4") && html.contains("Methodology"));
+}
+
+/// The sheet of a re-projected view (planar or cylindrical) of the street site, AVR1: page size,
+/// every number of its report in the text, and the printed width against the view's own
+/// viewing-distance formula (`d · 2·tan(HFoV/2)` flat, `d · HFoV` for a cylinder).
+fn check_reprojected_sheet(view: StandardView, paper: PaperSize, page_pt: [f64; 2]) {
+    let doc = site_with_true_cameras("street");
+    let options = ViewGeometryOptions {
+        paper,
+        ..ViewGeometryOptions::default()
+    };
+    let made = make_view(
+        &doc,
+        &view,
+        Some(AvrLevel::Avr1),
+        &options,
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let report = &made.geometry;
+    let tone = ToneMap {
+        exposure_stops: 0.0,
+        curve: ToneCurve::Clamp,
+    };
+    let [w, h] = made.image.size_px;
+    let rgb = image::RgbImage::from_fn(w, h, |x, y| {
+        let p = made.image.rgba[(y * w + x) as usize];
+        image::Rgb(encode_srgb8([p[0], p[1], p[2]], &tone))
+    });
+    let pdf = sheet_for_geometry(&doc, report, &rgb, AvrLevel::Avr1, SheetFormat::Pdf).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sheet.pdf");
+    write_sheet(&path, &pdf).unwrap();
+
+    let [w_pt, h_pt, _, _] = image_placement_pt(&pdf);
+    let printed_mm = w_pt * 25.4 / 72.0;
+    let hfov = report.hfov_deg.to_radians();
+    let want_mm = match report.projection {
+        ViewProjection::Cylindrical => report.viewing_distance_mm * hfov,
+        _ => report.viewing_distance_mm * 2.0 * (hfov / 2.0).tan(),
+    };
+    println!(
+        "{} {:?}: {w}×{h} px, HFoV {:.3}°, printed {printed_mm:.3} mm (formula {want_mm:.3} mm), \
+         viewing distance {:.1} mm",
+        paper.name(),
+        report.projection,
+        report.hfov_deg,
+        report.viewing_distance_mm
+    );
+    assert!((printed_mm - want_mm).abs() < PRINTED_WIDTH_TOL_MM);
+    assert!(
+        (h_pt / w_pt - f64::from(h) / f64::from(w)).abs() < 1e-4,
+        "aspect kept"
+    );
+
+    let p = path.to_str().unwrap();
+    let Some(info) = poppler("pdfinfo", &[p]) else {
+        return;
+    };
+    assert!(info.contains("Pages:           2"), "{info}");
+    let size_line = info.lines().find(|l| l.starts_with("Page size:")).unwrap();
+    let dims: Vec<f64> = size_line
+        .split_whitespace()
+        .filter_map(|t| t.parse().ok())
+        .collect();
+    assert!(
+        (dims[0] - page_pt[0]).abs() < PAGE_SIZE_TOL_PT
+            && (dims[1] - page_pt[1]).abs() < PAGE_SIZE_TOL_PT,
+        "{size_line}"
+    );
+    let text = poppler("pdftotext", &["-layout", p, "-"]).unwrap();
+    let json = serde_json::to_value(report).unwrap();
+    let missing: Vec<String> = number_strings(&json)
+        .into_iter()
+        .filter(|s| !text.contains(s.as_str()))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "numbers of the report missing from the PDF text: {missing:?}"
+    );
+    let projection = match report.projection {
+        ViewProjection::Cylindrical => "cylindrical, from",
+        _ => "planar, from",
+    };
+    assert!(text.contains(projection), "{projection}");
+    if report.projection == ViewProjection::Cylindrical {
+        assert!(text.contains("curve it about the eye"));
+    }
+}
+
+#[test]
+fn a3_sheet_of_a_50mm_planar_view() {
+    check_reprojected_sheet(
+        StandardView::Planar {
+            photo: "V1".into(),
+            focal_equiv_mm: 50.0,
+            size_px: Some([640, 480]),
+        },
+        PaperSize::A3,
+        [1190.55, 841.89],
+    );
+}
+
+#[test]
+fn a2_sheet_of_a_cylindrical_view() {
+    // A2: 594 × 420 mm = 1683.78 × 1190.55 pt.
+    check_reprojected_sheet(
+        StandardView::Cylindrical {
+            photos: vec!["V1".into()],
+            options: CylindricalOptions::default(),
+        },
+        PaperSize::A2,
+        [1683.78, 1190.55],
+    );
+}
+
+#[test]
+fn reprojected_views_refuse_bad_input_by_photo() {
+    let doc = site_with_true_cameras("street");
+    let make = |view: &StandardView| {
+        make_view(
+            &doc,
+            view,
+            Some(AvrLevel::Avr1),
+            &ViewGeometryOptions::default(),
+            &|_| {},
+            &AtomicBool::new(false),
+        )
+        .map(|_| ())
+        .unwrap_err()
+        .to_string()
+    };
+    // A panorama from photos metres apart names a photo and the rule.
+    let err = make(&StandardView::Cylindrical {
+        photos: vec!["V1".into(), "V3".into()],
+        options: CylindricalOptions::default(),
+    });
+    assert!(
+        err.contains("was not taken from the same point")
+            && (err.contains("V1") || err.contains("V3")),
+        "{err}"
+    );
+    // A focal length that cannot be converted.
+    let err = make(&StandardView::Planar {
+        photo: "V2".into(),
+        focal_equiv_mm: -5.0,
+        size_px: None,
+    });
+    assert!(err.contains("V2") && err.contains("35 mm"), "{err}");
+    // A view with no solved camera.
+    let unsolved = photomontage::site::SiteDocument::load(
+        &photomontage_tests::sample_site("street").join("site.toml"),
+    )
+    .unwrap();
+    let err = make_view(
+        &unsolved,
+        &StandardView::Planar {
+            photo: "V2".into(),
+            focal_equiv_mm: 50.0,
+            size_px: None,
+        },
+        Some(AvrLevel::Avr1),
+        &ViewGeometryOptions::default(),
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("V2") && err.contains("not solved"), "{err}");
+    // No proposal: a site without visible models.
+    let mut bare = site_with_true_cameras("street");
+    for m in &mut bare.site.models {
+        m.visible = false;
+    }
+    let err = make_view(
+        &bare,
+        &StandardView::Cylindrical {
+            photos: vec!["V1".into()],
+            options: CylindricalOptions::default(),
+        },
+        Some(AvrLevel::Avr1),
+        &ViewGeometryOptions::default(),
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("V1") && err.contains("no visible model"),
+        "{err}"
+    );
 }

@@ -15,15 +15,14 @@
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use crate::render::output::{LayerSet, OutputFormat, write_object_table, write_output};
-use crate::render::partial::{
-    PartError, from_hex, merge_parts, read_part_info, to_hex, write_part,
-};
+use crate::render::output::{LayerSet, OutputFormat, write_object_table};
+use crate::render::partial::{PartError, merge_parts, read_part_info, write_part};
 use crate::render::{Band, TileProgress};
 use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 use crate::site::render_photo::{RenderPlan, RenderRequest, site_content_sha256};
-use crate::verified::image_metadata::{view_exif, write_render};
+use crate::verified::ViewMetadata;
+use crate::verified::image_metadata::{view_metadata, write_render};
 
 /// The `format` of a job list this version writes and reads.
 pub const JOBS_FORMAT: &str = "photomontage-jobs/1";
@@ -436,7 +435,9 @@ pub fn run_job(
     let rendered = plan.render(&doc, on_tile, cancel)?;
     let mut info = plan.part_info(&rendered);
     // 8-bit merges carry the view geometry as EXIF, as a whole-image `render` writes it.
-    info.exif_hex = view_exif(&doc, &job.view).ok().map(|b| to_hex(&b));
+    info.view_json = view_metadata(&doc, &job.view)
+        .ok()
+        .map(|m| m.to_ascii_json());
     write_part(&output, &rendered.image, &rendered.layers, &info)?;
     Ok(JobOutcome::Rendered {
         output,
@@ -508,20 +509,25 @@ pub fn merge_to_file(
     let merged = merge_parts(parts)?;
     let tone_map = crate::colour::ToneMap::clamp_with_exposure(merged.info.exposure);
     let format = OutputFormat::from_path(out).map_err(|e| FarmError::Argument(e.to_string()))?;
+    // The view the whole render would carry: EXIF and XMP in 8-bit images, attributes in EXR.
+    let view: Option<ViewMetadata> = merged
+        .info
+        .view_json
+        .as_deref()
+        .and_then(|j| serde_json::from_str(j).ok());
     if format == OutputFormat::Exr {
-        write_output(out, &merged.image, &merged.layers, &tone_map)?;
+        write_render(out, &merged.image, &merged.layers, &tone_map, view.as_ref())?;
         if let (Some(names), Some(_)) = (&merged.info.object_names, &merged.layers.object_id) {
             write_object_table(out, names)?;
         }
     } else {
-        // 8-bit images drop the layers and carry the view's EXIF, as `render` writes them.
-        let exif = merged.info.exif_hex.as_deref().and_then(from_hex);
+        // 8-bit images drop the layers and carry the view, as `render` writes them.
         write_render(
             out,
             &merged.image,
             &crate::render::output::OutputLayers::default(),
             &tone_map,
-            exif,
+            view.as_ref(),
         )?;
     }
     Ok(merged)

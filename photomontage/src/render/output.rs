@@ -227,12 +227,32 @@ pub fn write_exr(
     image: &RenderedImage,
     layers: &OutputLayers,
 ) -> Result<(), OutputError> {
+    write_exr_with(
+        path,
+        image,
+        layers,
+        exr::prelude::LayerAttributes::default(),
+    )
+}
+
+/// [`write_exr`] with the layer's header `attributes` (owner, comments, capture date, position,
+/// custom ones in `other`). Keep at most one entry in `attributes.other`: it is a hash map, and
+/// with several the header's byte order would vary from run to run.
+///
+/// # Errors
+/// [`OutputError::Write`].
+pub fn write_exr_with(
+    path: &Path,
+    image: &RenderedImage,
+    layers: &OutputLayers,
+    attributes: exr::prelude::LayerAttributes,
+) -> Result<(), OutputError> {
     use exr::prelude::*;
     let [w, h] = image.size_px;
     let channels = exr_channels(image, layers);
     let layer = Layer::new(
         (w as usize, h as usize),
-        LayerAttributes::default(),
+        attributes,
         // ZIP over scan lines in increasing order: lossless, and the block order (so the file's
         // bytes) does not depend on which compression thread finishes first.
         Encoding::SMALL_LOSSLESS,

@@ -52,13 +52,14 @@ pub struct PartInfo {
     pub changed_pixels: usize,
     /// Primary rays shot in the band.
     pub primary_rays: u64,
-    /// EXIF block (TIFF-structured bytes, hex) that 8-bit outputs of the merged image carry:
-    /// the view geometry, so that a merged JPEG/PNG equals the whole render's byte for byte.
+    /// The view geometry the merged image carries (JSON of `verified::ViewMetadata`, opaque
+    /// here): EXIF and XMP in 8-bit outputs, header attributes in EXR, so that a merged file
+    /// equals the whole render's byte for byte.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub exif_hex: Option<String>,
+    pub view_json: Option<String>,
 }
 
-/// Lower-case hex of `bytes` (for [`PartInfo::exif_hex`]).
+/// Lower-case hex of `bytes` (content hashes in the job identity).
 #[must_use]
 pub fn to_hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()

@@ -79,7 +79,7 @@ fn write_bands(dir: &Path, count: u32, seed: &str) -> Vec<PathBuf> {
                 object_names: Some(vec!["polygon:ground".into(), "model:Ü".into()]),
                 changed_pixels: 1,
                 primary_rays: 2,
-                exif_hex: None,
+                view_json: None,
             };
             let path = dir.join(format!("{seed}-{i}-of-{count}.exr"));
             write_part(&path, &part_image, &part_layers, &info).unwrap();
@@ -207,7 +207,7 @@ fn a_band_image_that_does_not_fit_its_rows_is_not_written() {
         object_names: None,
         changed_pixels: 0,
         primary_rays: 0,
-        exif_hex: None,
+        view_json: None,
     };
     let path = dir.path().join("bad.exr");
     assert!(write_part(&path, &image, &layers, &info).is_err());

@@ -753,7 +753,7 @@ fn bands_rendered_alone_merge_into_the_whole_render_byte_for_byte() {
                 object_names: None,
                 changed_pixels: img.changed_pixels,
                 primary_rays: img.primary_rays,
-                exif_hex: None,
+                view_json: None,
             };
             let path = dir.path().join(format!("part-{index}-of-{count}.exr"));
             write_part(&path, &img, &layers, &info).unwrap();

@@ -318,7 +318,7 @@ impl RenderPlan {
                 .then(|| rendered.object_names.clone()),
             changed_pixels: rendered.image.changed_pixels,
             primary_rays: rendered.image.primary_rays,
-            exif_hex: None,
+            view_json: None,
         }
     }
 }

@@ -66,6 +66,9 @@ pub enum ViewGeometryError {
     /// The view is unknown or not solved, or the scene cannot be built.
     #[error(transparent)]
     Site(#[from] SiteRenderError),
+    /// A view made from several photos was given none.
+    #[error("a view needs at least one solved photo; none was given")]
+    NoPhotos,
     /// The optical axis is vertical: no bearing and no roll.
     #[error("photo {photo}: the optical axis is vertical, so bearing and roll are undefined")]
     VerticalAxis { photo: String },
@@ -79,6 +82,22 @@ pub enum ViewGeometryError {
         focal_px: f64,
         image_size_px: [u32; 2],
     },
+}
+
+/// What image the geometry describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ViewProjection {
+    /// The photo itself (its solved camera).
+    #[default]
+    Photo,
+    /// A pinhole view re-projected from a photo to a standard focal length
+    /// ([`super::planar_view`]).
+    Planar,
+    /// A level cylinder composed from several photos taken from one point
+    /// ([`super::cylindrical_view`]): `focal_px` is the cylinder radius, the fields of view are
+    /// the cylinder's.
+    Cylindrical,
 }
 
 /// Where the ground level below the camera came from.
@@ -117,7 +136,12 @@ pub struct ResidualRow {
 /// says otherwise; `None` (JSON `null`) where the site does not give what is needed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ViewGeometry {
+    /// The view's name: the photo's id, or the photos' ids joined by `+` for a cylinder.
     pub photo_id: String,
+    /// The image described: the photo, or a view re-projected from it.
+    pub projection: ViewProjection,
+    /// The solved photos the view is made from.
+    pub source_photos: Vec<String>,
     /// Projection centre [E, N, H] in the survey CRS.
     pub camera_position_m: [f64; 3],
     /// The survey CRS named by the site (`location.crs`).
@@ -483,6 +507,8 @@ pub fn view_geometry(
     let printed_image_width_mm = layout.printed_image_size_mm(intr.image_size_px)[0];
     Ok(ViewGeometry {
         photo_id: photo_id.to_owned(),
+        projection: ViewProjection::Photo,
+        source_photos: vec![photo_id.to_owned()],
         camera_position_m: centre.coords.into(),
         crs: crs_name,
         latitude_deg: lat_lon.map(|(lat, _)| lat),

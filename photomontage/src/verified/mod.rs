@@ -13,7 +13,10 @@
 //! - [`wireline`]: the proposal's feature edges with hidden-line removal;
 //! - [`planar_view`]: a photo re-projected to a standard (50 mm, 75 mm) focal length;
 //! - [`cylindrical_view`]: a panorama from several photos taken from one point;
-//! - [`image_metadata`]: the view geometry as EXIF in JPEG/PNG output;
+//! - [`reprojected_geometry`]: the view geometry of planar and cylindrical views;
+//! - [`standard_view`]: any of these views with the proposal at an AVR level, and its geometry;
+//! - [`view_metadata`], [`xmp`], [`tiff_ifd`] and [`image_metadata`]: the view geometry carried by
+//!   output images (EXIF and XMP in JPEG, PNG and TIFF; header attributes in EXR);
 //! - [`sheet`] (with [`sheet::html`]) and [`sheet_content`]: the sheet as PDF or HTML (view at print
 //!   scale, viewing distance, ruler, geometry table, map inset, AVR level, methodology and
 //!   residuals).
@@ -28,10 +31,18 @@ pub mod image_metadata;
 pub mod measure;
 pub mod paper;
 pub mod planar_view;
+pub mod reprojected_geometry;
 pub mod sheet;
 pub mod sheet_content;
+pub mod standard_view;
+pub mod tiff_ifd;
+pub mod view_metadata;
 pub mod wireline;
+pub mod xmp;
 
 pub use avr::{AvrLevel, AvrOverlay, apply_massing, avr_overlay};
-pub use geometry::{ViewGeometry, ViewGeometryError, ViewGeometryOptions, view_geometry};
+pub use geometry::{
+    ViewGeometry, ViewGeometryError, ViewGeometryOptions, ViewProjection, view_geometry,
+};
 pub use paper::PaperSize;
+pub use view_metadata::ViewMetadata;

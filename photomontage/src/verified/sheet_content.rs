@@ -15,13 +15,39 @@
 use nalgebra::Point3;
 
 use super::avr::AvrLevel;
-use super::geometry::{GroundSource, ViewGeometry};
+use super::geometry::{GroundSource, ViewGeometry, ViewProjection};
 use crate::scene::ObjectKind;
 use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 
 fn opt(v: Option<f64>, digits: usize, unit: &str) -> String {
     v.map_or_else(|| "unknown".to_owned(), |v| format!("{v:.digits$}{unit}"))
+}
+
+/// The sheet's viewing-distance sentence: for a photo or planar view the flat print seen from
+/// the viewing distance; for a cylinder the print curved about the eye at that radius.
+#[must_use]
+pub fn viewing_sentence(r: &ViewGeometry) -> String {
+    match r.projection {
+        ViewProjection::Photo | ViewProjection::Planar => format!(
+            "Viewing distance {:.1} mm: the image is printed {:.1} mm wide on {} landscape; view \
+             it from {:.1} mm for the correct perspective (HFoV {:.3} deg).",
+            r.viewing_distance_mm,
+            r.printed_image_width_mm,
+            r.paper.name(),
+            r.viewing_distance_mm,
+            r.hfov_deg
+        ),
+        ViewProjection::Cylindrical => format!(
+            "Viewing distance {:.1} mm: the panorama is printed {:.1} mm wide on {} landscape; \
+             curve it about the eye at a radius of {:.1} mm (width / HFoV {:.3} deg in radians).",
+            r.viewing_distance_mm,
+            r.printed_image_width_mm,
+            r.paper.name(),
+            r.viewing_distance_mm,
+            r.hfov_deg
+        ),
+    }
 }
 
 /// The view geometry table: (label, value) rows, every number of the report.
@@ -37,6 +63,16 @@ pub fn geometry_rows(r: &ViewGeometry) -> Vec<(String, String)> {
     };
     let rows: Vec<(&str, String)> = vec![
         ("Photo", r.photo_id.clone()),
+        (
+            "Projection",
+            match r.projection {
+                ViewProjection::Photo => "photo (as taken)".to_owned(),
+                ViewProjection::Planar => format!("planar, from {}", r.source_photos.join(" ")),
+                ViewProjection::Cylindrical => {
+                    format!("cylindrical, from {}", r.source_photos.join(" "))
+                }
+            },
+        ),
         ("Camera E", format!("{e:.3} m")),
         ("Camera N", format!("{n:.3} m")),
         ("Camera H (datum)", format!("{h:.3} m")),
@@ -156,7 +192,8 @@ pub fn methodology(
     avr: AvrLevel,
 ) -> Vec<(String, Vec<String>)> {
     let site = &doc.site;
-    let photo = site.photos.iter().find(|p| p.id == r.photo_id);
+    let photo_id = r.source_photos.first().unwrap_or(&r.photo_id);
+    let photo = site.photos.iter().find(|p| &p.id == photo_id);
     let enabled = site.control_points.iter().filter(|c| c.enabled).count();
     let camera_name = photo
         .and_then(|p| crate::photo::read_exif(&doc.resolve(&p.file)).ok())
@@ -199,6 +236,20 @@ pub fn methodology(
                 ),
                 "Pinhole with Brown-Conrady distortion (Durisch 1992 s3.5; OpenCV convention)."
                     .into(),
+                match r.projection {
+                    ViewProjection::Photo => "The view is the photo as taken.".to_owned(),
+                    ViewProjection::Planar => format!(
+                        "Planar view re-projected from photo {} to a {:.2} mm equivalent \
+                         (distortion-free pinhole, same centre and rotation).",
+                        photo_id, r.focal_35mm_equiv_mm
+                    ),
+                    ViewProjection::Cylindrical => format!(
+                        "Cylindrical view composed from photos {} (level cylinder, radius {:.2} px, \
+                         seams feathered); viewing distance = printed width / HFoV in radians.",
+                        r.source_photos.join(", "),
+                        r.focal_px
+                    ),
+                },
             ],
         ),
         (

@@ -7,11 +7,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use photomontage::colour::ToneMap;
 use photomontage::render::Band;
 use photomontage::render::output::{self, LayerSet, OutputFormat};
-use photomontage::render::partial::to_hex;
 use photomontage::render::partial::write_part;
 use photomontage::site::SiteDocument;
 use photomontage::site::render_photo::{RenderPlan, RenderRequest};
-use photomontage::verified::image_metadata::{view_exif, write_render};
+use photomontage::verified::ViewMetadata;
+use photomontage::verified::image_metadata::{view_metadata, write_render};
 use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -63,12 +63,13 @@ pub struct Args {
     avr: u8,
 }
 
-/// The view geometry as EXIF for 8-bit outputs; a warning (and no EXIF) when it cannot be had.
-fn exif_of(doc: &SiteDocument, view: &str) -> Option<Vec<u8>> {
-    match view_exif(doc, view) {
-        Ok(exif) => Some(exif),
+/// The view geometry the output carries (EXIF and XMP, EXR attributes); a warning (and none)
+/// when it cannot be had.
+fn view_of(doc: &SiteDocument, view: &str) -> Option<ViewMetadata> {
+    match view_metadata(doc, view) {
+        Ok(m) => Some(m),
         Err(e) => {
-            eprintln!("warning: no view geometry in the image's EXIF: {e}");
+            eprintln!("warning: no view geometry in the image's metadata: {e}");
             None
         }
     }
@@ -89,7 +90,7 @@ fn draw_overlay(
         &overlay.image,
         &output::OutputLayers::default(),
         &tone_map,
-        exif_of(doc, &args.view),
+        view_of(doc, &args.view).as_ref(),
     )?;
     println!(
         "drew {} ({}) of view {} into {}: {} pixels",
@@ -235,18 +236,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let elapsed_s = start.elapsed().as_secs_f64();
     let image = &rendered.image;
-    let exif = if format == OutputFormat::Exr && band.is_none() {
-        None
-    } else {
-        exif_of(&doc, &args.view)
-    };
+    let view = view_of(&doc, &args.view);
     let table = if band.is_some() {
         let mut info = plan.part_info(&rendered);
-        info.exif_hex = exif.as_deref().map(to_hex);
+        info.view_json = view.as_ref().map(ViewMetadata::to_ascii_json);
         write_part(&args.out, image, &rendered.layers, &info)?;
         None
     } else {
-        write_render(&args.out, image, &rendered.layers, &plan.tone_map(), exif)?;
+        write_render(
+            &args.out,
+            image,
+            &rendered.layers,
+            &plan.tone_map(),
+            view.as_ref(),
+        )?;
         if layers.object_id {
             Some(output::write_object_table(
                 &args.out,

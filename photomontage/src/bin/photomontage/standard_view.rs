@@ -1,18 +1,18 @@
 //! `photomontage view SITE --from V1[,V2,…] --projection planar|cylindrical --focal-equiv-mm 50
 //! --out FILE`: a solved photo re-projected to a standard focal length (TGN 06/19 planar views),
 //! or a cylindrical panorama of several photos taken from one point. The computations are
-//! `photomontage::verified::{planar_view, cylindrical_view}`; this file parses, writes the image
-//! and its projection (`FILE` with the extension `.camera.json` or `.cylinder.json`), and prints a
-//! summary.
+//! `photomontage::verified::standard_view`; this file parses, writes the image carrying the
+//! view's geometry (EXIF and XMP, or EXR attributes) and its projection (`FILE` with the extension
+//! `.camera.json` or `.cylinder.json`), and prints a summary.
 
 use anyhow::{Context, bail};
 use photomontage::colour::ToneMap;
 use photomontage::render::output;
-use photomontage::render::{DifferentialTracer, render_view};
 use photomontage::site::{SiteDocument, write_atomically};
-use photomontage::verified::cylindrical_view::{CylindricalOptions, site_cylindrical_view};
-use photomontage::verified::geometry::fields_of_view_deg;
-use photomontage::verified::planar_view::{planar_view, planar_view_job};
+use photomontage::verified::cylindrical_view::CylindricalOptions;
+use photomontage::verified::image_metadata::write_render;
+use photomontage::verified::standard_view::{StandardView, make_view};
+use photomontage::verified::{AvrLevel, ViewGeometryOptions, ViewMetadata};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
@@ -48,8 +48,9 @@ pub struct Args {
     /// refused (metres).
     #[arg(long, value_name = "M", default_value_t = 0.1)]
     max_centre_spread_m: f64,
-    /// Planar: render the montage (AVR3, the site's render settings) into the view, as into a
-    /// photo, instead of writing the re-projected photo alone.
+    /// Render the montage (AVR3, the site's render settings) into the view, as into a photo,
+    /// instead of writing the re-projected photos alone (cylindrical: each photo's montage,
+    /// composed on the cylinder).
     #[arg(long)]
     montage: bool,
     /// Planar: output size WIDTHxHEIGHT in pixels; default: the photo's size.
@@ -77,9 +78,9 @@ fn parse_size(text: &str) -> anyhow::Result<[u32; 2]> {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     output::OutputFormat::from_path(&args.out)?;
     let size = args.size.as_deref().map(parse_size).transpose()?;
-    let ids: Vec<&str> = args.from.split(',').map(str::trim).collect();
+    let ids: Vec<String> = args.from.split(',').map(|s| s.trim().to_owned()).collect();
     let doc = SiteDocument::load(&args.site)?;
-    let (image, projection_json, summary) = match args.projection {
+    let view = match args.projection {
         Projection::Planar => {
             let [id] = ids.as_slice() else {
                 bail!(
@@ -88,99 +89,92 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     args.from
                 );
             };
-            let (view, image) = if args.montage {
-                let (view, job) = planar_view_job(&doc, id, args.focal_equiv_mm, size)?;
-                for w in &job.warnings {
-                    eprintln!("warning: {w}");
-                }
-                let tracer = DifferentialTracer::new(
-                    &job.scene.scene,
-                    &job.lighting,
-                    &job.camera,
-                    &job.photo_linear,
-                    job.settings.max_depth,
-                )?;
-                eprintln!("rendering the montage into the view");
-                let montage =
-                    render_view(&tracer, &job.settings, &|_| {}, &AtomicBool::new(false))?;
-                (view, montage)
-            } else {
-                let view = planar_view(&doc, id, args.focal_equiv_mm, size)?;
-                let image = view.image.clone();
-                (view, image)
-            };
-            let [hfov, vfov] = fields_of_view_deg(&view.camera.intrinsics);
-            let [w, h] = view.camera.intrinsics.image_size_px;
-            if view.coverage < 1.0 {
-                eprintln!(
-                    "warning: the photo does not fill the view (its focal length is longer than \
-                     {} mm equivalent in some direction); uncovered pixels are transparent",
-                    args.focal_equiv_mm
-                );
+            StandardView::Planar {
+                photo: id.clone(),
+                focal_equiv_mm: args.focal_equiv_mm,
+                size_px: size,
             }
-            let summary = format!(
-                "planar view of photo {id} at {} mm equivalent: {w}×{h} px, f {:.2} px, field of \
-                 view {hfov:.3}° × {vfov:.3}°, {:.1} % covered by the photo",
-                args.focal_equiv_mm,
-                view.camera.intrinsics.focal_px,
-                100.0 * view.coverage
-            );
-            (
-                image,
-                ("camera.json", serde_json::to_string_pretty(&view.camera)?),
-                summary,
-            )
         }
         Projection::Cylindrical => {
-            if args.montage {
-                bail!("--montage is for planar views (the renderer needs a pinhole camera)");
-            }
             if size.is_some() {
                 bail!(
                     "--size is for planar views; a cylindrical view's size follows from its photos"
                 );
             }
-            let options = CylindricalOptions {
-                focal_equiv_mm: args.focal_equiv_mm,
-                max_centre_spread_m: args.max_centre_spread_m,
-                ..CylindricalOptions::default()
-            };
-            let view = site_cylindrical_view(&doc, &ids, &options)?;
-            let c = view.cylinder;
-            let summary = format!(
-                "cylindrical view of photos {} at {} mm equivalent: {}×{} px, radius {:.2} px, \
-                 {:.2}° wide from bearing {:.3}° (grid)",
-                ids.join(", "),
-                args.focal_equiv_mm,
-                c.size_px[0],
-                c.size_px[1],
-                c.focal_px,
-                f64::from(c.size_px[0]) / c.focal_px * 180.0 / std::f64::consts::PI,
-                c.azimuth_left.to_degrees().rem_euclid(360.0)
-            );
-            (
-                view.image,
-                ("cylinder.json", serde_json::to_string_pretty(&c)?),
-                summary,
-            )
+            StandardView::Cylindrical {
+                photos: ids.clone(),
+                options: CylindricalOptions {
+                    focal_equiv_mm: args.focal_equiv_mm,
+                    max_centre_spread_m: args.max_centre_spread_m,
+                    ..CylindricalOptions::default()
+                },
+            }
         }
     };
+    let avr = args.montage.then_some(AvrLevel::Avr3);
+    if avr.is_some() {
+        eprintln!("rendering the montage into the view");
+    }
+    let made = make_view(
+        &doc,
+        &view,
+        avr,
+        &ViewGeometryOptions::default(),
+        &|_| {},
+        &AtomicBool::new(false),
+    )?;
+    for w in &made.warnings {
+        eprintln!("warning: {w}");
+    }
+    let g = &made.geometry;
+    let [w, h] = g.image_size_px;
+    if made.coverage < 1.0 {
+        eprintln!(
+            "warning: the photos cover {:.1} % of the view (a focal length shorter than the \
+             photo's, or gaps between the photos); uncovered pixels are transparent",
+            100.0 * made.coverage
+        );
+    }
+    let summary = match args.projection {
+        Projection::Planar => format!(
+            "planar view of photo {} at {} mm equivalent: {w}×{h} px, f {:.2} px, field of view \
+             {:.3}° × {:.3}°, {:.1} % covered by the photo",
+            g.photo_id,
+            args.focal_equiv_mm,
+            g.focal_px,
+            g.hfov_deg,
+            g.vfov_deg,
+            100.0 * made.coverage
+        ),
+        Projection::Cylindrical => format!(
+            "cylindrical view of photos {} at {} mm equivalent: {w}×{h} px, radius {:.2} px, \
+             {:.2}° wide centred on bearing {:.3}° (grid)",
+            ids.join(", "),
+            args.focal_equiv_mm,
+            g.focal_px,
+            g.hfov_deg,
+            g.bearing_grid_deg
+        ),
+    };
     let tone_map = ToneMap::clamp_with_exposure(doc.site.render.exposure);
-    output::write_output(
+    let metadata = ViewMetadata::from(g);
+    write_render(
         &args.out,
-        &image,
+        &made.image,
         &output::OutputLayers::default(),
         &tone_map,
+        Some(&metadata),
     )?;
-    let (extension, json) = projection_json;
-    let side_path = args.out.with_extension(extension);
-    write_atomically(&side_path, json.as_bytes())
-        .with_context(|| format!("cannot write {}", side_path.display()))?;
     println!("{summary}");
-    println!(
-        "  wrote {} and its projection {}",
-        args.out.display(),
-        side_path.display()
-    );
+    if let Some((extension, json)) = &made.projection_json {
+        let side_path = args.out.with_extension(extension);
+        write_atomically(&side_path, json.as_bytes())
+            .with_context(|| format!("cannot write {}", side_path.display()))?;
+        println!(
+            "  wrote {} (with its view geometry) and its projection {}",
+            args.out.display(),
+            side_path.display()
+        );
+    }
     Ok(())
 }

@@ -14,7 +14,7 @@ use std::io::Cursor;
 use image::RgbImage;
 
 use super::{JPEG_QUALITY, SheetError, SheetInput};
-use crate::verified::sheet_content::{geometry_rows, residual_lines};
+use crate::verified::sheet_content::{geometry_rows, residual_lines, viewing_sentence};
 
 const BASE64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
@@ -107,15 +107,9 @@ pub fn sheet_html(input: &SheetInput<'_>) -> Result<String, SheetError> {
         escape(input.avr.description())
     ));
     s.push_str(&format!(
-        "<p>Viewing distance {:.1} mm: the image is printed {:.1} mm wide on {} landscape; view \
-         it from {:.1} mm for the correct perspective (HFoV {:.3} deg). Print at 100 % (not \
-         \"fit to page\"); the ruler below is 100 mm long when the scale is right.</p>\n\
-         <div class=\"ruler\"></div>\n",
-        r.viewing_distance_mm,
-        r.printed_image_width_mm,
-        r.paper.name(),
-        r.viewing_distance_mm,
-        r.hfov_deg
+        "<p>{} Print at 100 % (not \"fit to page\"); the ruler below is 100 mm long when the \
+         scale is right.</p>\n<div class=\"ruler\"></div>\n",
+        escape(&viewing_sentence(r))
     ));
     s.push_str("<table class=\"geometry\">\n");
     for (label, value) in geometry_rows(r) {

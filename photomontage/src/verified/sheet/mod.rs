@@ -28,7 +28,9 @@ use pdf_writer::{Content, Filter, Finish, Name, Pdf, Rect, Ref, Str};
 
 use super::avr::AvrLevel;
 use super::geometry::{ViewGeometry, ViewGeometryError, ViewGeometryOptions, view_geometry};
-use super::sheet_content::{MapInset, geometry_rows, map_inset, methodology, residual_lines};
+use super::sheet_content::{
+    MapInset, geometry_rows, map_inset, methodology, residual_lines, viewing_sentence,
+};
 use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 
@@ -54,7 +56,7 @@ pub enum SheetError {
     },
     #[error("photo {photo}: cannot encode the sheet image: {message}")]
     Encode { photo: String, message: String },
-    #[error("photo {photo}: the sheet image is {image_px:?} px but the photo is {photo_px:?} px")]
+    #[error("view {photo}: the sheet image is {image_px:?} px but the view is {photo_px:?} px")]
     SizeMismatch {
         photo: String,
         image_px: [u32; 2],
@@ -400,15 +402,7 @@ pub fn sheet_pdf(input: &SheetInput<'_>) -> Result<Vec<u8>, SheetError> {
         margin,
         band_top - 4.5 * scale,
         title,
-        &format!(
-            "Viewing distance {:.1} mm: the image is printed {:.1} mm wide on {} landscape; view it \
-             from {:.1} mm for the correct perspective (HFoV {:.3} deg).",
-            r.viewing_distance_mm,
-            r.printed_image_width_mm,
-            r.paper.name(),
-            r.viewing_distance_mm,
-            r.hfov_deg
-        ),
+        &viewing_sentence(r),
         chars_in(usable, title),
     );
     // Geometry table: three columns.
@@ -559,18 +553,34 @@ pub fn sheet_for_view_as(
     format: SheetFormat,
 ) -> Result<Vec<u8>, SheetError> {
     let report = view_geometry(doc, photo_id, options)?;
+    sheet_for_geometry(doc, &report, image, avr, format)
+}
+
+/// The sheet of the view `report` describes (a photo, or a planar or cylindrical view made from
+/// photos: [`super::reprojected_geometry`]) showing `image` (8-bit sRGB, the view's size).
+///
+/// # Errors
+/// [`SheetError::SizeMismatch`] when the image is not the view's size, the scene's errors and
+/// the writer's.
+pub fn sheet_for_geometry(
+    doc: &SiteDocument,
+    report: &ViewGeometry,
+    image: &RgbImage,
+    avr: AvrLevel,
+    format: SheetFormat,
+) -> Result<Vec<u8>, SheetError> {
     let (w, h) = image.dimensions();
     if [w, h] != report.image_size_px {
         return Err(SheetError::SizeMismatch {
-            photo: photo_id.to_owned(),
+            photo: report.photo_id.clone(),
             image_px: [w, h],
             photo_px: report.image_size_px,
         });
     }
-    let map = map_inset(doc, &report)?;
-    let methodology = methodology(doc, &report, avr);
+    let map = map_inset(doc, report)?;
+    let methodology = methodology(doc, report, avr);
     let input = SheetInput {
-        report: &report,
+        report,
         image,
         avr,
         map,
