@@ -8,14 +8,10 @@
 //!    last fix rather than of the exposure.
 //! 3. **Mapillary `MAPCaptureTime`**: the JSON object the Mapillary apps and `mapillary_tools`
 //!    write into EXIF `ImageDescription` (tag 0x010E), `"MAPCaptureTime":
-//!    "YYYY_MM_DD_HH_MM_SS_mmm"`. `mapillary_tools` writes it in **UTC** (formatted from
-//!    `datetime.utcfromtimestamp`) and writes no zone. The early Mapillary phone apps wrote a
-//!    `MAPLocalTimeZone` beside it (iOS app 1.8, 2014: `"Europe/Berlin (GMT+2) offset 7200
-//!    (Daylight)"`, the zone's description with its UTC offset in seconds); there the capture
-//!    time is the phone's **local** time at that offset. Evidence: the shadows in OpenSfM's
-//!    Berlin photos (`sample_sites/berlin`) agree with the sun at 12:56 at +02:00 and are ~30°
-//!    from the sun at 12:56 UTC (`tests/tests/berlin_site.rs`). So: with an `offset N` in
-//!    `MAPLocalTimeZone` the time is local at +N s, without one it is UTC.
+//!    "YYYY_MM_DD_HH_MM_SS_mmm"`, in **UTC** (`mapillary_tools` formats it from
+//!    `datetime.utcfromtimestamp`; Mapillary's API gives `captured_at` as a UTC epoch). The
+//!    `MAPLocalTimeZone` the early phone apps wrote beside it (iOS app 1.8, 2014: `"Europe/Berlin
+//!    (GMT+2) offset 7200 (Daylight)"`) records the phone's zone and is not applied.
 //!
 //! The result says which reading it came from, so a report can name it.
 //!
@@ -38,8 +34,7 @@ pub enum CaptureTimeSource {
     ExifOriginal,
     /// `GPSDateStamp` + `GPSTimeStamp` (UTC).
     GpsTime,
-    /// Mapillary `MAPCaptureTime` in `ImageDescription` (local time at `MAPLocalTimeZone`'s
-    /// offset when given, else UTC).
+    /// Mapillary `MAPCaptureTime` in `ImageDescription` (UTC).
     MapillaryCaptureTime,
 }
 
@@ -50,7 +45,7 @@ impl CaptureTimeSource {
         match self {
             Self::ExifOriginal => "EXIF DateTimeOriginal + OffsetTimeOriginal",
             Self::GpsTime => "EXIF GPS date/time (UTC)",
-            Self::MapillaryCaptureTime => "Mapillary MAPCaptureTime",
+            Self::MapillaryCaptureTime => "Mapillary MAPCaptureTime (UTC)",
         }
     }
 }
@@ -92,39 +87,14 @@ pub fn gps_time(date_stamp: &str, hms: [f64; 3]) -> Option<DateTime<FixedOffset>
     Some(Utc.from_utc_datetime(&date.and_time(time)).fixed_offset())
 }
 
-/// Most a UTC offset can be: ±18 h (what RFC 3339 and chrono accept is less, ±24 h).
-const MAX_OFFSET_S: i64 = 18 * 3600;
-
-/// `MAPCaptureTime` from the Mapillary JSON of an `ImageDescription`: local time at the offset of
-/// `MAPLocalTimeZone` (`"… offset 7200 …"`, seconds east of UTC) when it names one, else UTC.
-/// `None` when the text is not a JSON object, has no `MAPCaptureTime`, or its value is not
-/// `YYYY_MM_DD_HH_MM_SS_mmm`.
+/// `MAPCaptureTime` from the Mapillary JSON of an `ImageDescription`, UTC. `None` when the text
+/// is not a JSON object, has no `MAPCaptureTime`, or its value is not `YYYY_MM_DD_HH_MM_SS_mmm`.
 #[must_use]
 pub fn mapillary_capture_time(image_description: &str) -> Option<DateTime<FixedOffset>> {
     let json: serde_json::Value = serde_json::from_str(image_description.trim()).ok()?;
     let text = json.get("MAPCaptureTime")?.as_str()?;
     let naive = NaiveDateTime::parse_from_str(text.trim(), "%Y_%m_%d_%H_%M_%S_%3f").ok()?;
-    let zone_offset_s = json
-        .get("MAPLocalTimeZone")
-        .and_then(serde_json::Value::as_str)
-        .and_then(mapillary_zone_offset_s);
-    match zone_offset_s {
-        Some(offset_s) => FixedOffset::east_opt(offset_s)?
-            .from_local_datetime(&naive)
-            .single(),
-        None => Some(Utc.from_utc_datetime(&naive).fixed_offset()),
-    }
-}
-
-/// The `offset N` (seconds east of UTC) in a `MAPLocalTimeZone` description.
-fn mapillary_zone_offset_s(zone: &str) -> Option<i32> {
-    let mut words = zone.split_whitespace();
-    words.find(|w| *w == "offset")?;
-    let seconds: i64 = words.next()?.parse().ok()?;
-    if seconds.abs() > MAX_OFFSET_S {
-        return None;
-    }
-    i32::try_from(seconds).ok()
+    Some(Utc.from_utc_datetime(&naive).fixed_offset())
 }
 
 impl ExifInfo {
@@ -166,20 +136,10 @@ mod tests {
     const BERLIN_01: &str = r#"{"MAPAppNameString":"mapillary_ios","MAPLongitude":"13.400295","MAPDeviceModel":"iPhone4,1","MAPAccelerometerVector":{"x":0.9466457,"y":0.01739691,"z":0.3218063},"MAPLocalTimeZone":"Europe\/Berlin (GMT+2) offset 7200 (Daylight)","MAPCaptureTime":"2014_05_26_12_56_02_384"}"#;
 
     #[test]
-    fn mapillary_capture_time_is_local_at_the_apps_zone_else_utc() {
-        // The 2014 iOS app's zone: local time at +7200 s.
+    fn mapillary_capture_time_is_utc_to_the_millisecond() {
+        // The app's MAPLocalTimeZone (+7200 s) is not applied.
         let t = mapillary_capture_time(BERLIN_01).expect("time");
-        assert_eq!(t.to_rfc3339(), "2014-05-26T12:56:02.384+02:00");
-        // mapillary_tools writes no zone: UTC.
-        let t = mapillary_capture_time(r#"{"MAPCaptureTime":"2014_05_26_12_56_02_384"}"#)
-            .expect("time");
         assert_eq!(t.to_rfc3339(), "2014-05-26T12:56:02.384+00:00");
-        // A zone without a usable offset is ignored (UTC).
-        let t = mapillary_capture_time(
-            r#"{"MAPCaptureTime":"2014_05_26_12_56_02_384","MAPLocalTimeZone":"Europe/Berlin offset 99999999"}"#,
-        )
-        .expect("time");
-        assert_eq!(t.offset().local_minus_utc(), 0);
         assert_eq!(mapillary_capture_time("a plain caption"), None);
         assert_eq!(mapillary_capture_time(r#"{"MAPCaptureTime":"2014-05-26"}"#), None);
         assert_eq!(mapillary_capture_time(r#"{"MAPCaptureTime":12}"#), None);

@@ -1,6 +1,8 @@
 //! EXIF metadata a photomontage needs (CIPA DC-008 "Exif 2.3"): camera make and model, focal
 //! length (actual and 35 mm equivalent), focal-plane resolution, the original date and time with
-//! its offset, GPS position and the orientation. Read with kamadak-exif.
+//! its offset, the GPS position and time, Mapillary's `MAPCaptureTime` (in `ImageDescription`)
+//! and the orientation. Read with kamadak-exif. The capture time's order of precedence is
+//! [`super::capture_time`]'s.
 //!
 //! The initial focal length in pixels is taken, in order of trust, from
 //! 1. the focal-plane resolution (pixels per unit on the sensor), rescaled when the stored image
