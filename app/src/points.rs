@@ -115,13 +115,14 @@ pub fn import_file(
                     .iter()
                     .map(|r| r.point_in_world.coords.into())
                     .collect();
-                location =
-                    Some(location_from_points(&points, &target, &target.site_name()).map_err(
+                location = Some(
+                    location_from_points(&points, &target, &target.site_name()).map_err(
                         |source| ImportError::Location {
                             path: shown.clone(),
                             source,
                         },
-                    )?);
+                    )?,
+                );
             }
             None if SourceCrs::from_header(&list.crs).is_ok_and(|c| c.is_geographic()) => {
                 return Err(ImportError::NoSiteCrs {

@@ -538,7 +538,13 @@ mod tests {
 
     #[test]
     fn site_names_round_trip() {
-        for name in ["EPSG:2056", "EPSG:27700", "EPSG:32633", "EPSG:32733", "EPSG:32601"] {
+        for name in [
+            "EPSG:2056",
+            "EPSG:27700",
+            "EPSG:32633",
+            "EPSG:32733",
+            "EPSG:32601",
+        ] {
             let crs = ProjectedCrs::from_name(name).expect("valid");
             assert_eq!(crs.site_name(), name);
         }

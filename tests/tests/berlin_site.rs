@@ -98,8 +98,7 @@ fn control_and_location_come_from_the_shipped_gcp_list() {
     assert!((loc.latitude_deg - expected.latitude_deg).abs() < LOCATION_TEXT_TOL_DEG);
     assert!((loc.longitude_deg - expected.longitude_deg).abs() < LOCATION_TEXT_TOL_DEG);
     assert!(
-        (loc.grid_convergence_deg - expected.grid_convergence_deg).abs()
-            < CONVERGENCE_TEXT_TOL_DEG
+        (loc.grid_convergence_deg - expected.grid_convergence_deg).abs() < CONVERGENCE_TEXT_TOL_DEG
     );
     assert!((loc.elevation_m - expected.elevation_m).abs() < 1e-3);
 }
@@ -113,7 +112,10 @@ fn capture_time_is_the_mapillary_time_in_utc() {
         ("03", "2014-05-26T12:56:30.953+00:00"),
     ] {
         let p = doc.site.photos.iter().find(|p| p.id == id).unwrap();
-        assert!(p.taken_at.is_none(), "{id}: the site leaves the time to EXIF");
+        assert!(
+            p.taken_at.is_none(),
+            "{id}: the site leaves the time to EXIF"
+        );
         let exif = photo::read_exif(&doc.resolve(&p.file)).unwrap();
         // No DateTimeOriginal and no GPS time: Mapillary's is the only reading.
         assert!(exif.date_time_original.is_none() && exif.gps_date_time_utc.is_none());
@@ -135,7 +137,10 @@ fn berlin_solves_fits_and_renders_the_pavilion() {
     let zone33 = ProjectedCrs::from_name("EPSG:32633").unwrap();
     for s in &solution.photos {
         let p = doc.site.photos.iter().find(|p| p.id == s.id).unwrap();
-        let gps = photo::read_exif(&doc.resolve(&p.file)).unwrap().gps.unwrap();
+        let gps = photo::read_exif(&doc.resolve(&p.file))
+            .unwrap()
+            .gps
+            .unwrap();
         let (e, n) = zone33
             .from_lat_lon_deg(gps.latitude_deg, gps.longitude_deg)
             .unwrap();
@@ -201,5 +206,8 @@ fn berlin_solves_fits_and_renders_the_pavilion() {
             );
         }
     }
-    eprintln!("Berlin montage at 1/{RENDER_SCALE}: {} pixels traced", out.changed_pixels);
+    eprintln!(
+        "Berlin montage at 1/{RENDER_SCALE}: {} pixels traced",
+        out.changed_pixels
+    );
 }

@@ -141,7 +141,10 @@ mod tests {
         let t = mapillary_capture_time(BERLIN_01).expect("time");
         assert_eq!(t.to_rfc3339(), "2014-05-26T12:56:02.384+00:00");
         assert_eq!(mapillary_capture_time("a plain caption"), None);
-        assert_eq!(mapillary_capture_time(r#"{"MAPCaptureTime":"2014-05-26"}"#), None);
+        assert_eq!(
+            mapillary_capture_time(r#"{"MAPCaptureTime":"2014-05-26"}"#),
+            None
+        );
         assert_eq!(mapillary_capture_time(r#"{"MAPCaptureTime":12}"#), None);
     }
 

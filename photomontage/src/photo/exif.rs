@@ -124,10 +124,9 @@ fn gps_date_time(exif: &exif::Exif) -> Option<chrono::DateTime<chrono::FixedOffs
     let date = ascii(exif, Tag::GPSDateStamp)?;
     let field = exif.get_field(Tag::GPSTimeStamp, In::PRIMARY)?;
     match &field.value {
-        Value::Rational(r) if r.len() == 3 => super::capture_time::gps_time(
-            &date,
-            [r[0].to_f64(), r[1].to_f64(), r[2].to_f64()],
-        ),
+        Value::Rational(r) if r.len() == 3 => {
+            super::capture_time::gps_time(&date, [r[0].to_f64(), r[1].to_f64(), r[2].to_f64()])
+        }
         _ => None,
     }
 }

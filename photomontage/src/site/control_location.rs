@@ -141,8 +141,14 @@ mod tests {
             },
         ];
         let loc = location_from_control(&points, &zone33, "EPSG:32633").expect("location");
-        assert!((loc.latitude_deg - 52.5192).abs() < ROUND_TRIP_DEG, "{loc:?}");
-        assert!((loc.longitude_deg - 13.4006).abs() < ROUND_TRIP_DEG, "{loc:?}");
+        assert!(
+            (loc.latitude_deg - 52.5192).abs() < ROUND_TRIP_DEG,
+            "{loc:?}"
+        );
+        assert!(
+            (loc.longitude_deg - 13.4006).abs() < ROUND_TRIP_DEG,
+            "{loc:?}"
+        );
         assert!((loc.elevation_m - 4.0).abs() < 1e-12);
         assert_eq!(loc.crs.as_deref(), Some("EPSG:32633"));
         // West of the central meridian 15° E in the north the meridians lean east towards it:
