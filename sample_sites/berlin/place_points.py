@@ -1,4 +1,4 @@
-"""Prints the [[control_points]] that carry the Berlin site's scene polygons (README.md,
+"""Prints the [[control_points]] that carry the Berlin site's scene polygons (docs/berlin.md,
 "How the scene was placed"). Plain Python 3, no dependencies:
 
     python3 sample_sites/berlin/place_points.py
