@@ -3,7 +3,8 @@
 //! `gcp_list.txt` reprojected by the library, its `[location]` is the one the library derives from
 //! that control, the capture time comes from the photos' Mapillary metadata, the three cameras
 //! solve with self-calibrated focal length within the acceptance bounds, the daylight fit runs on
-//! the photo samples, and the pavilion is rendered into photo 02 (box-filtered 8 × 8, low spp).
+//! the photo samples, the renderer's sun is pvlib's at photo 02's time, and the pavilion is
+//! rendered into photo 02 (box-filtered 8 × 8, the site's 4–8 rays per pixel).
 //!
 //! Measured (2026-11-24, debug build): bundle RMS 0.139 px; focal 3102.1 / 3106.6 px (01, 02;
 //! 03 kept at 3104 px, its six GCPs cannot separate focal length from distance); camera centres
@@ -40,6 +41,11 @@ const CONVERGENCE_TEXT_TOL_DEG: f64 = 6e-5;
 const FOCAL_MOVED_MIN_PX: f64 = 100.0;
 /// Box-filter factor of the test render (3264 × 2448 → 408 × 306).
 const RENDER_SCALE: u32 = 8;
+/// The sun at 12:56 UTC by pvlib (the dataset's README, to 0.1°): azimuth 225.5°, elevation
+/// 51.9°. Photo 02 is 11 s later (≈ 0.05° of sun motion) and its values are rounded to 0.05°.
+const PVLIB_SUN_AZIMUTH_DEG: f64 = 225.5;
+const PVLIB_SUN_ELEVATION_DEG: f64 = 51.9;
+const PVLIB_SUN_TOL_DEG: f64 = 0.15;
 
 fn load() -> SiteDocument {
     SiteDocument::load(&sample_site("berlin").join("site.toml")).unwrap()
@@ -172,6 +178,15 @@ fn berlin_solves_fits_and_renders_the_pavilion() {
     // The montage at 1/8 size: the pavilion changes the pixels it covers and nothing at the top
     // of the photo (the mosaic and the arch are far above and behind it).
     let mut job = prepare_view(&doc, "02").unwrap();
+    // The renderer's sun is the SPA sun at photo 02's Mapillary time (UTC) at [location],
+    // turned into the grid by the convergence.
+    let sun_dir = job.lighting.daylight.sun.as_ref().unwrap().dir_in_world;
+    let convergence = doc.site.location.as_ref().unwrap().grid_convergence_deg;
+    let azimuth_deg = (sun_dir.x.atan2(sun_dir.y).to_degrees() - convergence).rem_euclid(360.0);
+    let elevation_deg = sun_dir.z.asin().to_degrees();
+    eprintln!("Berlin sun for photo 02: azimuth {azimuth_deg:.3}°, elevation {elevation_deg:.3}°");
+    assert!((azimuth_deg - PVLIB_SUN_AZIMUTH_DEG).abs() < PVLIB_SUN_TOL_DEG);
+    assert!((elevation_deg - PVLIB_SUN_ELEVATION_DEG).abs() < PVLIB_SUN_TOL_DEG);
     let photo = downscale(&job.photo_linear, RENDER_SCALE);
     let s = f64::from(RENDER_SCALE);
     let k = &mut job.camera.intrinsics;
