@@ -12,7 +12,7 @@
 //! the restored edits are kept but can no longer be undone one by one.
 
 use photomontage::site::{
-    CadModel, ControlPoint, Exterior, Interior, Observation, Placement, Polygon,
+    CadModel, ControlPoint, Exterior, Interior, Location, Observation, Placement, Polygon,
     SelfCalibrationFlags, Site, TiePoint,
 };
 
@@ -73,6 +73,8 @@ pub enum Command {
     },
     /// Replaces the tie points.
     SetTiePoints(Vec<TiePoint>),
+    /// Sets (or clears) the site's `[location]`.
+    SetLocation(Option<Location>),
     /// Inserts the scene polygon, or replaces the one with the same id in place.
     PutPolygon { polygon: Polygon, at: Option<usize> },
     /// Removes a scene polygon.
@@ -107,6 +109,7 @@ impl Command {
             Self::RemoveControlPoint { id } => format!("remove control point {id}"),
             Self::SetOrientation { photo, .. } => format!("orientation of {photo}"),
             Self::SetTiePoints(t) => format!("{} tie points", t.len()),
+            Self::SetLocation(_) => "site location".to_owned(),
             Self::SetModelPlacement { model, .. } => format!("place model {model}"),
             Self::PutPolygon { polygon, .. } => format!("polygon {}", polygon.id),
             Self::PutModel { model, .. } => format!("model {}", model.id),
@@ -214,6 +217,9 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
         }
         Command::SetTiePoints(ties) => {
             Command::SetTiePoints(std::mem::replace(&mut site.tie_points, ties))
+        }
+        Command::SetLocation(location) => {
+            Command::SetLocation(std::mem::replace(&mut site.location, location))
         }
         Command::PutPolygon { polygon, at } => {
             match site.polygons.iter().position(|p| p.id == polygon.id) {

@@ -2,7 +2,9 @@
 //! and the point's observation in the current photo (position, on/off, delete); plus importing
 //! control points from a CSV (`id,X,Y,Z[,σ]`, or `id,X,Y,Z,x,y[,σ_px]` with observations in the
 //! current photo) or an OpenDroneMap `gcp_list.txt` (observations matched to photos by file
-//! name; a list in another CRS, WGS 84 included, is reprojected into the site's `location.crs`).
+//! name; a list in another CRS, WGS 84 included, is reprojected into the site's `location.crs`;
+//! a WGS 84 list imported into a site without `[location]` goes to its centroid's UTM zone and
+//! fills `[location]` from the control points, in the same undoable batch).
 //! The table only emits [`Command`]s; `crate::Studio` applies them.
 //!
 //! File formats: `photomontage::photogrammetry::control_io` (ODM's documented GCP format).
@@ -18,6 +20,7 @@ use photomontage::geo::{ProjectedCrs, SourceCrs};
 use photomontage::photogrammetry::control_io::{
     ControlIoError, parse_control_points_csv, parse_odm_gcp_list, parse_points_csv,
 };
+use photomontage::site::control_location::location_from_points;
 use photomontage::site::{ControlPoint, Observation, Site};
 use std::path::Path;
 
@@ -55,6 +58,11 @@ pub enum ImportError {
         "{path}: the control points are geographic (`{header}`); set the site's location.crs (e.g. EPSG:32633) so they can be reprojected"
     )]
     NoSiteCrs { path: String, header: String },
+    #[error("{path}: cannot place the site by its control points: {source}")]
+    Location {
+        path: String,
+        source: photomontage::site::control_location::ControlLocationError,
+    },
 }
 
 /// Control points (and observations) of a file, as one undoable batch.
@@ -81,6 +89,7 @@ pub fn import_file(
         .is_some_and(|e| e.eq_ignore_ascii_case("txt"));
     let control;
     let mut observations = Vec::new();
+    let mut location = None;
     if is_gcp_list {
         let mut list = parse_odm_gcp_list(&text).map_err(parse_err)?;
         // Control in any CRS: into the site's CRS when it names one.
@@ -93,6 +102,27 @@ pub fn import_file(
                         source,
                     })?;
                 list = list.reprojected(Some(&target)).map_err(parse_err)?.0;
+            }
+            // A site without a location: a geographic list goes to its centroid's UTM zone
+            // and the site's [location] is filled from the control points.
+            None if site.location.is_none()
+                && SourceCrs::from_header(&list.crs).is_ok_and(|c| c.is_geographic()) =>
+            {
+                let (utm, target) = list.reprojected(None).map_err(parse_err)?;
+                list = utm;
+                let points: Vec<[f64; 3]> = list
+                    .rows
+                    .iter()
+                    .map(|r| r.point_in_world.coords.into())
+                    .collect();
+                location = Some(
+                    location_from_points(&points, &target, &target.site_name()).map_err(
+                        |source| ImportError::Location {
+                            path: shown.clone(),
+                            source,
+                        },
+                    )?,
+                );
             }
             None if SourceCrs::from_header(&list.crs).is_ok_and(|c| c.is_geographic()) => {
                 return Err(ImportError::NoSiteCrs {
@@ -161,6 +191,9 @@ pub fn import_file(
                 at: None,
             }),
     );
+    if let Some(location) = location {
+        batch.push(Command::SetLocation(Some(location)));
+    }
     Ok(Command::Batch(batch))
 }
 
@@ -339,7 +372,29 @@ mod tests {
         });
         let gcp = dir.path().join("gcp_list.txt");
         std::fs::write(&gcp, "WGS84\n13.4 52.52 12.5 40 50 01.jpg g1\n").expect("write");
-        // Without a site CRS the geographic list is refused, naming what to set.
+        // A site without [location]: the list goes to its centroid's UTM zone (33N) and the
+        // location is filled from the control points, undoably in the same batch.
+        let Command::Batch(b) = import_file(&site, &gcp, None).expect("import") else {
+            panic!("a batch");
+        };
+        let Some(Command::SetLocation(Some(loc))) = b.last() else {
+            panic!("the batch sets the location: {b:?}");
+        };
+        assert_eq!(loc.crs.as_deref(), Some("EPSG:32633"));
+        assert!((loc.latitude_deg - 52.52).abs() < 1e-9 && (loc.longitude_deg - 13.4).abs() < 1e-9);
+        let mut applied = site.clone();
+        let undo = crate::commands::apply(&mut applied, Command::Batch(b)).expect("applies");
+        assert!(applied.location.is_some() && applied.control_points.len() == 1);
+        crate::commands::apply(&mut applied, undo).expect("undoes");
+        assert_eq!(applied, site);
+        // A location without a CRS: the geographic list is refused, naming what to set.
+        site.location = Some(photomontage::site::Location {
+            latitude_deg: 52.52,
+            longitude_deg: 13.4,
+            elevation_m: 0.0,
+            crs: None,
+            grid_convergence_deg: 0.0,
+        });
         let e = import_file(&site, &gcp, None).expect_err("no crs");
         assert!(e.to_string().contains("location.crs"), "{e}");
         site.location = Some(photomontage::site::Location {

@@ -197,6 +197,27 @@ impl ProjectedCrs {
         &self.definition
     }
 
+    /// The name a site file gives this CRS (`location.crs`): `EPSG:2056`, `EPSG:27700`,
+    /// `EPSG:326NN` / `EPSG:327NN` for the presets [`Self::from_name`] knows, else the PROJ.4
+    /// definition itself. [`Self::from_name`] of the result gives this CRS back.
+    #[must_use]
+    pub fn site_name(&self) -> String {
+        if self.definition == SWISS_LV95 {
+            return "EPSG:2056".to_owned();
+        }
+        if self.definition == BRITISH_NATIONAL_GRID {
+            return "EPSG:27700".to_owned();
+        }
+        for zone in 1..=60_u8 {
+            for (hemisphere, base) in [(Hemisphere::North, 32600), (Hemisphere::South, 32700)] {
+                if Self::utm(zone, hemisphere).is_ok_and(|u| u.definition == self.definition) {
+                    return format!("EPSG:{}", base + u32::from(zone));
+                }
+            }
+        }
+        self.definition.clone()
+    }
+
     /// WGS84 latitude and longitude (degrees) of a projected point (metres).
     ///
     /// # Errors
@@ -513,6 +534,23 @@ mod tests {
             (got + gamma.to_degrees()).abs() < CONVERGENCE_TOL_DEG,
             "{got}"
         );
+    }
+
+    #[test]
+    fn site_names_round_trip() {
+        for name in [
+            "EPSG:2056",
+            "EPSG:27700",
+            "EPSG:32633",
+            "EPSG:32733",
+            "EPSG:32601",
+        ] {
+            let crs = ProjectedCrs::from_name(name).expect("valid");
+            assert_eq!(crs.site_name(), name);
+        }
+        let custom = "+proj=tmerc +lat_0=0 +lon_0=9 +k=1 +x_0=0 +y_0=0 +ellps=GRS80 +units=m";
+        let crs = ProjectedCrs::from_name(custom).expect("valid");
+        assert_eq!(crs.site_name(), custom);
     }
 
     #[test]

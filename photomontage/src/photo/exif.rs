@@ -1,6 +1,8 @@
 //! EXIF metadata a photomontage needs (CIPA DC-008 "Exif 2.3"): camera make and model, focal
 //! length (actual and 35 mm equivalent), focal-plane resolution, the original date and time with
-//! its offset, GPS position and the orientation. Read with kamadak-exif.
+//! its offset, the GPS position and time, Mapillary's `MAPCaptureTime` (in `ImageDescription`)
+//! and the orientation. Read with kamadak-exif. The capture time's order of precedence is
+//! [`super::capture_time`]'s.
 //!
 //! The initial focal length in pixels is taken, in order of trust, from
 //! 1. the focal-plane resolution (pixels per unit on the sensor), rescaled when the stored image
@@ -48,22 +50,21 @@ pub struct ExifInfo {
     pub date_time_original: Option<String>,
     /// OffsetTimeOriginal (`+HH:MM`), when present.
     pub offset_time_original: Option<String>,
+    /// GPSDateStamp + GPSTimeStamp (UTC), when both are present and valid.
+    pub gps_date_time_utc: Option<chrono::DateTime<chrono::FixedOffset>>,
+    /// Mapillary `MAPCaptureTime` from the JSON in ImageDescription (UTC), when present.
+    pub mapillary_capture_time: Option<chrono::DateTime<chrono::FixedOffset>>,
     pub gps: Option<GpsPosition>,
     /// Orientation tag 1–8 (1 when absent).
     pub orientation: u16,
 }
 
 impl ExifInfo {
-    /// The original capture time as RFC 3339 when both the time and its offset are known.
+    /// The capture time as RFC 3339 ([`ExifInfo::capture_time`]: `DateTimeOriginal` with its
+    /// offset, else GPS time, else Mapillary `MAPCaptureTime`).
     #[must_use]
     pub fn taken_at_rfc3339(&self) -> Option<String> {
-        let dt = self.date_time_original.as_ref()?;
-        let offset = self.offset_time_original.as_ref()?;
-        let naive = chrono::NaiveDateTime::parse_from_str(dt.trim(), "%Y:%m:%d %H:%M:%S").ok()?;
-        let text = format!("{}{}", naive.format("%Y-%m-%dT%H:%M:%S"), offset.trim());
-        chrono::DateTime::parse_from_rfc3339(&text)
-            .ok()
-            .map(|t| t.to_rfc3339())
+        self.capture_time().map(|c| c.time.to_rfc3339())
     }
 
     /// `make model` for display.
@@ -113,6 +114,18 @@ fn dms(exif: &exif::Exif, tag: Tag) -> Option<f64> {
     match &field.value {
         Value::Rational(r) if r.len() == 3 => {
             Some(r[0].to_f64() + r[1].to_f64() / 60.0 + r[2].to_f64() / 3600.0)
+        }
+        _ => None,
+    }
+}
+
+/// GPSDateStamp + GPSTimeStamp (three rationals), UTC.
+fn gps_date_time(exif: &exif::Exif) -> Option<chrono::DateTime<chrono::FixedOffset>> {
+    let date = ascii(exif, Tag::GPSDateStamp)?;
+    let field = exif.get_field(Tag::GPSTimeStamp, In::PRIMARY)?;
+    match &field.value {
+        Value::Rational(r) if r.len() == 3 => {
+            super::capture_time::gps_time(&date, [r[0].to_f64(), r[1].to_f64(), r[2].to_f64()])
         }
         _ => None,
     }
@@ -182,6 +195,10 @@ pub fn read_exif(path: &Path) -> Result<ExifInfo, PhotoError> {
         exif_image_size_px,
         date_time_original: ascii(&exif, Tag::DateTimeOriginal),
         offset_time_original: ascii(&exif, Tag::OffsetTimeOriginal),
+        gps_date_time_utc: gps_date_time(&exif),
+        mapillary_capture_time: ascii(&exif, Tag::ImageDescription)
+            .as_deref()
+            .and_then(super::capture_time::mapillary_capture_time),
         gps,
         orientation: exif
             .get_field(Tag::Orientation, In::PRIMARY)

@@ -8,9 +8,11 @@
 //! Only the first image of a multi-page TIFF and the first layer of an EXR are read. EXIF is read
 //! from JPEG, TIFF and PNG containers (kamadak-exif); HEIC is not supported.
 
+pub mod capture_time;
 pub mod exif;
 pub mod sensor_table;
 
+pub use capture_time::{CaptureTime, CaptureTimeSource};
 pub use exif::{
     ExifInfo, FocalEstimate, FocalMissing, FocalSource, focal_px_from_exif, initial_focal_px,
     read_exif,

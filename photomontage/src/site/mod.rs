@@ -13,6 +13,7 @@
 //! [`Site::save`] writes; for hand-written inline tables the error names the field but may give
 //! the line of the enclosing table.
 
+pub mod control_location;
 mod locate;
 pub mod luminaires;
 pub mod models;

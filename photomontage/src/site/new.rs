@@ -2,8 +2,9 @@
 //! per file with an id from its file name, the image size read from the file, the interior
 //! orientation started from EXIF (CIPA DC-008 "Exif 2.3" via [`crate::photo::exif`]: focal
 //! length in mm with the focal-plane resolution or a known sensor size, else the 35 mm equivalent
-//! focal length → focal length in pixels), the capture time from EXIF `DateTimeOriginal` +
-//! `OffsetTimeOriginal`, and file paths relative to the site file. This is the "image data" step
+//! focal length → focal length in pixels), the capture time ([`crate::photo::capture_time`]:
+//! EXIF `DateTimeOriginal` + `OffsetTimeOriginal`, else GPS time, else Mapillary
+//! `MAPCaptureTime`), and file paths relative to the site file. This is the "image data" step
 //! of Durisch 1992 §4.1 before any control point is measured.
 //!
 //! When EXIF gives no focal length the photo still gets an interior orientation with the stated

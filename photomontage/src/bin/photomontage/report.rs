@@ -26,6 +26,10 @@ pub struct PhotoRecord<'a> {
     /// How the control coordinates reached the CRS of `camera_center` (reprojected lists only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub control_crs: Option<String>,
+    /// The site location the control points give (centroid, its CRS and grid convergence), for
+    /// a site whose `[location]` is still empty (control from a list that names its CRS).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub site_location: Option<photomontage::site::Location>,
 }
 
 pub fn rotation_rows(camera: &Camera) -> [[f64; 3]; 3] {
@@ -45,6 +49,16 @@ pub fn print_photo(r: &PhotoRecord<'_>) {
     );
     if let Some(crs) = &r.control_crs {
         println!("  control    {crs}");
+    }
+    if let Some(l) = &r.site_location {
+        println!(
+            "  location   {:.6}° N {:.6}° E, crs {}, grid convergence {:.4}° (control centroid; \
+             the site's [location] when empty)",
+            l.latitude_deg,
+            l.longitude_deg,
+            l.crs.as_deref().unwrap_or("?"),
+            l.grid_convergence_deg
+        );
     }
     println!(
         "  centre     X {:.4}  Y {:.4}  Z {:.4}   σ {:.4} {:.4} {:.4} m",

@@ -7,6 +7,7 @@ use photomontage::geo::ProjectedCrs;
 use photomontage::photo;
 use photomontage::photogrammetry::control_io::{parse_odm_gcp_list, parse_points_csv};
 use photomontage::photogrammetry::{ResectionOptions, SelfCalibration, resect};
+use photomontage::site::control_location::location_from_points;
 use std::path::PathBuf;
 
 /// Standard deviation given to control points read from a file that states none.
@@ -60,6 +61,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .transpose()
         .context("--crs")?;
     let mut control_crs = None;
+    let mut location_crs = None;
     let (control, observations, photo_id) = if looks_odm {
         let context = || {
             format!(
@@ -81,6 +83,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 }
             ));
         }
+        location_crs = Some(crs);
         let Some(image) = args.image.clone() else {
             bail!(
                 "{} is a GCP list for several images: choose one with --image (one of: {})",
@@ -163,6 +166,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     options.seed = args.seed;
     let r = resect(&control, &observations, &options)?;
     let intr = r.camera.intrinsics;
+    // The site's [location] from the control, when the list names its CRS.
+    let site_location = match &location_crs {
+        Some(crs) => {
+            let points: Vec<[f64; 3]> = control
+                .iter()
+                .map(|c| c.point_in_world.coords.into())
+                .collect();
+            Some(
+                location_from_points(&points, crs, &crs.site_name())
+                    .context("site location from the control points")?,
+            )
+        }
+        None => None,
+    };
     let record = PhotoRecord {
         id: &photo_id,
         camera_center: r.camera.pose.camera_center_in_world.coords.into(),
@@ -181,6 +198,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         residuals: &r.residuals,
         solved_by: "resection",
         control_crs,
+        site_location,
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&record)?);
