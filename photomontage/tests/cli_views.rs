@@ -92,7 +92,10 @@ fn views_carry_their_geometry_and_their_sheets_are_written() {
         panic!("XMP tag type");
     };
     let packet = String::from_utf8(packet.clone()).unwrap();
-    assert!(packet.contains("photomontage:projection=\"planar\""), "{packet}");
+    assert!(
+        packet.contains("photomontage:projection=\"planar\""),
+        "{packet}"
+    );
     let decoded = image::load_from_memory(&bytes).unwrap();
     assert_eq!(
         [decoded.width(), decoded.height()],

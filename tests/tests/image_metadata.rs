@@ -177,8 +177,8 @@ fn assert_xmp_matches(props: &BTreeMap<String, String>, m: &ViewMetadata) {
                         serde_json::Value::Number(n) if key == "image_size_px" => {
                             let axis = ["image_width_px", "image_height_px"][i];
                             assert_eq!(
-                                number(props, &format!("photomontage:{axis}")),
-                                n.as_f64().unwrap()
+                                number(props, &format!("photomontage:{axis}")).to_bits(),
+                                n.as_f64().unwrap().to_bits()
                             );
                         }
                         serde_json::Value::Number(n) => {

@@ -49,13 +49,14 @@ pub fn planar_view_geometry(
 ) -> Result<ViewGeometry, ViewGeometryError> {
     let mut r = view_geometry(doc, photo_id, options)?;
     let intr = camera.intrinsics;
-    r.focal_35mm_equiv_mm = focal_35mm_equiv_mm(intr.focal_px, intr.image_size_px).ok_or(
-        ViewGeometryError::FocalNotConvertible {
-            photo: photo_id.to_owned(),
-            focal_px: intr.focal_px,
-            image_size_px: intr.image_size_px,
-        },
-    )?;
+    r.focal_35mm_equiv_mm =
+        focal_35mm_equiv_mm(intr.focal_px, intr.image_size_px).ok_or_else(|| {
+            ViewGeometryError::FocalNotConvertible {
+                photo: photo_id.to_owned(),
+                focal_px: intr.focal_px,
+                image_size_px: intr.image_size_px,
+            }
+        })?;
     let angles = camera_angles(camera).ok_or_else(|| ViewGeometryError::VerticalAxis {
         photo: photo_id.to_owned(),
     })?;
@@ -150,13 +151,13 @@ pub fn cylindrical_view_geometry(
     r.pitch_deg = (cylinder.height_top - h / (2.0 * f)).atan().to_degrees();
     r.roll_deg = 0.0;
     r.focal_px = f;
-    r.focal_35mm_equiv_mm = focal_35mm_equiv_mm(f, first.image_size_px).ok_or(
+    r.focal_35mm_equiv_mm = focal_35mm_equiv_mm(f, first.image_size_px).ok_or_else(|| {
         ViewGeometryError::FocalNotConvertible {
             photo: first.photo_id.clone(),
             focal_px: f,
             image_size_px: first.image_size_px,
-        },
-    )?;
+        }
+    })?;
     r.hfov_deg = (w / f).to_degrees();
     r.vfov_deg = (cylinder.height_top.atan() - (cylinder.height_top - h / f).atan()).to_degrees();
     r.image_size_px = cylinder.size_px;

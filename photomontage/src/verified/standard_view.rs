@@ -149,11 +149,10 @@ pub fn photo_avr_image(
     render_job(job, avr, on_tile, cancel, warnings)
 }
 
+#[allow(clippy::cast_precision_loss)]
 fn coverage(image: &RenderedImage) -> f64 {
     let covered = image.rgba.iter().filter(|p| p[3] > 0.0).count();
-    #[allow(clippy::cast_precision_loss)]
-    let share = covered as f64 / image.rgba.len().max(1) as f64;
-    share
+    covered as f64 / image.rgba.len().max(1) as f64
 }
 
 /// Makes `view` with the proposal at `avr` (`None`: the photos alone) and its geometry for
