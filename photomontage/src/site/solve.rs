@@ -74,6 +74,9 @@ pub struct PhotoSolution {
     pub solved_by: &'static str,
     /// Where the starting focal length came from.
     pub focal_source: &'static str,
+    /// Radial residual pattern of the resection (k1 warning; see
+    /// [`crate::photogrammetry::radial_pattern`]).
+    pub radial_pattern: Option<crate::photogrammetry::radial_pattern::RadialPattern>,
 }
 
 /// A photo that could not be solved.
@@ -267,6 +270,7 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
                     estimated: r.estimated,
                     solved_by: "resection",
                     focal_source: prep.focal_source,
+                    radial_pattern: r.radial_pattern,
                 });
                 prepared_by_id.insert(p.id.clone(), prep);
             }

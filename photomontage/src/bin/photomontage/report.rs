@@ -2,6 +2,7 @@
 
 use photomontage::camera::{BrownConrady, Camera};
 use photomontage::photogrammetry::ObservationResidual;
+use photomontage::photogrammetry::radial_pattern::RadialPattern;
 use serde::Serialize;
 
 /// What `solve --json` and `resect --json` print for each photo.
@@ -26,6 +27,9 @@ pub struct PhotoRecord<'a> {
     /// How the control coordinates reached the CRS of `camera_center` (reprojected lists only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub control_crs: Option<String>,
+    /// Correlation of the radial residuals with r³ (uncorrected distortion when strong).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radial_pattern: Option<RadialPattern>,
 }
 
 pub fn rotation_rows(camera: &Camera) -> [[f64; 3]; 3] {

@@ -181,6 +181,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         residuals: &r.residuals,
         solved_by: "resection",
         control_crs,
+        radial_pattern: r.radial_pattern,
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&record)?);

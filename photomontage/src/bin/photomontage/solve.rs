@@ -65,6 +65,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 warnings: &s.warnings,
                 residuals: &s.residuals,
                 control_crs: None,
+                radial_pattern: s.radial_pattern,
                 solved_by: s.solved_by,
             }
         })
