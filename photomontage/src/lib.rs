@@ -13,6 +13,7 @@ pub mod atomic_file;
 pub mod bounded_read;
 pub mod bvh;
 pub mod camera;
+pub mod exchange;
 pub mod colour;
 pub mod farm;
 pub mod fit;
