@@ -12,6 +12,7 @@ pub mod atmosphere;
 pub mod atomic_file;
 pub mod bounded_read;
 pub mod bvh;
+pub mod calibration;
 pub mod camera;
 pub mod exchange;
 pub mod colour;

@@ -54,6 +54,11 @@ pub enum PhotoSolveError {
     },
     #[error(transparent)]
     Solver(#[from] PhotogrammetryError),
+    #[error("photo `{photo}`: {source}")]
+    Profile {
+        photo: String,
+        source: crate::calibration::profile::ProfileError,
+    },
 }
 
 /// The solution of one photo.
@@ -122,9 +127,19 @@ fn prepare(
             actual,
         });
     }
-    let (intrinsics, focal_source) = match &p.interior {
-        Some(interior) => (interior_to_intrinsics(interior, actual), "site"),
-        None => {
+    let (intrinsics, focal_source) = match (&p.interior, &p.profile) {
+        (Some(interior), _) => (interior_to_intrinsics(interior, actual), "site"),
+        (None, Some(profile)) => {
+            let profile_path = doc.resolve(profile);
+            let loaded = crate::calibration::profile::CameraProfile::load(&profile_path)
+                .and_then(|c| c.intrinsics_for(&profile_path, &p.id, actual))
+                .map_err(|source| PhotoSolveError::Profile {
+                    photo: p.id.clone(),
+                    source,
+                })?;
+            (loaded, "camera_profile")
+        }
+        (None, None) => {
             let exif = photo::read_exif(&path);
             let estimate = exif
                 .as_ref()

@@ -1,5 +1,6 @@
 //! The `photomontage` command-line tool.
 
+mod calibrate;
 mod exchange;
 mod farm;
 mod fit;
@@ -93,6 +94,9 @@ enum Command {
     /// Import cameras from a COLMAP text model or an OpenSfM reconstruction.json as initial
     /// values (interior; --with-poses also the exterior) for the site's photos.
     ImportCameras(exchange::ImportArgs),
+    /// Lens calibration from chessboard photos (own corner detector, Zhang 2000): fx, fy,
+    /// principal point, k1, k2, p1, p2, written as a camera profile (TOML) that sites reuse.
+    Calibrate(calibrate::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -124,5 +128,6 @@ fn main() -> anyhow::Result<()> {
         Command::Radiosity(args) => radiosity::run(&args),
         Command::ExportCameras(args) => exchange::export(&args),
         Command::ImportCameras(args) => exchange::import(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
     }
 }
