@@ -26,8 +26,18 @@ const SAME_CORNERS_FOCAL_TOLERANCE: f64 = 1e-4;
 const SAME_CORNERS_PP_TOLERANCE_PX: f64 = 0.05;
 const SAME_CORNERS_RMS_TOLERANCE_PX: f64 = 1e-4;
 /// Our corners against OpenCV's: both refine by gradient orthogonality, with different windows
-/// (ours ≤ 0.4 square, OpenCV's 11 px); mean distance measured 2026-11-24 (see the printout).
-const MAX_MEAN_CORNER_DISTANCE_PX: f64 = 0.25;
+/// (ours ≤ 0.4 square, OpenCV's 11 px). Measured 2026-11-24: mean 0.075 px over the 13 photos,
+/// ≤ 0.08 px on 11 of them, 0.15 px on left13 and 0.48 px on left02.
+const MAX_MEAN_CORNER_DISTANCE_PX: f64 = 0.1;
+/// The photo where OpenCV's corners are off: the board at a grazing angle, bottom squares
+/// ~7 px tall, and the 11×11 `cornerSubPix` window pulls corners up to 5 px off (OpenCV's
+/// per-view RMS there is 1.22 px against ≤ 0.47 px elsewhere; its own shipped
+/// `left_intrinsics.yml` shows the same, 1.18 px). Our window shrinks with the squares.
+const GRAZING_PHOTO: &str = "left02.jpg";
+/// All 13 photos, own corners against OpenCV's corners: OpenCV's left02 corners pull its fx by
+/// +0.38 % (534.44 px without left02, 536.46 px with it), so on all 13 the focal lengths differ
+/// by 0.59 %; the 0.5 % holds without left02 (next test). Bound for all 13: 1 %.
+const ALL_PHOTOS_FOCAL_DEVIATION: f64 = 0.01;
 
 const BOARD: (usize, usize) = (9, 6);
 const SQUARE_MM: f64 = 25.0;
@@ -119,12 +129,12 @@ fn mean_corner_distance(ours: &[Point2<f64>], theirs: &[Point2<f64>]) -> f64 {
         / ours.len() as f64
 }
 
-#[test]
-fn own_detector_finds_the_corners_and_its_calibration_matches_opencv() {
-    let Some(dir) = photomontage_tests::shared_file("data/real/calib/left01.jpg") else {
-        return;
-    };
-    let dir = dir.parent().unwrap().to_path_buf();
+/// Our detector's corners of every reference photo (None when the shared data is absent).
+fn own_views() -> Option<Vec<BoardView>> {
+    let dir = photomontage_tests::shared_file("data/real/calib/left01.jpg")?
+        .parent()
+        .unwrap()
+        .to_path_buf();
     let reference_corners = opencv_corners();
     let mut views = Vec::new();
     let mut distances = Vec::new();
@@ -146,8 +156,21 @@ fn own_detector_finds_the_corners_and_its_calibration_matches_opencv() {
     let mean = distances.iter().sum::<f64>() / distances.len() as f64;
     println!("mean over {} photos: {mean:.3} px", distances.len());
     assert!(mean < MAX_MEAN_CORNER_DISTANCE_PX, "{mean} px");
-    let ours = calibrate(&board(), &views, IMAGE_SIZE_PX, &CalibrationOptions { tangential: true }).unwrap();
-    compare(&ours, &opencv_model("k1_k2_p1_p2"), MAX_FOCAL_DEVIATION, MAX_PRINCIPAL_POINT_DEVIATION_PX);
+    Some(views)
+}
+
+#[test]
+fn own_detector_finds_every_board_and_calibrates_like_opencv() {
+    let Some(views) = own_views() else { return };
+    let all = calibrate(&board(), &views, IMAGE_SIZE_PX, &CalibrationOptions { tangential: true }).unwrap();
+    println!("all 13 photos, per-view RMS {:?}", all.view_rms_px);
+    compare(&all, &opencv_model("k1_k2_p1_p2"), ALL_PHOTOS_FOCAL_DEVIATION, MAX_PRINCIPAL_POINT_DEVIATION_PX);
+    let without: Vec<BoardView> = views.into_iter().filter(|v| v.photo != GRAZING_PHOTO).collect();
+    let reference = opencv_model("k1_k2_p1_p2_without_left02");
+    assert_eq!(reference["images"].as_array().unwrap().len(), without.len());
+    let ours = calibrate(&board(), &without, IMAGE_SIZE_PX, &CalibrationOptions { tangential: true }).unwrap();
+    println!("without {GRAZING_PHOTO}:");
+    compare(&ours, &reference, MAX_FOCAL_DEVIATION, MAX_PRINCIPAL_POINT_DEVIATION_PX);
 }
 
 #[test]

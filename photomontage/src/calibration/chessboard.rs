@@ -45,6 +45,11 @@ const SEARCH_RADIUS_FRACTION: f64 = 0.35;
 const X_JUNCTION_HARMONIC_RATIO: f64 = 0.6;
 /// Samples on the X-junction ring.
 const RING_SAMPLES: usize = 32;
+/// Ring radii (pixels) of the candidate pre-filter: a candidate passes at either. Small enough
+/// for squares foreshortened to ~7 px, large enough to step over JPEG blocking along edges.
+const PREFILTER_RING_RADII_PX: [f64; 2] = [3.0, 5.0];
+/// Growth stops beyond this many times the board's corner count.
+const MAX_GRID_FACTOR: usize = 4;
 /// Sub-pixel refinement stops when the corner moves less than this (pixels), as OpenCV's
 /// tutorial criterion (EPS 0.001 on the squared step ≈ 0.03 px; we are stricter).
 const SUBPIXEL_EPSILON_PX: f64 = 0.01;
@@ -225,6 +230,12 @@ fn candidates(smooth: &GrayImage) -> Vec<Candidate> {
     }
     out.sort_by(|a, b| b.response.total_cmp(&a.response));
     out.truncate(MAX_CANDIDATES);
+    // Saddles along edges (blocking, noise, text) are not X-junctions.
+    out.retain(|c| {
+        PREFILTER_RING_RADII_PX
+            .iter()
+            .any(|r| is_x_junction(smooth, c.point, *r))
+    });
     out
 }
 
@@ -321,7 +332,7 @@ fn grow(
                     grid.insert(target, k);
                     used.insert(k);
                     added = true;
-                    if grid.len() > max_cells {
+                    if grid.len() > MAX_GRID_FACTOR * max_cells {
                         return Some(grid);
                     }
                 }
@@ -331,6 +342,41 @@ fn grow(
             return Some(grid);
         }
     }
+}
+
+/// The fully populated columns × rows window of a grown grid (either orientation), in board
+/// order; when the grid holds several (it grew into a border row), the one with the strongest
+/// saddles.
+fn board_window(
+    grid: &std::collections::HashMap<Cell, usize>,
+    cands: &[Candidate],
+    columns: usize,
+    rows: usize,
+) -> Option<Vec<Point2<f64>>> {
+    let (i0, i1) = grid.keys().fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.0), m.1.max(c.0)));
+    let (j0, j1) = grid.keys().fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.1), m.1.max(c.1)));
+    let mut best: Option<(f64, Vec<Point2<f64>>)> = None;
+    for transpose in [false, true] {
+        let (wi, wj) = if transpose { (rows as i64, columns as i64) } else { (columns as i64, rows as i64) };
+        for a in i0..=i1 - wi + 1 {
+            for b in j0..=j1 - wj + 1 {
+                let mut corners = Vec::with_capacity(columns * rows);
+                let mut strength = 0.0;
+                'cells: for r in 0..rows as i64 {
+                    for c in 0..columns as i64 {
+                        let cell = if transpose { (a + r, b + c) } else { (a + c, b + r) };
+                        let Some(&k) = grid.get(&cell) else { break 'cells };
+                        corners.push(cands[k].point);
+                        strength += cands[k].response;
+                    }
+                }
+                if corners.len() == columns * rows && best.as_ref().is_none_or(|(s, _)| strength > *s) {
+                    best = Some((strength, corners));
+                }
+            }
+        }
+    }
+    best.map(|(_, corners)| corners)
 }
 
 /// Refines a corner by the gradient-orthogonality condition (OpenCV `cornerSubPix`).
@@ -395,31 +441,13 @@ pub fn find_chessboard(
         let Some(grid) = grow(&smooth, &cands, seed, expected) else {
             continue;
         };
-        largest = largest.max(grid.len());
-        if grid.len() != expected {
+        largest = largest.max(grid.len().min(expected));
+        if grid.len() < expected {
             continue;
         }
-        let (i0, i1) = grid.keys().fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.0), m.1.max(c.0)));
-        let (j0, j1) = grid.keys().fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.1), m.1.max(c.1)));
-        let (span_i, span_j) = ((i1 - i0 + 1) as usize, (j1 - j0 + 1) as usize);
-        let transpose = if (span_i, span_j) == (columns, rows) {
-            false
-        } else if (span_i, span_j) == (rows, columns) {
-            true
-        } else {
+        let Some(corners) = board_window(&grid, &cands, columns, rows) else {
             continue;
         };
-        let mut corners = Vec::with_capacity(expected);
-        for r in 0..rows as i64 {
-            for c in 0..columns as i64 {
-                let cell = if transpose { (i0 + r, j0 + c) } else { (i0 + c, j0 + r) };
-                let Some(&k) = grid.get(&cell) else { break };
-                corners.push(cands[k].point);
-            }
-        }
-        if corners.len() != expected {
-            continue;
-        }
         // Square size near each corner bounds the refinement window.
         let refined = corners
             .iter()
