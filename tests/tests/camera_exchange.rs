@@ -10,7 +10,6 @@
 
 use std::collections::HashMap;
 
-
 use nalgebra::{Matrix3, Point2, Point3, Rotation3, Vector3};
 use photomontage::camera::{BrownConrady, Camera};
 use photomontage::exchange::colmap::{ColmapModel, read_colmap, write_colmap};
@@ -211,9 +210,10 @@ fn check_site(name: &str, distortion: Option<BrownConrady>) {
     opencv_yaml::write_opencv(&set, dir.path()).unwrap();
     let mut worst_opencv: f64 = 0.0;
     for (k, id, x, px) in &ours {
-        let file = dir
-            .path()
-            .join(format!("{}.yml", opencv_yaml::file_stem(&set.cameras[*k].id)));
+        let file = dir.path().join(format!(
+            "{}.yml",
+            opencv_yaml::file_stem(&set.cameras[*k].id)
+        ));
         let yaml = std::fs::read_to_string(file).unwrap();
         let e = (opencv_project(&yaml, x) - px).norm();
         worst_opencv = worst_opencv.max(e);
@@ -249,7 +249,10 @@ fn a_colmap_model_without_the_photos_k1_is_refused_naming_k1() {
         other => panic!("{other}"),
     }
     let text = err.to_string();
-    assert!(text.contains("SIMPLE_PINHOLE") && text.contains("k1"), "{text}");
+    assert!(
+        text.contains("SIMPLE_PINHOLE") && text.contains("k1"),
+        "{text}"
+    );
     assert!(!dir.path().join("cameras.txt").exists(), "nothing written");
 }
 
@@ -288,7 +291,10 @@ fn assert_cameras_equal(a: &Camera, b: &Camera) {
     let difference = (a.pose.rotation_world_from_camera.matrix()
         - b.pose.rotation_world_from_camera.matrix())
     .norm();
-    assert!(difference < ROUND_TRIP_TOLERANCE, "rotation differs by {difference}");
+    assert!(
+        difference < ROUND_TRIP_TOLERANCE,
+        "rotation differs by {difference}"
+    );
 }
 
 #[test]
@@ -296,20 +302,36 @@ fn colmap_fisheye_and_non_square_cameras_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let images = "1 1 0 0 0 0 0 0 1 a.jpg\n\n";
     for (cameras, needle) in [
-        ("1 OPENCV_FISHEYE 100 80 90 90 50 40 0.1 0 0 0\n", "OPENCV_FISHEYE"),
+        (
+            "1 OPENCV_FISHEYE 100 80 90 90 50 40 0.1 0 0 0\n",
+            "OPENCV_FISHEYE",
+        ),
         ("1 PINHOLE 100 80 90 95 50 40\n", "fy = 95"),
-        ("1 FULL_OPENCV 100 80 90 90 50 40 0 0 0 0 0 0.2 0 0\n", "k4 = 0.2"),
-        ("1 SIMPLE_RADIAL 100 80 90 50\n", "2 parameters given, 4 expected"),
+        (
+            "1 FULL_OPENCV 100 80 90 90 50 40 0 0 0 0 0 0.2 0 0\n",
+            "k4 = 0.2",
+        ),
+        (
+            "1 SIMPLE_RADIAL 100 80 90 50\n",
+            "2 parameters given, 4 expected",
+        ),
     ] {
         std::fs::write(dir.path().join("cameras.txt"), cameras).unwrap();
         std::fs::write(dir.path().join("images.txt"), images).unwrap();
         let err = read_colmap(dir.path()).unwrap_err().to_string();
         assert!(err.contains(needle) && err.contains("cameras.txt"), "{err}");
     }
-    std::fs::write(dir.path().join("cameras.txt"), "1 SIMPLE_PINHOLE 100 80 90 50 40\n").unwrap();
+    std::fs::write(
+        dir.path().join("cameras.txt"),
+        "1 SIMPLE_PINHOLE 100 80 90 50 40\n",
+    )
+    .unwrap();
     std::fs::write(dir.path().join("images.txt"), "1 1 0 0 0 x 0 0 1 a.jpg\n").unwrap();
     let err = read_colmap(dir.path()).unwrap_err().to_string();
-    assert!(err.contains("images.txt line 1") && err.contains("`x`"), "{err}");
+    assert!(
+        err.contains("images.txt line 1") && err.contains("`x`"),
+        "{err}"
+    );
 }
 
 /// OpenSfM's conventions, written out by hand for one `brown` camera and one `perspective`
@@ -335,25 +357,36 @@ fn opensfm_shots_project_as_opensfm_defines_them() {
     assert_eq!(cameras.len(), 2);
     let x = Point3::new(0.7, -1.3, 2.1);
     for c in &cameras {
-        let (rot, t, size, f, cxy, d): ([f64; 3], [f64; 3], [f64; 2], f64, [f64; 2], BrownConrady) = if c.image_name == "a.jpg" {
-            (
-                [0.1, -0.2, 0.3],
-                [1.0, 2.0, 30.0],
-                [4000.0, 3000.0],
-                0.8,
-                [0.01, -0.02],
-                BrownConrady { k1: -0.1, k2: 0.02, k3: 0.001, p1: 0.0005, p2: -0.0003 },
-            )
-        } else {
-            (
-                [-0.3, 0.1, 0.05],
-                [-2.0, 0.5, 20.0],
-                [1000.0, 1500.0],
-                0.9,
-                [0.0, 0.0],
-                BrownConrady { k1: -0.05, k2: 0.01, ..BrownConrady::default() },
-            )
-        };
+        let (rot, t, size, f, cxy, d): ([f64; 3], [f64; 3], [f64; 2], f64, [f64; 2], BrownConrady) =
+            if c.image_name == "a.jpg" {
+                (
+                    [0.1, -0.2, 0.3],
+                    [1.0, 2.0, 30.0],
+                    [4000.0, 3000.0],
+                    0.8,
+                    [0.01, -0.02],
+                    BrownConrady {
+                        k1: -0.1,
+                        k2: 0.02,
+                        k3: 0.001,
+                        p1: 0.0005,
+                        p2: -0.0003,
+                    },
+                )
+            } else {
+                (
+                    [-0.3, 0.1, 0.05],
+                    [-2.0, 0.5, 20.0],
+                    [1000.0, 1500.0],
+                    0.9,
+                    [0.0, 0.0],
+                    BrownConrady {
+                        k1: -0.05,
+                        k2: 0.01,
+                        ..BrownConrady::default()
+                    },
+                )
+            };
         let r = Rotation3::new(Vector3::from(rot));
         let p = r * x.coords + Vector3::from(t);
         let n = d.distort(Point2::new(p.x / p.z, p.y / p.z));
@@ -363,11 +396,16 @@ fn opensfm_shots_project_as_opensfm_defines_them() {
             s * (f * n.y + cxy[1]) + size[1] / 2.0 - 0.5,
         );
         let got = c.camera.project(&x).unwrap();
-        assert!((got - expected).norm() < 1e-9, "{}: {got} vs {expected}", c.image_name);
+        assert!(
+            (got - expected).norm() < 1e-9,
+            "{}: {got} vs {expected}",
+            c.image_name
+        );
     }
     // A shot on the fisheye camera is refused naming its projection.
     let fisheye = json.replace("\"camera\": \"v2 persp\"", "\"camera\": \"v2 fish\"");
-    let err = parse_opensfm(&fisheye, "reconstruction.json").unwrap_err().to_string();
+    let err = parse_opensfm(&fisheye, "reconstruction.json")
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("fisheye") && err.contains("v2 fish"), "{err}");
 }
-

@@ -35,7 +35,11 @@ fn courtyard_with_profile(size: [u32; 2]) -> (tempfile::TempDir, SiteDocument) {
     let path = dir.path().join("lens.toml");
     std::fs::write(&path, profile(size).to_toml().unwrap()).unwrap();
     let back = CameraProfile::load(&path).unwrap();
-    assert_eq!(back, profile(size), "the TOML reads back to the same profile");
+    assert_eq!(
+        back,
+        profile(size),
+        "the TOML reads back to the same profile"
+    );
     let mut doc = SiteDocument::load(&sample_site("courtyard").join("site.toml")).unwrap();
     for p in &mut doc.site.photos {
         p.interior = None;
@@ -63,5 +67,8 @@ fn a_profile_for_another_image_size_is_refused_naming_photo_and_profile() {
     let solution = solve_site(&doc);
     assert_eq!(solution.failures.len(), 3);
     let e = &solution.failures[0].error;
-    assert!(e.contains("P1") && e.contains("lens.toml") && e.contains("[640, 480]"), "{e}");
+    assert!(
+        e.contains("P1") && e.contains("lens.toml") && e.contains("[640, 480]"),
+        "{e}"
+    );
 }

@@ -89,8 +89,16 @@ fn compare(ours: &Calibration, reference: &Value, focal_tol: f64, pp_tol: f64) {
         ours.rms_px,
         f(reference, "rms_px")
     );
-    assert!((ours.fx_px / fx - 1.0).abs() < focal_tol, "fx {} vs {fx}", ours.fx_px);
-    assert!((ours.fy_px / fy - 1.0).abs() < focal_tol, "fy {} vs {fy}", ours.fy_px);
+    assert!(
+        (ours.fx_px / fx - 1.0).abs() < focal_tol,
+        "fx {} vs {fx}",
+        ours.fx_px
+    );
+    assert!(
+        (ours.fy_px / fy - 1.0).abs() < focal_tol,
+        "fy {} vs {fy}",
+        ours.fy_px
+    );
     assert!((ours.principal_point_px[0] - cx).abs() < pp_tol, "cx");
     assert!((ours.principal_point_px[1] - cy).abs() < pp_tol, "cy");
 }
@@ -110,21 +118,42 @@ fn zhang_on_opencv_corners_matches_calibrate_camera() {
     let views = views_from(&opencv_corners());
     assert_eq!(views.len(), 13);
     for (label, tangential) in [("k1_k2_p1_p2", true), ("k1_k2", false)] {
-        let ours = calibrate(&board(), &views, IMAGE_SIZE_PX, &CalibrationOptions { tangential }).unwrap();
+        let ours = calibrate(
+            &board(),
+            &views,
+            IMAGE_SIZE_PX,
+            &CalibrationOptions { tangential },
+        )
+        .unwrap();
         assert!(ours.converged);
         let reference = opencv_model(label);
         println!("{label}: closed form {:?}", ours.closed_form);
-        compare(&ours, &reference, SAME_CORNERS_FOCAL_TOLERANCE, SAME_CORNERS_PP_TOLERANCE_PX);
+        compare(
+            &ours,
+            &reference,
+            SAME_CORNERS_FOCAL_TOLERANCE,
+            SAME_CORNERS_PP_TOLERANCE_PX,
+        );
         assert!((ours.rms_px - f(&reference, "rms_px")).abs() < SAME_CORNERS_RMS_TOLERANCE_PX);
         // And therefore within the bounds.
-        compare(&ours, &reference, MAX_FOCAL_DEVIATION, MAX_PRINCIPAL_POINT_DEVIATION_PX);
+        compare(
+            &ours,
+            &reference,
+            MAX_FOCAL_DEVIATION,
+            MAX_PRINCIPAL_POINT_DEVIATION_PX,
+        );
     }
 }
 
 /// Mean distance from each of our corners to the nearest OpenCV corner of the same photo.
 fn mean_corner_distance(ours: &[Point2<f64>], theirs: &[Point2<f64>]) -> f64 {
     ours.iter()
-        .map(|p| theirs.iter().map(|q| (p - q).norm()).fold(f64::INFINITY, f64::min))
+        .map(|p| {
+            theirs
+                .iter()
+                .map(|q| (p - q).norm())
+                .fold(f64::INFINITY, f64::min)
+        })
         .sum::<f64>()
         / ours.len() as f64
 }
@@ -140,8 +169,8 @@ fn own_views() -> Option<Vec<BoardView>> {
     let mut distances = Vec::new();
     for (photo, theirs) in &reference_corners {
         let image = GrayImage::load(&dir.join(photo)).unwrap();
-        let ours = find_chessboard(&image, photo, BOARD.0, BOARD.1)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let ours =
+            find_chessboard(&image, photo, BOARD.0, BOARD.1).unwrap_or_else(|e| panic!("{e}"));
         let d = mean_corner_distance(&ours, theirs);
         // Every OpenCV corner is matched by one of ours (no corner found twice, none missed).
         let back = mean_corner_distance(theirs, &ours);
@@ -162,15 +191,40 @@ fn own_views() -> Option<Vec<BoardView>> {
 #[test]
 fn own_detector_finds_every_board_and_calibrates_like_opencv() {
     let Some(views) = own_views() else { return };
-    let all = calibrate(&board(), &views, IMAGE_SIZE_PX, &CalibrationOptions { tangential: true }).unwrap();
+    let all = calibrate(
+        &board(),
+        &views,
+        IMAGE_SIZE_PX,
+        &CalibrationOptions { tangential: true },
+    )
+    .unwrap();
     println!("all 13 photos, per-view RMS {:?}", all.view_rms_px);
-    compare(&all, &opencv_model("k1_k2_p1_p2"), ALL_PHOTOS_FOCAL_DEVIATION, MAX_PRINCIPAL_POINT_DEVIATION_PX);
-    let without: Vec<BoardView> = views.into_iter().filter(|v| v.photo != GRAZING_PHOTO).collect();
+    compare(
+        &all,
+        &opencv_model("k1_k2_p1_p2"),
+        ALL_PHOTOS_FOCAL_DEVIATION,
+        MAX_PRINCIPAL_POINT_DEVIATION_PX,
+    );
+    let without: Vec<BoardView> = views
+        .into_iter()
+        .filter(|v| v.photo != GRAZING_PHOTO)
+        .collect();
     let reference = opencv_model("k1_k2_p1_p2_without_left02");
     assert_eq!(reference["images"].as_array().unwrap().len(), without.len());
-    let ours = calibrate(&board(), &without, IMAGE_SIZE_PX, &CalibrationOptions { tangential: true }).unwrap();
+    let ours = calibrate(
+        &board(),
+        &without,
+        IMAGE_SIZE_PX,
+        &CalibrationOptions { tangential: true },
+    )
+    .unwrap();
     println!("without {GRAZING_PHOTO}:");
-    compare(&ours, &reference, MAX_FOCAL_DEVIATION, MAX_PRINCIPAL_POINT_DEVIATION_PX);
+    compare(
+        &ours,
+        &reference,
+        MAX_FOCAL_DEVIATION,
+        MAX_PRINCIPAL_POINT_DEVIATION_PX,
+    );
 }
 
 #[test]
@@ -183,10 +237,15 @@ fn a_board_that_is_not_there_is_refused_naming_the_photo() {
     let err = find_chessboard(&image, "left01.jpg", 10, 7).unwrap_err();
     assert!(matches!(err, ChessboardError::NotFound { .. }));
     let text = err.to_string();
-    assert!(text.contains("left01.jpg") && text.contains("10×7"), "{text}");
+    assert!(
+        text.contains("left01.jpg") && text.contains("10×7"),
+        "{text}"
+    );
     // A photo without a board.
     let site = photomontage_tests::sample_site("courtyard").join("photos/P1.png");
     let image = GrayImage::load(&site).unwrap();
-    let text = find_chessboard(&image, "P1.png", 9, 6).unwrap_err().to_string();
+    let text = find_chessboard(&image, "P1.png", 9, 6)
+        .unwrap_err()
+        .to_string();
     assert!(text.contains("P1.png"), "{text}");
 }

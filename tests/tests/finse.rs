@@ -23,6 +23,10 @@ const MAX_VERTICAL_OFFSET_M: f64 = 3.0;
 const CLICK_SIGMA_PX: f64 = 4.0;
 /// Focal length from the data sheet (4 mm on a 5.175 mm wide 1920 px sensor), the start.
 const DATASHEET_FOCAL_PX: f64 = 1484.0;
+/// Without outlier rejection our solve and OpenCV's `calibrateCamera` minimise the same cost:
+/// they agree to their stopping tolerances.
+const PEER_RELATIVE_TOLERANCE: f64 = 1e-4;
+const PEER_CENTRE_TOLERANCE_M: f64 = 0.01;
 /// A pinhole solve is "far off" beyond this (issue: about 8 m).
 const PINHOLE_OFFSET_AT_LEAST_M: f64 = 5.0;
 
@@ -107,13 +111,19 @@ fn finse_self_calibrated_f_k1_k2_meets_the_rms_and_camera_position() {
         "f {:.1} px, k1 {:.4}, k2 {:.4}; RMS over 45 GCPs {rms:.2} px (outliers {:?}); centre {horizontal:.2} m horizontally, {vertical:+.2} m vertically from camera_pos; σ0 {:.2}; warnings {:?}",
         intr.focal_px, intr.distortion.k1, intr.distortion.k2, r.outliers, r.sigma0, r.warnings
     );
-    assert!(r.estimated.focal && r.estimated.k1 && r.estimated.k2, "{:?}", r.warnings);
+    assert!(
+        r.estimated.focal && r.estimated.k1 && r.estimated.k2,
+        "{:?}",
+        r.warnings
+    );
     assert!(rms <= MAX_RMS_PX, "RMS {rms} px");
     assert!(horizontal <= MAX_HORIZONTAL_OFFSET_M, "{horizontal} m");
     assert!(vertical.abs() <= MAX_VERTICAL_OFFSET_M, "{vertical} m");
     assert!(intr.distortion.k1 < 0.0, "barrel distortion: k1 < 0");
     assert!(
-        !r.warnings.iter().any(|w| w.contains("radial residual pattern")),
+        !r.warnings
+            .iter()
+            .any(|w| w.contains("radial residual pattern")),
         "{:?}",
         r.warnings
     );
@@ -134,8 +144,56 @@ fn finse_pinhole_solve_warns_about_the_radial_residual_pattern() {
     assert!(pattern.is_significant(), "{pattern:?}");
     assert!(pattern.implied_k1 < 0.0, "barrel: {pattern:?}");
     assert!(
-        r.warnings.iter().any(|w| w.contains("radial residual pattern")),
+        r.warnings
+            .iter()
+            .any(|w| w.contains("radial residual pattern")),
         "{:?}",
         r.warnings
     );
+}
+
+/// The same solve with every GCP kept against `peers/finse/opencv_calibrate_finse.py`
+/// (`cv2.calibrateCamera`, f k1 k2 free, principal point fixed at the centre).
+#[test]
+fn finse_without_outlier_rejection_matches_opencv_calibrate_camera() {
+    let Some(data) = finse() else { return };
+    let text = std::fs::read_to_string(
+        photomontage_tests::repo_root().join("peers/finse/opencv_finse.json"),
+    )
+    .unwrap();
+    let peer: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let num = |k: &str| peer[k].as_f64().unwrap();
+    let mut options = ResectionOptions::new(Intrinsics::centred(DATASHEET_FOCAL_PX, [1920, 1080]));
+    options.self_calibration = SelfCalibration {
+        focal: true,
+        k1: true,
+        k2: true,
+        ..SelfCalibration::default()
+    };
+    options.outlier_threshold_sigma = f64::MAX;
+    let r = resect(&data.control, &data.observations, &options).unwrap();
+    assert!(r.outliers.is_empty());
+    let intr = r.camera.intrinsics;
+    let rms = rms_all_px(&r);
+    println!(
+        "all 45 kept: f {:.3} k1 {:.5} k2 {:.5} RMS {rms:.4} px; OpenCV f {:.3} k1 {:.5} k2 {:.5} RMS {:.4} px",
+        intr.focal_px,
+        intr.distortion.k1,
+        intr.distortion.k2,
+        num("f_px"),
+        num("k1"),
+        num("k2"),
+        num("rms_px_all_45")
+    );
+    assert!((intr.focal_px / num("f_px") - 1.0).abs() < PEER_RELATIVE_TOLERANCE);
+    assert!((intr.distortion.k1 - num("k1")).abs() < PEER_RELATIVE_TOLERANCE * 10.0);
+    assert!((intr.distortion.k2 - num("k2")).abs() < PEER_RELATIVE_TOLERANCE * 10.0);
+    assert!((rms / num("rms_px_all_45") - 1.0).abs() < PEER_RELATIVE_TOLERANCE);
+    let c = &peer["camera_center"];
+    let centre = Point3::new(
+        c[0].as_f64().unwrap(),
+        c[1].as_f64().unwrap(),
+        c[2].as_f64().unwrap(),
+    );
+    assert!((r.camera.pose.camera_center_in_world - centre).norm() < PEER_CENTRE_TOLERANCE_M);
 }

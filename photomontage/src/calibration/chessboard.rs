@@ -207,7 +207,7 @@ fn candidates(smooth: &GrayImage) -> Vec<Candidate> {
             'window: for yy in y - n..=y + n {
                 for xx in x - n..=x + n {
                     let o = s[yy * w + xx];
-                    if o > r || (o == r && (yy, xx) < (y, x)) {
+                    if o > r || (o.total_cmp(&r).is_eq() && (yy, xx) < (y, x)) {
                         is_max = false;
                         break 'window;
                     }
@@ -217,7 +217,11 @@ fn candidates(smooth: &GrayImage) -> Vec<Candidate> {
                 // Sub-pixel peak of S by a 1-D parabola per axis.
                 let px = |a: f64, b: f64, c: f64| {
                     let d = a - 2.0 * b + c;
-                    if d.abs() > 0.0 { (0.5 * (a - c) / d).clamp(-0.5, 0.5) } else { 0.0 }
+                    if d.abs() > 0.0 {
+                        (0.5 * (a - c) / d).clamp(-0.5, 0.5)
+                    } else {
+                        0.0
+                    }
                 };
                 let dx = px(s[y * w + x - 1], r, s[y * w + x + 1]);
                 let dy = px(s[(y - 1) * w + x], r, s[(y + 1) * w + x]);
@@ -245,7 +249,10 @@ fn is_x_junction(smooth: &GrayImage, p: Point2<f64>, radius: f64) -> bool {
     let mut values = Vec::with_capacity(RING_SAMPLES);
     for k in 0..RING_SAMPLES {
         let a = std::f64::consts::TAU * k as f64 / RING_SAMPLES as f64;
-        values.push((a, smooth.sample(p.x + radius * a.cos(), p.y + radius * a.sin())));
+        values.push((
+            a,
+            smooth.sample(p.x + radius * a.cos(), p.y + radius * a.sin()),
+        ));
     }
     let mean = values.iter().map(|v| v.1).sum::<f64>() / RING_SAMPLES as f64;
     for (a, v) in &values {
@@ -304,7 +311,9 @@ fn grow(
                 if grid.contains_key(&target) {
                     continue;
                 }
-                let Some(p) = point(&grid, (i, j)) else { continue };
+                let Some(p) = point(&grid, (i, j)) else {
+                    continue;
+                };
                 let mut prediction = None;
                 if let Some(q) = point(&grid, (i - di, j - dj)) {
                     prediction = Some((p + (p - q), (p - q).norm()));
@@ -319,13 +328,19 @@ fn grow(
                         }
                     }
                 }
-                let Some((pred, step)) = prediction else { continue };
+                let Some((pred, step)) = prediction else {
+                    continue;
+                };
                 let radius = SEARCH_RADIUS_FRACTION * step;
                 let best = cands
                     .iter()
                     .enumerate()
                     .filter(|(k, c)| !used.contains(k) && (c.point - pred).norm() < radius)
-                    .min_by(|x, y| (x.1.point - pred).norm().total_cmp(&(y.1.point - pred).norm()));
+                    .min_by(|x, y| {
+                        (x.1.point - pred)
+                            .norm()
+                            .total_cmp(&(y.1.point - pred).norm())
+                    });
                 if let Some((k, c)) = best
                     && is_x_junction(smooth, c.point, (0.3 * step).max(2.0))
                 {
@@ -353,24 +368,40 @@ fn board_window(
     columns: usize,
     rows: usize,
 ) -> Option<Vec<Point2<f64>>> {
-    let (i0, i1) = grid.keys().fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.0), m.1.max(c.0)));
-    let (j0, j1) = grid.keys().fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.1), m.1.max(c.1)));
+    let (i0, i1) = grid
+        .keys()
+        .fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.0), m.1.max(c.0)));
+    let (j0, j1) = grid
+        .keys()
+        .fold((i64::MAX, i64::MIN), |m, c| (m.0.min(c.1), m.1.max(c.1)));
     let mut best: Option<(f64, Vec<Point2<f64>>)> = None;
     for transpose in [false, true] {
-        let (wi, wj) = if transpose { (rows as i64, columns as i64) } else { (columns as i64, rows as i64) };
+        let (wi, wj) = if transpose {
+            (rows as i64, columns as i64)
+        } else {
+            (columns as i64, rows as i64)
+        };
         for a in i0..=i1 - wi + 1 {
             for b in j0..=j1 - wj + 1 {
                 let mut corners = Vec::with_capacity(columns * rows);
                 let mut strength = 0.0;
                 'cells: for r in 0..rows as i64 {
                     for c in 0..columns as i64 {
-                        let cell = if transpose { (a + r, b + c) } else { (a + c, b + r) };
-                        let Some(&k) = grid.get(&cell) else { break 'cells };
+                        let cell = if transpose {
+                            (a + r, b + c)
+                        } else {
+                            (a + c, b + r)
+                        };
+                        let Some(&k) = grid.get(&cell) else {
+                            break 'cells;
+                        };
                         corners.push(cands[k].point);
                         strength += cands[k].response;
                     }
                 }
-                if corners.len() == columns * rows && best.as_ref().is_none_or(|(s, _)| strength > *s) {
+                if corners.len() == columns * rows
+                    && best.as_ref().is_none_or(|(s, _)| strength > *s)
+                {
                     best = Some((strength, corners));
                 }
             }
@@ -454,8 +485,16 @@ pub fn find_chessboard(
             .enumerate()
             .map(|(k, &p)| {
                 let (c, r) = (k % columns, k / columns);
-                let neighbour = if c + 1 < columns { corners[k + 1] } else { corners[k - 1] };
-                let other = if r + 1 < rows { corners[k + columns] } else { corners[k - columns] };
+                let neighbour = if c + 1 < columns {
+                    corners[k + 1]
+                } else {
+                    corners[k - 1]
+                };
+                let other = if r + 1 < rows {
+                    corners[k + columns]
+                } else {
+                    corners[k - columns]
+                };
                 let step = (neighbour - p).norm().min((other - p).norm());
                 #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // small positive
                 let hw = ((0.4 * step).floor() as usize).clamp(2, 11);

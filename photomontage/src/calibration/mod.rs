@@ -64,13 +64,14 @@ impl Board {
         let err = || CalibrationError::BoardSpec {
             text: text.to_owned(),
         };
-        let (c, r) = text
-            .trim()
-            .split_once(['x', 'X', '×'])
-            .ok_or_else(err)?;
+        let (c, r) = text.trim().split_once(['x', 'X', '×']).ok_or_else(err)?;
         let columns: usize = c.trim().parse().map_err(|_| err())?;
         let rows: usize = r.trim().parse().map_err(|_| err())?;
-        if columns < 2 || rows < 2 || columns * rows > 10_000 || !(square_mm.is_finite() && square_mm > 0.0) {
+        if columns < 2
+            || rows < 2
+            || columns * rows > 10_000
+            || !(square_mm.is_finite() && square_mm > 0.0)
+        {
             return Err(err());
         }
         Ok(Self {
@@ -85,9 +86,8 @@ impl Board {
     pub fn plane_points(&self) -> Vec<Point2<f64>> {
         (0..self.rows)
             .flat_map(|j| {
-                (0..self.columns).map(move |i| {
-                    Point2::new(self.square_m * i as f64, self.square_m * j as f64)
-                })
+                (0..self.columns)
+                    .map(move |i| Point2::new(self.square_m * i as f64, self.square_m * j as f64))
             })
             .collect()
     }
@@ -155,7 +155,17 @@ pub fn calibrate(
     let [w, h] = image_size_px.map(f64::from);
     let s = w.max(h);
     // Image coordinates scaled to ~[−0.5, 0.5] for conditioning (see `zhang`).
-    let n = Matrix3::new(1.0 / s, 0.0, -w / 2.0 / s, 0.0, 1.0 / s, -h / 2.0 / s, 0.0, 0.0, 1.0);
+    let n = Matrix3::new(
+        1.0 / s,
+        0.0,
+        -w / 2.0 / s,
+        0.0,
+        1.0 / s,
+        -h / 2.0 / s,
+        0.0,
+        0.0,
+        1.0,
+    );
     let mut homographies = Vec::with_capacity(views.len());
     for v in views {
         if v.corners_px.len() != plane.len() {
@@ -172,9 +182,10 @@ pub fn calibrate(
             .iter()
             .map(|p| Point2::new((p.x - w / 2.0) / s, (p.y - h / 2.0) / s))
             .collect();
-        let hm = zhang::homography(&plane, &scaled).ok_or_else(|| CalibrationError::NoHomography {
-            photo: v.photo.clone(),
-        })?;
+        let hm =
+            zhang::homography(&plane, &scaled).ok_or_else(|| CalibrationError::NoHomography {
+                photo: v.photo.clone(),
+            })?;
         homographies.push(hm);
     }
     let k_scaled = zhang::intrinsics_from_homographies(&homographies)?;
@@ -184,12 +195,23 @@ pub fn calibrate(
         .iter()
         .zip(views)
         .map(|(hm, v)| {
-            zhang::pose_from_homography(&k_scaled, hm).ok_or_else(|| CalibrationError::NoHomography {
-                photo: v.photo.clone(),
+            zhang::pose_from_homography(&k_scaled, hm).ok_or_else(|| {
+                CalibrationError::NoHomography {
+                    photo: v.photo.clone(),
+                }
             })
         })
         .collect::<Result<_, _>>()?;
-    let start = [k[(0, 0)], k[(1, 1)], k[(0, 2)], k[(1, 2)], 0.0, 0.0, 0.0, 0.0];
+    let start = [
+        k[(0, 0)],
+        k[(1, 1)],
+        k[(0, 2)],
+        k[(1, 2)],
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
     let corners: Vec<Vec<Point2<f64>>> = views.iter().map(|v| v.corners_px.clone()).collect();
     let r = refine::refine(&plane, &corners, start, &poses, options.tangential)
         .ok_or(CalibrationError::NoConvergence)?;

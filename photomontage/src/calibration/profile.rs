@@ -121,7 +121,12 @@ impl CameraProfile {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-        let finite = [p.fx_px, p.fy_px, p.principal_point_px[0], p.principal_point_px[1]];
+        let finite = [
+            p.fx_px,
+            p.fy_px,
+            p.principal_point_px[0],
+            p.principal_point_px[1],
+        ];
         if finite.iter().any(|v| !v.is_finite()) || p.fx_px <= 0.0 || p.fy_px <= 0.0 {
             return Err(ProfileError::Parse {
                 path: path.to_path_buf(),
@@ -160,7 +165,12 @@ impl CameraProfile {
     ///
     /// # Errors
     /// [`ProfileError::SizeMismatch`].
-    pub fn intrinsics_for(&self, path: &Path, photo: &str, photo_size: [u32; 2]) -> Result<Intrinsics, ProfileError> {
+    pub fn intrinsics_for(
+        &self,
+        path: &Path,
+        photo: &str,
+        photo_size: [u32; 2],
+    ) -> Result<Intrinsics, ProfileError> {
         if photo_size != self.image_size_px {
             return Err(ProfileError::SizeMismatch {
                 path: path.to_path_buf(),

@@ -38,7 +38,12 @@ pub struct Refined {
 
 /// Pixel of a board point (X, Y, 0) for intrinsics `k` and a pose.
 #[must_use]
-pub fn project(k: &[f64], rotation_vector: &Vector3<f64>, t: &Vector3<f64>, board: &Point2<f64>) -> Point2<f64> {
+pub fn project(
+    k: &[f64],
+    rotation_vector: &Vector3<f64>,
+    t: &Vector3<f64>,
+    board: &Point2<f64>,
+) -> Point2<f64> {
     let r = Rotation3::new(*rotation_vector);
     let x = r * Vector3::new(board.x, board.y, 0.0) + t;
     let n = Point2::new(x.x / x.z, x.y / x.z);
@@ -185,7 +190,11 @@ pub fn refine(
     let corners = (board.len() * views.len()) as f64;
     let rms_px = (solution.cost / corners).sqrt();
     let redundancy = 2.0 * corners - problem.unknowns() as f64;
-    let sigma0_sq = if redundancy > 0.0 { solution.cost / redundancy } else { 1.0 };
+    let sigma0_sq = if redundancy > 0.0 {
+        solution.cost / redundancy
+    } else {
+        1.0
+    };
     let mut sigma = [0.0; INTRINSIC_COUNT];
     if let Some(inv) = spd_inverse(&solution.normal) {
         for (c, &i) in free.iter().enumerate() {

@@ -18,9 +18,16 @@ use super::CalibrationError;
 /// The similarity that takes `points` to centroid 0 and mean distance √2 (Hartley).
 fn normalising_transform(points: &[Point2<f64>]) -> Matrix3<f64> {
     let n = points.len().max(1) as f64;
-    let c = points.iter().fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords) / n;
+    let c = points
+        .iter()
+        .fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords)
+        / n;
     let mean = points.iter().map(|p| (p.coords - c).norm()).sum::<f64>() / n;
-    let s = if mean > 0.0 { std::f64::consts::SQRT_2 / mean } else { 1.0 };
+    let s = if mean > 0.0 {
+        std::f64::consts::SQRT_2 / mean
+    } else {
+        1.0
+    };
     Matrix3::new(s, 0.0, -s * c.x, 0.0, s, -s * c.y, 0.0, 0.0, 1.0)
 }
 
@@ -112,7 +119,8 @@ pub fn intrinsics_from_homographies(hs: &[Matrix3<f64>]) -> Result<Matrix3<f64>,
     };
     let b = smallest_right_singular_vector(&vm).ok_or_else(|| degenerate("no null vector of V"))?;
     // Zhang, Appendix B.
-    let [mut b11, mut b12, mut b22, mut b13, mut b23, mut b33] = [b[0], b[1], b[2], b[3], b[4], b[5]];
+    let [mut b11, mut b12, mut b22, mut b13, mut b23, mut b33] =
+        [b[0], b[1], b[2], b[3], b[4], b[5]];
     if b11 < 0.0 {
         for x in [&mut b11, &mut b12, &mut b22, &mut b13, &mut b23, &mut b33] {
             *x = -*x;
@@ -139,7 +147,10 @@ pub fn intrinsics_from_homographies(hs: &[Matrix3<f64>]) -> Result<Matrix3<f64>,
 /// The pose (R_camera_from_board, t) of one view from K and its homography (Zhang §3.1), R made
 /// orthonormal by SVD (Appendix C) and the board put in front of the camera.
 #[must_use]
-pub fn pose_from_homography(k: &Matrix3<f64>, h: &Matrix3<f64>) -> Option<(Rotation3<f64>, Vector3<f64>)> {
+pub fn pose_from_homography(
+    k: &Matrix3<f64>,
+    h: &Matrix3<f64>,
+) -> Option<(Rotation3<f64>, Vector3<f64>)> {
     let k_inv = k.try_inverse()?;
     let a1 = k_inv * h.column(0);
     let a2 = k_inv * h.column(1);
@@ -171,13 +182,27 @@ mod tests {
     fn closed_form_recovers_k_and_poses_from_exact_views() {
         let k = Matrix3::new(800.0, 0.0, 330.0, 0.0, 800.0, 245.0, 0.0, 0.0, 1.0);
         let plane: Vec<Point2<f64>> = (0..6)
-            .flat_map(|j| (0..9).map(move |i| Point2::new(0.03 * f64::from(i), 0.03 * f64::from(j))))
+            .flat_map(|j| {
+                (0..9).map(move |i| Point2::new(0.03 * f64::from(i), 0.03 * f64::from(j)))
+            })
             .collect();
         let poses = [
-            (Vector3::new(0.3, -0.2, 0.1), Vector3::new(-0.12, -0.08, 0.6)),
-            (Vector3::new(-0.25, 0.35, -0.05), Vector3::new(-0.1, -0.1, 0.7)),
-            (Vector3::new(0.1, 0.2, 0.4), Vector3::new(-0.15, -0.05, 0.55)),
-            (Vector3::new(-0.4, -0.1, 0.2), Vector3::new(-0.1, -0.06, 0.65)),
+            (
+                Vector3::new(0.3, -0.2, 0.1),
+                Vector3::new(-0.12, -0.08, 0.6),
+            ),
+            (
+                Vector3::new(-0.25, 0.35, -0.05),
+                Vector3::new(-0.1, -0.1, 0.7),
+            ),
+            (
+                Vector3::new(0.1, 0.2, 0.4),
+                Vector3::new(-0.15, -0.05, 0.55),
+            ),
+            (
+                Vector3::new(-0.4, -0.1, 0.2),
+                Vector3::new(-0.1, -0.06, 0.65),
+            ),
         ];
         let mut hs = Vec::new();
         for (w, t) in &poses {

@@ -61,11 +61,9 @@ pub struct BlenderCamera {
 #[must_use]
 pub fn blender_cameras(set: &ExportSet) -> (Vector3<f64>, Vec<BlenderCamera>) {
     let n = set.cameras.len().max(1) as f64;
-    let mean = set
-        .cameras
-        .iter()
-        .fold(Vector3::zeros(), |a, c| a + c.camera.pose.camera_center_in_world.coords)
-        / n;
+    let mean = set.cameras.iter().fold(Vector3::zeros(), |a, c| {
+        a + c.camera.pose.camera_center_in_world.coords
+    }) / n;
     let offset = mean.map(f64::round);
     let flip = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0));
     let cameras = set

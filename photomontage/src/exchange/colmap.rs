@@ -101,12 +101,22 @@ impl ColmapModel {
 }
 
 /// The model for one photo, or the term the chosen model cannot carry.
-fn model_for(photo: &str, intr: &Intrinsics, chosen: ColmapModel) -> Result<ColmapModel, ExchangeError> {
+fn model_for(
+    photo: &str,
+    intr: &Intrinsics,
+    chosen: ColmapModel,
+) -> Result<ColmapModel, ExchangeError> {
     let d = intr.distortion;
     if chosen == ColmapModel::Auto {
         return Ok(ColmapModel::smallest_for(&d));
     }
-    let terms = [("k1", d.k1), ("k2", d.k2), ("k3", d.k3), ("p1", d.p1), ("p2", d.p2)];
+    let terms = [
+        ("k1", d.k1),
+        ("k2", d.k2),
+        ("k3", d.k3),
+        ("p1", d.p1),
+        ("p2", d.p2),
+    ];
     for ((term, value), carried) in terms.into_iter().zip(chosen.carries()) {
         if value != 0.0 && !carried {
             return Err(ExchangeError::TermNotCarried {
@@ -198,7 +208,11 @@ pub fn colmap_text(set: &ExportSet, model: ColmapModel) -> Result<[String; 4], E
                 count += 1;
             }
         }
-        let error = if count > 0 { (sum / count as f64).sqrt() } else { 0.0 };
+        let error = if count > 0 {
+            (sum / count as f64).sqrt()
+        } else {
+            0.0
+        };
         let track: Vec<String> = tracks[n]
             .iter()
             .map(|(k, idx)| format!("{} {idx}", k + 1))
@@ -244,7 +258,11 @@ pub fn colmap_text(set: &ExportSet, model: ColmapModel) -> Result<[String; 4], E
 ///
 /// # Errors
 /// [`ExchangeError::TermNotCarried`] or [`ExchangeError::Write`].
-pub fn write_colmap(set: &ExportSet, model: ColmapModel, dir: &Path) -> Result<Vec<PathBuf>, ExchangeError> {
+pub fn write_colmap(
+    set: &ExportSet,
+    model: ColmapModel,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, ExchangeError> {
     let [cameras, images, points, names] = colmap_text(set, model)?;
     Ok(vec![
         write_file(dir, "cameras.txt", &cameras)?,
@@ -273,14 +291,21 @@ fn parse_err(file: &str, line: usize, message: impl Into<String>) -> ExchangeErr
     }
 }
 
-fn numbers(file: &str, line: usize, fields: &[&str], what: &str) -> Result<Vec<f64>, ExchangeError> {
+fn numbers(
+    file: &str,
+    line: usize,
+    fields: &[&str],
+    what: &str,
+) -> Result<Vec<f64>, ExchangeError> {
     fields
         .iter()
         .map(|f| {
             f.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| parse_err(file, line, format!("{what}: `{f}` is not a finite number")))
+                .ok_or_else(|| {
+                    parse_err(file, line, format!("{what}: `{f}` is not a finite number"))
+                })
         })
         .collect()
 }
@@ -299,8 +324,12 @@ fn intrinsics_from_colmap(
         "RADIAL" => 5,
         "OPENCV" => 8,
         "FULL_OPENCV" => 12,
-        "OPENCV_FISHEYE" | "SIMPLE_RADIAL_FISHEYE" | "RADIAL_FISHEYE" | "THIN_PRISM_FISHEYE"
-        | "FOV" | "RAD_TAN_THIN_PRISM_FISHEYE" => {
+        "OPENCV_FISHEYE"
+        | "SIMPLE_RADIAL_FISHEYE"
+        | "RADIAL_FISHEYE"
+        | "THIN_PRISM_FISHEYE"
+        | "FOV"
+        | "RAD_TAN_THIN_PRISM_FISHEYE" => {
             return Err(ExchangeError::UnsupportedModel {
                 file: file.to_owned(),
                 camera: camera.to_owned(),
@@ -389,11 +418,19 @@ pub fn parse_colmap(
         }
         let f: Vec<&str> = t.split_whitespace().collect();
         if f.len() < 4 {
-            return Err(parse_err(cameras_name, line_no, "expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS…"));
+            return Err(parse_err(
+                cameras_name,
+                line_no,
+                "expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS…",
+            ));
         }
         let size = [f[2], f[3]].map(|s| s.parse::<u32>().ok().filter(|v| *v > 0));
         let [Some(w), Some(h)] = size else {
-            return Err(parse_err(cameras_name, line_no, "WIDTH and HEIGHT must be positive integers"));
+            return Err(parse_err(
+                cameras_name,
+                line_no,
+                "WIDTH and HEIGHT must be positive integers",
+            ));
         };
         let p = numbers(cameras_name, line_no, &f[4..], "camera parameter")?;
         let intr = intrinsics_from_colmap(cameras_name, f[0], f[1], [w, h], &p)?;
@@ -427,17 +464,24 @@ pub fn parse_colmap(
         let name = f[9..].join(" ");
         let q = Quaternion::new(v[0], v[1], v[2], v[3]);
         if !(q.norm() > 0.5 && q.norm() < 2.0) {
-            return Err(parse_err(images_name, line_no, "the quaternion is not a rotation"));
+            return Err(parse_err(
+                images_name,
+                line_no,
+                "the quaternion is not a rotation",
+            ));
         }
-        let camera_from_world: Rotation3<f64> = UnitQuaternion::from_quaternion(q).to_rotation_matrix();
+        let camera_from_world: Rotation3<f64> =
+            UnitQuaternion::from_quaternion(q).to_rotation_matrix();
         let t_vec = Vector3::new(v[4], v[5], v[6]);
         let world_from_camera = camera_from_world.inverse();
         let centre = -(world_from_camera * t_vec);
-        let intr = intrinsics.get(f[8]).ok_or_else(|| ExchangeError::UnknownCamera {
-            file: images_name.to_owned(),
-            image: name.clone(),
-            camera: f[8].to_owned(),
-        })?;
+        let intr = intrinsics
+            .get(f[8])
+            .ok_or_else(|| ExchangeError::UnknownCamera {
+                file: images_name.to_owned(),
+                image: name.clone(),
+                camera: f[8].to_owned(),
+            })?;
         out.push(ImportedCamera {
             image_name: name,
             camera: Camera {
@@ -462,7 +506,8 @@ pub fn read_colmap(path: &Path) -> Result<Vec<ImportedCamera>, ExchangeError> {
     let dir = if path.is_dir() {
         path.to_path_buf()
     } else {
-        path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+        path.parent()
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
     };
     let read = |name: &str| {
         let p = dir.join(name);

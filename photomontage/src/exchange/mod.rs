@@ -215,7 +215,11 @@ pub(crate) fn num(x: f64) -> String {
 }
 
 /// Writes `text` to `dir/name` atomically.
-pub(crate) fn write_file(dir: &std::path::Path, name: &str, text: &str) -> Result<PathBuf, ExchangeError> {
+pub(crate) fn write_file(
+    dir: &std::path::Path,
+    name: &str,
+    text: &str,
+) -> Result<PathBuf, ExchangeError> {
     let path = dir.join(name);
     crate::atomic_file::write_atomically(&path, text.as_bytes()).map_err(|source| {
         ExchangeError::Write {

@@ -58,9 +58,17 @@ pub fn opencv_yaml(c: &ExportCamera) -> String {
     ));
     s.push_str(&matrix("rvec", 3, 1, &[rvec.x, rvec.y, rvec.z]));
     s.push_str(&matrix("tvec", 3, 1, &[t.x, t.y, t.z]));
-    let rows: Vec<f64> = (0..3).flat_map(|i| (0..3).map(move |j| (i, j))).map(|(i, j)| r[(i, j)]).collect();
+    let rows: Vec<f64> = (0..3)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .map(|(i, j)| r[(i, j)])
+        .collect();
     s.push_str(&matrix("R", 3, 3, &rows));
-    s.push_str(&matrix("camera_center", 3, 1, &[centre.x, centre.y, centre.z]));
+    s.push_str(&matrix(
+        "camera_center",
+        3,
+        1,
+        &[centre.x, centre.y, centre.z],
+    ));
     s
 }
 
@@ -79,6 +87,12 @@ pub fn write_opencv(set: &ExportSet, dir: &Path) -> Result<Vec<PathBuf>, Exchang
 #[must_use]
 pub fn file_stem(id: &str) -> String {
     id.chars()
-        .map(|ch| if ch.is_ascii_alphanumeric() || "._-".contains(ch) { ch } else { '_' })
+        .map(|ch| {
+            if ch.is_ascii_alphanumeric() || "._-".contains(ch) {
+                ch
+            } else {
+                '_'
+            }
+        })
         .collect()
 }

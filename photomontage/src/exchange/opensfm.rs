@@ -52,7 +52,10 @@ fn intrinsics(file: &str, id: &str, c: &Value) -> Result<Intrinsics, ExchangeErr
         .unwrap_or("perspective");
     let get = |key: &str| field(file, id, c, key);
     let size = [get("width")?, get("height")?];
-    if size.iter().any(|v| *v < 1.0 || *v > f64::from(u32::MAX) || v.fract() != 0.0) {
+    if size
+        .iter()
+        .any(|v| *v < 1.0 || *v > f64::from(u32::MAX) || v.fract() != 0.0)
+    {
         return Err(ExchangeError::UnsupportedModel {
             file: file.to_owned(),
             camera: id.to_owned(),
@@ -114,7 +117,11 @@ fn vector3(file: &str, shot: &str, v: &Value, key: &str) -> Result<Vector3<f64>,
         .and_then(Value::as_array)
         .filter(|a| a.len() == 3)
         .and_then(|a| {
-            let x: Vec<f64> = a.iter().filter_map(Value::as_f64).filter(|x| x.is_finite()).collect();
+            let x: Vec<f64> = a
+                .iter()
+                .filter_map(Value::as_f64)
+                .filter(|x| x.is_finite())
+                .collect();
             (x.len() == 3).then(|| Vector3::new(x[0], x[1], x[2]))
         });
     a.ok_or_else(|| ExchangeError::Parse {
@@ -154,13 +161,13 @@ pub fn parse_opensfm(text: &str, file: &str) -> Result<Vec<ImportedCamera>, Exch
         };
         for (name, shot) in shots {
             let camera_id = shot.get("camera").and_then(Value::as_str).unwrap_or("");
-            let c = cameras
-                .and_then(|m| m.get(camera_id))
-                .ok_or_else(|| ExchangeError::UnknownCamera {
+            let c = cameras.and_then(|m| m.get(camera_id)).ok_or_else(|| {
+                ExchangeError::UnknownCamera {
                     file: file.to_owned(),
                     image: name.clone(),
                     camera: camera_id.to_owned(),
-                })?;
+                }
+            })?;
             let intr = intrinsics(file, camera_id, c)?;
             let rotation = vector3(file, name, shot, "rotation")?;
             let translation = vector3(file, name, shot, "translation")?;

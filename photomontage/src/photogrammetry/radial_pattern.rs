@@ -119,7 +119,10 @@ mod tests {
         let mut v = Vec::new();
         for i in 0..7 {
             for j in 0..5 {
-                v.push(Point2::new(100.0 + 250.0 * f64::from(i), 90.0 + 240.0 * f64::from(j)));
+                v.push(Point2::new(
+                    100.0 + 250.0 * f64::from(i),
+                    90.0 + 240.0 * f64::from(j),
+                ));
             }
         }
         v
@@ -141,9 +144,15 @@ mod tests {
             })
             .collect();
         let pattern = radial_pattern(&pinhole, &observed, &residuals).unwrap();
-        assert!((pattern.correlation - 1.0).abs() < CORRELATION_TOLERANCE, "{pattern:?}");
+        assert!(
+            (pattern.correlation - 1.0).abs() < CORRELATION_TOLERANCE,
+            "{pattern:?}"
+        );
         assert!(pattern.is_significant());
-        assert!((pattern.implied_k1 - k1).abs() < IMPLIED_K1_TOLERANCE, "{pattern:?}");
+        assert!(
+            (pattern.implied_k1 - k1).abs() < IMPLIED_K1_TOLERANCE,
+            "{pattern:?}"
+        );
     }
 
     #[test]

@@ -41,9 +41,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut views = Vec::new();
     let mut size: Option<[u32; 2]> = None;
     for path in &args.images {
-        let name = path
-            .file_name()
-            .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
         let image = GrayImage::load(path).with_context(|| format!("reading {}", path.display()))?;
         #[allow(clippy::cast_possible_truncation)] // decoded sizes are u32
         let this = [image.width as u32, image.height as u32];
@@ -52,7 +53,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         {
             bail!(
                 "photo {name} is {}×{} px but the first photo is {}×{} px: calibrate one image size at a time",
-                this[0], this[1], s[0], s[1]
+                this[0],
+                this[1],
+                s[0],
+                s[1]
             );
         }
         size = Some(this);
@@ -62,7 +66,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             corners_px: corners,
         });
     }
-    let Some(size) = size else { bail!("no photos given") };
+    let Some(size) = size else {
+        bail!("no photos given")
+    };
     let options = CalibrationOptions {
         tangential: !args.no_tangential,
     };

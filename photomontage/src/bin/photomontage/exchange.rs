@@ -39,7 +39,8 @@ pub struct ExportArgs {
 
 pub fn export(args: &ExportArgs) -> anyhow::Result<()> {
     let doc = SiteDocument::load(&args.site)?;
-    let set = ExportSet::from_site(&doc).with_context(|| format!("exporting {}", args.site.display()))?;
+    let set =
+        ExportSet::from_site(&doc).with_context(|| format!("exporting {}", args.site.display()))?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let files = match args.format {
@@ -117,8 +118,14 @@ pub fn import(args: &ImportArgs) -> anyhow::Result<()> {
         ImportFormat::Colmap => (read_colmap(&args.file)?, "colmap"),
         ImportFormat::Opensfm => (read_opensfm(&args.file)?, "opensfm"),
     };
-    let report = apply_imported(&mut doc.site, &cameras, name, args.with_poses)
-        .with_context(|| format!("importing {} into {}", args.file.display(), args.site.display()))?;
+    let report =
+        apply_imported(&mut doc.site, &cameras, name, args.with_poses).with_context(|| {
+            format!(
+                "importing {} into {}",
+                args.file.display(),
+                args.site.display()
+            )
+        })?;
     if report.matched.is_empty() {
         bail!(
             "no image of {} matches a photo of {} (images: {}); the site is unchanged",
@@ -141,10 +148,16 @@ pub fn import(args: &ImportArgs) -> anyhow::Result<()> {
             );
         }
         if !report.unmatched_images.is_empty() {
-            println!("images matching no photo: {}", report.unmatched_images.join(", "));
+            println!(
+                "images matching no photo: {}",
+                report.unmatched_images.join(", ")
+            );
         }
         if !report.photos_without_camera.is_empty() {
-            println!("photos left unchanged: {}", report.photos_without_camera.join(", "));
+            println!(
+                "photos left unchanged: {}",
+                report.photos_without_camera.join(", ")
+            );
         }
     }
     Ok(())

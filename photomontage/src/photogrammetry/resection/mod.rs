@@ -49,11 +49,11 @@ use super::projection::{
 };
 mod ransac;
 
+use super::radial_pattern::{RadialPattern, radial_pattern};
 use super::{
     ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, validate_control,
     validate_intrinsics, validate_observations,
 };
-use super::radial_pattern::{RadialPattern, radial_pattern};
 use crate::camera::{Camera, Intrinsics};
 use ransac::{Side, behind_the_camera, normalised_error_sq, ransac};
 
