@@ -2,9 +2,10 @@
 """OpenCV check of photomontage's camera exports (issue 15, camera exchange).
 
 Reads an export of the courtyard sample site made by
-    photomontage solve sample_sites/courtyard/site.toml --out /tmp/c/site.toml
-    photomontage export-cameras /tmp/c/site.toml --format colmap --out peers/camera_exchange/courtyard
-    photomontage export-cameras /tmp/c/site.toml --format opencv --out peers/camera_exchange/courtyard
+    photomontage solve sample_sites/courtyard/site.toml --out sample_sites/courtyard/solved.toml
+    photomontage export-cameras sample_sites/courtyard/solved.toml --format colmap --out peers/camera_exchange/courtyard
+    photomontage export-cameras sample_sites/courtyard/solved.toml --format opencv --out peers/camera_exchange/courtyard
+    rm sample_sites/courtyard/solved.toml
 and projects every point of points3D.txt into every image with cv2.projectPoints twice:
   * from the OpenCV YAML (read with cv2.FileStorage: camera_matrix, distortion_coefficients,
     rvec, tvec), and

@@ -409,3 +409,67 @@ fn opensfm_shots_project_as_opensfm_defines_them() {
         .to_string();
     assert!(err.contains("fisheye") && err.contains("v2 fish"), "{err}");
 }
+
+/// OpenCV's `projectPoints` agrees with the YAML and COLMAP conventions:
+/// `peers/camera_exchange/opencv_project.py` projected every point of a committed courtyard
+/// export through `cv2.FileStorage`-read YAML and through COLMAP converted by COLMAP's documented
+/// conventions; here the same COLMAP files are read by our importer and projected by our camera.
+#[test]
+fn opencv_project_points_agrees_with_the_exported_conventions() {
+    /// The CSV keeps 9 decimals; the two routes differ by ~1e-7 px (quaternion and Rodrigues
+    /// round trips at 2.7·10⁶ m world coordinates).
+    const PEER_TOLERANCE_PX: f64 = 1e-5;
+    let dir = photomontage_tests::repo_root().join("peers/camera_exchange");
+    let cameras = read_colmap(&dir.join("courtyard")).unwrap();
+    let names: HashMap<String, String> =
+        std::fs::read_to_string(dir.join("courtyard/point_names.txt"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| {
+                let (n, id) = l.split_once(' ').unwrap();
+                (id.to_owned(), n.to_owned())
+            })
+            .collect();
+    let points: HashMap<String, Point3<f64>> =
+        std::fs::read_to_string(dir.join("courtyard/points3D.txt"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| {
+                let f: Vec<f64> = l
+                    .split_whitespace()
+                    .take(4)
+                    .map(|v| v.parse().unwrap())
+                    .collect();
+                (format!("{}", f[0]), Point3::new(f[1], f[2], f[3]))
+            })
+            .collect();
+    let csv = std::fs::read_to_string(dir.join("opencv_projections.csv")).unwrap();
+    let mut compared = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let camera = &cameras
+            .iter()
+            .find(|c| c.image_name == f[0])
+            .unwrap()
+            .camera;
+        let x = points[&names[f[1]]];
+        let ours = camera.project(&x).unwrap();
+        let v = |i: usize| f[i].parse::<f64>().unwrap();
+        for (route, px) in [
+            ("YAML", Point2::new(v(2), v(3))),
+            ("COLMAP", Point2::new(v(4), v(5))),
+        ] {
+            let e = (ours - px).norm();
+            assert!(
+                e < PEER_TOLERANCE_PX,
+                "{} {} via {route}: {e} px",
+                f[0],
+                f[1]
+            );
+        }
+        compared += 1;
+    }
+    assert_eq!(compared, 60);
+}
