@@ -473,3 +473,17 @@ fn opencv_project_points_agrees_with_the_exported_conventions() {
     }
     assert_eq!(compared, 60);
 }
+
+#[test]
+fn importing_interiors_only_removes_the_stale_solved_poses() {
+    let doc = solved("courtyard");
+    let set = ExportSet::from_site(&doc).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    write_colmap(&set, ColmapModel::Auto, dir.path()).unwrap();
+    let imported = read_colmap(dir.path()).unwrap();
+    let mut site = doc.site.clone();
+    let report = apply_imported(&mut site, &imported, "colmap", false).unwrap();
+    assert_eq!(report.exteriors_cleared.len(), 3, "{report:?}");
+    assert!(site.photos.iter().all(|p| p.exterior.is_none()));
+    assert!(site.photos.iter().all(|p| p.interior.is_some()));
+}

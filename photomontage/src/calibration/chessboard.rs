@@ -511,3 +511,87 @@ pub fn find_chessboard(
         expected,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix3, Vector3};
+
+    /// Corners of a rendered board (4×4 supersampling, exact geometry) are found within this of
+    /// the true positions. Measured 2026-11-24: worst 0.100 px over the 54 corners (the
+    /// gradient-orthogonality window of 0.4 square meets the blurred zone of the junction and, in
+    /// perspective, is not symmetric about it); on OpenCV's sample photos our corners lie
+    /// 0.013–0.08 px from OpenCV's on 11 of 13 photos.
+    const SYNTHETIC_CORNER_TOLERANCE_PX: f64 = 0.15;
+
+    /// A 9×6-inner-corner board (10×7 squares) with a white margin, seen through `h`
+    /// (image ~ h · (X, Y, 1), X and Y in squares), 4×4 supersampled.
+    fn render(h: &Matrix3<f64>, width: usize, height: usize) -> GrayImage {
+        let inv = h.try_inverse().unwrap();
+        let mut values = vec![0.0; width * height];
+        for y in 0..height {
+            for x in 0..width {
+                let mut acc = 0.0;
+                for sy in 0..4 {
+                    for sx in 0..4 {
+                        let px = x as f64 + (f64::from(sx) + 0.5) / 4.0 - 0.5;
+                        let py = y as f64 + (f64::from(sy) + 0.5) / 4.0 - 0.5;
+                        let b = inv * Vector3::new(px, py, 1.0);
+                        let (bx, by) = (b.x / b.z, b.y / b.z);
+                        let inside = (0.0..10.0).contains(&bx) && (0.0..7.0).contains(&by);
+                        let dark = inside && (bx.floor() + by.floor()).rem_euclid(2.0) < 0.5;
+                        acc += if dark { 0.1 } else { 0.9 };
+                    }
+                }
+                values[y * width + x] = acc / 16.0;
+            }
+        }
+        GrayImage {
+            width,
+            height,
+            values,
+        }
+    }
+
+    #[test]
+    fn finds_the_corners_of_a_rendered_board_in_perspective() {
+        // Squares of ~26 px with a perspective tilt, the board centred in 360×280 px.
+        let h = Matrix3::new(26.0, 3.0, 48.0, -2.0, 24.0, 52.0, 0.0004, 0.004, 1.0);
+        let image = render(&h, 360, 280);
+        let corners = find_chessboard(&image, "synthetic", 9, 6).unwrap();
+        let truth: Vec<Point2<f64>> = (1..7)
+            .flat_map(|j| {
+                (1..10).map(move |i| {
+                    let v = h * Vector3::new(f64::from(i), f64::from(j), 1.0);
+                    Point2::new(v.x / v.z, v.y / v.z)
+                })
+            })
+            .collect();
+        let mut worst: f64 = 0.0;
+        for t in &truth {
+            let nearest = corners
+                .iter()
+                .map(|c| (c - t).norm())
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(nearest);
+        }
+        assert!(
+            worst < SYNTHETIC_CORNER_TOLERANCE_PX,
+            "worst corner {worst} px"
+        );
+        // Board order: consecutive corners of a row are one square apart.
+        let step = (corners[1] - corners[0]).norm();
+        assert!(step > 15.0 && step < 40.0, "{step}");
+    }
+
+    #[test]
+    fn a_blank_image_has_no_board() {
+        let image = GrayImage {
+            width: 64,
+            height: 48,
+            values: vec![0.5; 64 * 48],
+        };
+        let err = find_chessboard(&image, "blank.png", 9, 6).unwrap_err();
+        assert!(err.to_string().contains("blank.png"), "{err}");
+    }
+}

@@ -237,3 +237,102 @@ pub fn calibrate(
         poses: r.poses,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::BrownConrady;
+
+    /// Noise-free synthetic corners: the refinement recovers the generating camera to the LM
+    /// stopping tolerance.
+    const EXACT_RELATIVE: f64 = 1e-7;
+    const EXACT_DISTORTION: f64 = 1e-7;
+
+    #[test]
+    fn calibration_recovers_a_synthetic_camera_with_distortion() {
+        let board = Board::parse("9x6", 30.0).unwrap();
+        let (fx, fy, cx, cy) = (810.0, 806.0, 331.0, 247.0);
+        let d = BrownConrady {
+            k1: -0.21,
+            k2: 0.06,
+            k3: 0.0,
+            p1: 0.0012,
+            p2: -0.0007,
+        };
+        let poses = [
+            (
+                Vector3::new(0.3, -0.2, 0.1),
+                Vector3::new(-0.12, -0.08, 0.6),
+            ),
+            (
+                Vector3::new(-0.25, 0.35, -0.05),
+                Vector3::new(-0.1, -0.1, 0.7),
+            ),
+            (
+                Vector3::new(0.1, 0.2, 0.4),
+                Vector3::new(-0.15, -0.05, 0.55),
+            ),
+            (
+                Vector3::new(-0.4, -0.1, 0.2),
+                Vector3::new(-0.1, -0.06, 0.65),
+            ),
+            (
+                Vector3::new(0.05, 0.45, -0.3),
+                Vector3::new(-0.13, -0.09, 0.6),
+            ),
+        ];
+        let views: Vec<BoardView> = poses
+            .iter()
+            .enumerate()
+            .map(|(k, (w, t))| BoardView {
+                photo: format!("v{k}"),
+                corners_px: board
+                    .plane_points()
+                    .iter()
+                    .map(|p| refine::project(&[fx, fy, cx, cy, d.k1, d.k2, d.p1, d.p2], w, t, p))
+                    .collect(),
+            })
+            .collect();
+        let c = calibrate(&board, &views, [640, 480], &CalibrationOptions::default()).unwrap();
+        assert!(c.converged);
+        assert!((c.fx_px / fx - 1.0).abs() < EXACT_RELATIVE, "{c:?}");
+        assert!((c.fy_px / fy - 1.0).abs() < EXACT_RELATIVE, "{c:?}");
+        assert!((c.principal_point_px[0] - cx).abs() < EXACT_RELATIVE * fx);
+        assert!((c.principal_point_px[1] - cy).abs() < EXACT_RELATIVE * fy);
+        for (got, want) in [(c.k1, d.k1), (c.k2, d.k2), (c.p1, d.p1), (c.p2, d.p2)] {
+            assert!((got - want).abs() < EXACT_DISTORTION, "{got} vs {want}");
+        }
+        assert!(c.rms_px < 1e-6);
+    }
+
+    #[test]
+    fn too_few_views_and_wrong_corner_counts_are_named() {
+        let board = Board::parse("9x6", 30.0).unwrap();
+        let one = BoardView {
+            photo: "a.jpg".into(),
+            corners_px: vec![Point2::new(0.0, 0.0); 10],
+        };
+        assert_eq!(
+            calibrate(
+                &board,
+                &[one.clone()],
+                [640, 480],
+                &CalibrationOptions::default()
+            )
+            .unwrap_err(),
+            CalibrationError::TooFewViews { found: 1 }
+        );
+        let err = calibrate(
+            &board,
+            &[one.clone(), one.clone(), one],
+            [640, 480],
+            &CalibrationOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("a.jpg") && err.contains("10 corners"), "{err}");
+        assert!(Board::parse("9by6", 25.0).is_err());
+        assert!(Board::parse("1x6", 25.0).is_err());
+        assert!(Board::parse("9x6", 0.0).is_err());
+    }
+}

@@ -4,7 +4,8 @@
 //! its file name, then by the photo id. The matched photo's interior (focal length, principal
 //! point, distortion, image size) is replaced, so `solve` starts from it; with `with_poses` the
 //! exterior is written too (`solved_by = "import:<format>"`), which is only right when the
-//! reconstruction is in the site's world frame.
+//! reconstruction is in the site's world frame. Without it a previously solved exterior is
+//! removed (it belonged to the old interior) and the photo must be solved again.
 //!
 //! # Known limitations
 //! Names are matched exactly (after the folder is dropped); no fuzzy matching.
@@ -27,6 +28,8 @@ pub struct ImportReport {
     pub unmatched_images: Vec<String>,
     /// Photos no imported image matches (left unchanged).
     pub photos_without_camera: Vec<String>,
+    /// Photos whose solved exterior was removed because their interior changed.
+    pub exteriors_cleared: Vec<String>,
     pub with_poses: bool,
 }
 
@@ -99,6 +102,8 @@ pub fn apply_imported(
                 sigma_center_m: [0.0; 3],
                 solved_by: format!("import:{format}"),
             });
+        } else if p.exterior.take().is_some() {
+            report.exteriors_cleared.push(p.id.clone());
         }
         report.matched.push((p.id.clone(), c.image_name.clone()));
     }

@@ -153,6 +153,12 @@ pub fn import(args: &ImportArgs) -> anyhow::Result<()> {
                 report.unmatched_images.join(", ")
             );
         }
+        if !report.exteriors_cleared.is_empty() {
+            println!(
+                "solved poses removed (they belong to the old interior; solve again): {}",
+                report.exteriors_cleared.join(", ")
+            );
+        }
         if !report.photos_without_camera.is_empty() {
             println!(
                 "photos left unchanged: {}",
