@@ -205,6 +205,7 @@ fn self_calibration_flags_undo_to_the_exact_site() {
         id: "P1".into(),
         file: "p1.png".into(),
         taken_at: None,
+        profile: None,
         interior: None,
         self_calibration: SelfCalibrationFlags::default(),
         exterior: None,

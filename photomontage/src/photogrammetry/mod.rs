@@ -53,6 +53,7 @@ pub mod intersection;
 pub(crate) mod least_squares;
 pub mod p3p;
 pub(crate) mod projection;
+pub mod radial_pattern;
 pub mod resection;
 pub mod synthetic;
 

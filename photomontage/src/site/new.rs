@@ -272,6 +272,7 @@ pub fn site_from_photos(
                 })?
                 .to_owned(),
             taken_at,
+            profile: None,
             interior: Some(Interior {
                 focal_px,
                 principal_point_px: None,

@@ -47,6 +47,7 @@ fn fixture(dir: &Path) -> SiteDocument {
         id: id.into(),
         file: "p1.png".into(),
         taken_at: None,
+        profile: None,
         interior: Some(Interior {
             focal_px: 60.0,
             principal_point_px: None,

@@ -164,9 +164,14 @@ pub struct Photo {
     /// When the photo was taken (RFC 3339 with offset); overrides the EXIF time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub taken_at: Option<String>,
-    /// Interior orientation; when absent it is started from the EXIF focal length.
+    /// Interior orientation; when absent it is started from the camera profile, else from the
+    /// EXIF focal length.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interior: Option<Interior>,
+    /// A camera profile written by `photomontage calibrate` (TOML, relative to the site file):
+    /// the interior orientation `solve` starts from when `interior` is absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<String>,
     /// Which interior parameters the solver may estimate.
     #[serde(default)]
     pub self_calibration: SelfCalibrationFlags,

@@ -54,6 +54,11 @@ pub enum PhotoSolveError {
     },
     #[error(transparent)]
     Solver(#[from] PhotogrammetryError),
+    #[error("photo `{photo}`: {source}")]
+    Profile {
+        photo: String,
+        source: crate::calibration::profile::ProfileError,
+    },
 }
 
 /// The solution of one photo.
@@ -74,6 +79,9 @@ pub struct PhotoSolution {
     pub solved_by: &'static str,
     /// Where the starting focal length came from.
     pub focal_source: &'static str,
+    /// Radial residual pattern of the resection (k1 warning; see
+    /// [`crate::photogrammetry::radial_pattern`]).
+    pub radial_pattern: Option<crate::photogrammetry::radial_pattern::RadialPattern>,
 }
 
 /// A photo that could not be solved.
@@ -119,9 +127,19 @@ fn prepare(
             actual,
         });
     }
-    let (intrinsics, focal_source) = match &p.interior {
-        Some(interior) => (interior_to_intrinsics(interior, actual), "site"),
-        None => {
+    let (intrinsics, focal_source) = match (&p.interior, &p.profile) {
+        (Some(interior), _) => (interior_to_intrinsics(interior, actual), "site"),
+        (None, Some(profile)) => {
+            let profile_path = doc.resolve(profile);
+            let loaded = crate::calibration::profile::CameraProfile::load(&profile_path)
+                .and_then(|c| c.intrinsics_for(&profile_path, &p.id, actual))
+                .map_err(|source| PhotoSolveError::Profile {
+                    photo: p.id.clone(),
+                    source,
+                })?;
+            (loaded, "camera_profile")
+        }
+        (None, None) => {
             let exif = photo::read_exif(&path);
             let estimate = exif
                 .as_ref()
@@ -267,6 +285,7 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
                     estimated: r.estimated,
                     solved_by: "resection",
                     focal_source: prep.focal_source,
+                    radial_pattern: r.radial_pattern,
                 });
                 prepared_by_id.insert(p.id.clone(), prep);
             }

@@ -1,5 +1,7 @@
 //! The `photomontage` command-line tool.
 
+mod calibrate;
+mod exchange;
 mod farm;
 mod fit;
 mod info;
@@ -86,6 +88,15 @@ enum Command {
     /// progressive or direct); report patches, links, passes, time and residual, optionally
     /// write the mesh (PLY) and the convergence record (CSV). Not yet used by `render`.
     Radiosity(radiosity::Args),
+    /// Export the site's solved cameras for Blender (Python script), COLMAP (text model) or
+    /// OpenCV (FileStorage YAML); a format that cannot carry a distortion term is refused.
+    ExportCameras(exchange::ExportArgs),
+    /// Import cameras from a COLMAP text model or an OpenSfM reconstruction.json as initial
+    /// values (interior; --with-poses also the exterior) for the site's photos.
+    ImportCameras(exchange::ImportArgs),
+    /// Lens calibration from chessboard photos (own corner detector, Zhang 2000): fx, fy,
+    /// principal point, k1, k2, p1, p2, written as a camera profile (TOML) that sites reuse.
+    Calibrate(calibrate::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -115,5 +126,8 @@ fn main() -> anyhow::Result<()> {
         Command::View(args) => standard_view::run(&args),
         Command::Sheet(args) => sheet::run(&args),
         Command::Radiosity(args) => radiosity::run(&args),
+        Command::ExportCameras(args) => exchange::export(&args),
+        Command::ImportCameras(args) => exchange::import(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
     }
 }

@@ -2,6 +2,7 @@
 
 use photomontage::camera::{BrownConrady, Camera};
 use photomontage::photogrammetry::ObservationResidual;
+use photomontage::photogrammetry::radial_pattern::RadialPattern;
 use serde::Serialize;
 
 /// What `solve --json` and `resect --json` print for each photo.
@@ -30,6 +31,9 @@ pub struct PhotoRecord<'a> {
     /// a site whose `[location]` is still empty (control from a list that names its CRS).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub site_location: Option<photomontage::site::Location>,
+    /// Correlation of the radial residuals with r³ (uncorrected distortion when strong).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radial_pattern: Option<RadialPattern>,
 }
 
 pub fn rotation_rows(camera: &Camera) -> [[f64; 3]; 3] {

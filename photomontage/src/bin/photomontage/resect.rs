@@ -199,6 +199,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         solved_by: "resection",
         control_crs,
         site_location,
+        radial_pattern: r.radial_pattern,
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&record)?);

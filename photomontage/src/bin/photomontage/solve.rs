@@ -66,6 +66,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 residuals: &s.residuals,
                 control_crs: None,
                 site_location: None,
+                radial_pattern: s.radial_pattern,
                 solved_by: s.solved_by,
             }
         })

@@ -130,6 +130,7 @@ pub(crate) fn base_site() -> Site {
         id: "P1".into(),
         file: "p1.exr".into(),
         taken_at: Some("2024-06-21T10:30:00+02:00".into()),
+        profile: None,
         interior: Some(Interior {
             focal_px: FOCAL_PX,
             principal_point_px: None,

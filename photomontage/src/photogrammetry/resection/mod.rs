@@ -49,6 +49,7 @@ use super::projection::{
 };
 mod ransac;
 
+use super::radial_pattern::{RadialPattern, radial_pattern};
 use super::{
     ControlPoint, ImageObservation, PhotogrammetryError, SelfCalibration, validate_control,
     validate_intrinsics, validate_observations,
@@ -133,6 +134,9 @@ pub struct Resection {
     pub estimated: SelfCalibration,
     /// Whether the final adjustment met its convergence test.
     pub converged: bool,
+    /// Radial residual pattern over all observations (see [`super::radial_pattern`]); when k1
+    /// was not estimated and the pattern is significant, `warnings` names it.
+    pub radial_pattern: Option<RadialPattern>,
 }
 
 /// Minimum number of control points for a unique pose.
@@ -496,6 +500,14 @@ pub fn resect(
             "low redundancy ({redundancy}): gross errors may go undetected"
         ));
     }
+    let observed_px: Vec<Point2<f64>> = observations.iter().map(|o| o.pixel).collect();
+    let residual_px: Vec<[f64; 2]> = residuals.iter().map(|r| r.residual_px).collect();
+    let pattern = radial_pattern(&camera.intrinsics, &observed_px, &residual_px);
+    if !free.k1
+        && let Some(p) = pattern.filter(RadialPattern::is_significant)
+    {
+        warnings.push(p.warning());
+    }
     camera.pose.camera_center_in_world += origin;
     Ok(Resection {
         camera,
@@ -513,6 +525,7 @@ pub fn resect(
         warnings,
         estimated: free,
         converged,
+        radial_pattern: pattern,
     })
 }
 
