@@ -3,6 +3,7 @@
 mod farm;
 mod fit;
 mod info;
+mod irradiance;
 mod luminaire;
 mod merge;
 mod radiosity;
@@ -86,6 +87,10 @@ enum Command {
     /// progressive or direct); report patches, links, passes, time and residual, optionally
     /// write the mesh (PLY) and the convergence record (CSV). Not yet used by `render`.
     Radiosity(radiosity::Args),
+    /// Irradiance at points (CSV rows `id,X,Y,Z,nx,ny,nz`) from the site's radiosity solution:
+    /// sun, sky, luminaires and interreflection, split into direct and indirect (JSON with
+    /// `--json`).
+    Irradiance(irradiance::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -115,5 +120,6 @@ fn main() -> anyhow::Result<()> {
         Command::View(args) => standard_view::run(&args),
         Command::Sheet(args) => sheet::run(&args),
         Command::Radiosity(args) => radiosity::run(&args),
+        Command::Irradiance(args) => irradiance::run(&args),
     }
 }
