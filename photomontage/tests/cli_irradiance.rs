@@ -73,7 +73,11 @@ fn unoccluded_points_meet_the_closed_form() {
                 .map(|v| v.as_f64().unwrap())
                 .collect()
         };
-        let (total, direct, indirect) = (get("irradiance_rgb"), get("direct_rgb"), get("indirect_rgb"));
+        let (total, direct, indirect) = (
+            get("irradiance_rgb"),
+            get("direct_rgb"),
+            get("indirect_rgb"),
+        );
         for c in 0..3 {
             assert!(
                 (total[c] - want).abs() / want < tol,
@@ -91,7 +95,10 @@ fn bad_rows_are_named_by_line() {
     let dir = tempfile::tempdir().unwrap();
     let site = site(dir.path());
     for (text, words) in [
-        ("id,X,Y,Z,nx,ny,nz\np1,0,0,0,0,0,1\np2,1,1,0,0,0,3\n", "line 3"),
+        (
+            "id,X,Y,Z,nx,ny,nz\np1,0,0,0,0,0,1\np2,1,1,0,0,0,3\n",
+            "line 3",
+        ),
         ("p1,0,NaN,0,0,0,1\n", "line 1"),
         ("p1,0,0,0,0,0,1\np2,1,1,0,0,1\n", "line 2: 6 columns"),
     ] {
@@ -106,7 +113,10 @@ fn bad_rows_are_named_by_line() {
         ]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success());
-        assert!(stderr.contains(words) && stderr.contains("points.csv"), "{stderr}");
+        assert!(
+            stderr.contains(words) && stderr.contains("points.csv"),
+            "{stderr}"
+        );
         assert!(out.stdout.is_empty());
     }
 }

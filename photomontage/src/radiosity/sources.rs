@@ -318,7 +318,7 @@ const GROUND_STREAM: u64 = 0xFFFF_0000;
 /// A light that does not do what it seems to (warnings, naming the light and the object).
 #[derive(Debug, Clone, PartialEq)]
 pub enum LightWarning {
-    /// At least [`INSIDE_PROBE_FRACTION`] of the probe rays from a point source meet the back of
+    /// More than [`INSIDE_PROBE_FRACTION`] of the probe rays from a point source meet the back of
     /// a surface: it sits inside a closed object, and its light never reaches a front face.
     LuminaireInsideObject {
         /// Light group name.
@@ -373,10 +373,11 @@ impl std::fmt::Display for LightWarning {
 /// modelling slop without flagging lights recessed in a ceiling).
 pub const LUMINAIRE_WALL_EPS_M: f64 = 0.05;
 
-/// A point source is inside a closed object when at least this fraction of its 26 probe rays
-/// meet back faces (not all: a closed object standing on the ground shares its bottom face with
-/// the ground's plane, and a coplanar front face may be hit first).
-pub const INSIDE_PROBE_FRACTION: f64 = 0.75;
+/// A point source is inside a closed object when more than this fraction of its 26 probe rays
+/// meet back faces (not all: a building standing on the ground is often open at the bottom, or
+/// shares its bottom face with the ground's plane, whose front face may be hit first; a light
+/// outside sees the sky or front faces in most directions).
+pub const INSIDE_PROBE_FRACTION: f64 = 0.5;
 
 /// Directions probed from a point source: the 26 neighbours of a cube cell.
 fn probe_directions() -> Vec<Vector3<f64>> {
@@ -433,7 +434,7 @@ pub fn check_point_sources(
         }
         if let Some((distance_m, object)) = nearest_back {
             #[allow(clippy::cast_precision_loss)]
-            if back_hits as f64 >= INSIDE_PROBE_FRACTION * dirs.len() as f64 {
+            if back_hits as f64 > INSIDE_PROBE_FRACTION * dirs.len() as f64 {
                 out.push(LightWarning::LuminaireInsideObject {
                     group: group.to_owned(),
                     object,

@@ -515,6 +515,14 @@ impl Transfer {
         })
     }
 
+    /// The same transfer relighting with another strategy and sweep.
+    #[must_use]
+    pub fn with_strategy(mut self, strategy: RelightStrategy, sweep: Sweep) -> Self {
+        self.params.strategy = strategy;
+        self.params.sweep = sweep;
+        self
+    }
+
     /// The current solution.
     #[must_use]
     pub fn solution(&self) -> &Solution {

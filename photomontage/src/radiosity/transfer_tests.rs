@@ -567,7 +567,8 @@ fn a_luminaire_inside_a_block_or_behind_a_wall_is_named() {
     let inside = NamedLuminaire {
         name: "luminaire:buried".into(),
         source: PointSource {
-            position_in_world_m: Point3::new(0.0, 0.0, 0.5),
+            // Inside the 0.2 m thick wall, 0.1 m from its faces.
+            position_in_world_m: Point3::new(1.6, 0.3, 1.2),
             luminaire: None,
             intensity_rgb: [1.0; 3],
         },
@@ -598,7 +599,7 @@ fn a_luminaire_inside_a_block_or_behind_a_wall_is_named() {
         .collect();
     assert!(
         text.iter()
-            .any(|w| w.contains("`luminaire:buried`") && w.contains("inside object `block`")),
+            .any(|w| w.contains("`luminaire:buried`") && w.contains("inside object `wall`")),
         "{text:?}"
     );
     // The wall is 0.2 m thick: 1 cm from the west face, which faces away (a closed object too).
