@@ -182,6 +182,8 @@ fn bench_transfer(c: &mut Criterion) {
     );
     let mut group = c.benchmark_group("relight_50k");
     group.sample_size(20);
+    group.warm_up_time(std::time::Duration::from_secs(1));
+    group.measurement_time(std::time::Duration::from_secs(3));
     // The sun's direct term alone: one shadow ray per element sample (2 × 2) towards the sun.
     let engine = FormFactorEngine::new(&s.mesh, base.tracer(), p.solve.form_factors).unwrap();
     let moved = [photomontage::radiosity::DistantSource {
