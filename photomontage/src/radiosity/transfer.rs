@@ -736,7 +736,7 @@ impl Transfer {
             }
             let mesh = &self.solution.mesh;
             let b0_new = initial_exitance(mesh, &group.direct_irradiance_rgb, emission);
-            if b0_new.iter().all(|b| *b == [0.0; 3]) {
+            if b0_new.iter().flatten().all(|&v| v == 0.0) {
                 // A dark group (sun down, sky off, light off): B = 0 exactly.
                 group.radiosity_rgb.clone_from(&b0_new);
                 group.convergence.clear();

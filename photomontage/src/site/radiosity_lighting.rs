@@ -90,7 +90,7 @@ pub fn site_transfer_lighting(
         dir_in_world: d,
         normal_irradiance_rgb: if sun_weighted { l.sun_weight } else { [0.0; 3] },
     });
-    let sky = sky_weighted.then(|| Sky {
+    let sky = sky_weighted.then_some(Sky {
         model,
         horizontal_irradiance_rgb: l.sky_weight,
     });
