@@ -416,6 +416,16 @@ fn sun_below_the_horizon_and_bad_changes() {
         before,
         "a refused change changes nothing"
     );
+    // A scene with nothing to mesh.
+    let err = Transfer::build(
+        &Scene::new(),
+        &lighting(),
+        &params(RelightStrategy::LinearResponses, Sweep::GaussSeidel),
+        &AtomicBool::new(false),
+        &|_| {},
+    )
+    .unwrap_err();
+    assert!(matches!(err, RadiosityError::NoPatches { .. }), "{err}");
     // The solver must be hierarchical.
     let mut p = params(RelightStrategy::LinearResponses, Sweep::GaussSeidel);
     p.solve.solver = Solver::Progressive;
