@@ -21,6 +21,10 @@
 //! elements (its leaves); [`sources`] computes each light group's direct irradiance per element
 //! with shadow rays; [`progressive`] or [`hierarchical`] solves the interreflection; each group
 //! keeps its own solution, so groups add linearly (`Solution::total_radiosity_rgb`).
+//! [`transfer::Transfer`] keeps the geometry-dependent part (mesh, links, ground transfer) and
+//! relights it (sun, sky, dimming, reflectance) without recomputing form factors;
+//! [`query`] interpolates irradiance at any surface point, with a final gather where the mesh
+//! is coarse.
 //!
 //! # Known limitations
 //! Surfaces are one-sided (front = counter-clockwise normal) and Lambertian: specular, glass and
@@ -28,7 +32,7 @@
 //! subdivision (midpoint 1→4 splits to the element size); there is no discontinuity meshing, the
 //! adaptivity is the hierarchical solver's (links at coarser levels where the transfer is small).
 //! The renderer does not use the solution yet. No spectral mode (RGB only). Luminaires are point
-//! sources.
+//! sources. [`transfer`] relights on the links refined for the lighting it was built with.
 
 pub mod convergence;
 pub mod convergence_plot;
@@ -37,8 +41,10 @@ pub mod form_factor;
 pub mod hierarchical;
 pub mod mesh;
 pub mod progressive;
+pub mod query;
 mod solve;
 pub mod sources;
+pub mod transfer;
 
 #[cfg(test)]
 mod form_factor_tests;
@@ -48,12 +54,19 @@ mod radiance_tests;
 mod solver_tests;
 #[cfg(test)]
 pub(crate) mod test_scenes;
+#[cfg(test)]
+mod transfer_tests;
 
 pub use convergence::{ConvergenceRow, StopRule};
 pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning};
+pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
 pub use solve::{GroupSolution, LightGroup, Solution, SolveParams, Solver, solve, solve_on_mesh};
-pub use sources::{DistantSource, PointSource};
+pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
+pub use transfer::{
+    LightingChange, NamedLuminaire, RelightStrategy, Sky, Sun, Sweep, Transfer, TransferLighting,
+    TransferParams,
+};
 
 /// RGB triple (linear).
 pub type Rgb = [f64; 3];
@@ -99,6 +112,20 @@ pub enum RadiosityError {
         limit: usize,
         /// The object being meshed when the budget ran out.
         object: String,
+    },
+    /// A row of a points file is unusable.
+    #[error("points file line {line}: {message}")]
+    PointsRow {
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A lighting change names a material the scene does not have.
+    #[error("material `{material}` is not in the scene")]
+    UnknownMaterial {
+        /// The name given.
+        material: String,
     },
     /// A light source with a non-finite or negative value.
     #[error("light group `{group}`: {reason}")]

@@ -1,6 +1,7 @@
 //! One entry point: mesh the scene, light each group directly, solve the interreflection with the
 //! chosen solver, keep every group's solution apart (they add linearly).
 
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use super::convergence::{ConvergenceRow, StopRule};
@@ -8,7 +9,7 @@ use super::form_factor::{FormFactorEngine, FormFactorParams};
 use super::hierarchical::{HierarchicalParams, Hierarchy};
 use super::mesh::{Mesh, MeshParams};
 use super::progressive::RowCache;
-use super::sources::{self, DistantSource, PointSource};
+use super::sources::{self, DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 use super::{RadiosityError, Rgb, direct, progressive};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
@@ -37,6 +38,9 @@ pub struct SolveParams {
     pub stop: StopRule,
     /// Form factors the progressive solver may cache (f32 each).
     pub row_cache_entries: usize,
+    /// Light from below the horizon where the ground is not modelled (`None`: nothing lights
+    /// from below; the scene's own ground, if any, does).
+    pub ground: Option<GroundBelowHorizon>,
 }
 
 impl Default for SolveParams {
@@ -48,6 +52,7 @@ impl Default for SolveParams {
             solver: Solver::Hierarchical(HierarchicalParams::default()),
             stop: StopRule::default(),
             row_cache_entries: 32 << 20,
+            ground: None,
         }
     }
 }
@@ -156,14 +161,18 @@ impl GroupSolution {
 /// The solution of all groups on one mesh.
 #[derive(Debug, Clone)]
 pub struct Solution {
-    /// The mesh.
-    pub mesh: Mesh,
+    /// The mesh (shared with the [`super::Transfer`] that relit it, if any).
+    pub mesh: Arc<Mesh>,
     /// Per-group solutions, in the order of the groups given.
     pub groups: Vec<GroupSolution>,
     /// Links (hierarchical), cached rows × elements (progressive), matrix entries (direct).
     pub interactions: u64,
     /// Convergence of the hierarchical refinement (empty for the other solvers).
     pub refinement: Vec<ConvergenceRow>,
+    /// Lights that do not do what they seem to (a luminaire inside a wall, the sun down).
+    pub warnings: Vec<LightWarning>,
+    /// Element lookup and per-vertex irradiance for [`Solution::irradiance_at`], built on first use.
+    pub(crate) locator: std::sync::OnceLock<super::query::ElementLocator>,
 }
 
 impl Solution {
@@ -234,36 +243,20 @@ pub fn solve_on_mesh(
 ) -> Result<Solution, RadiosityError> {
     let engine = FormFactorEngine::new(&mesh, tracer, params.form_factors)?;
     let n = mesh.elements.len();
+    let ground = GroundTerm::new(&engine, params.ground.as_ref())?;
     let mut directs = Vec::with_capacity(groups.len());
     let mut b0s = Vec::with_capacity(groups.len());
+    let mut warnings = Vec::new();
     for (g, group) in groups.iter().enumerate() {
-        sources::validate(&group.name, &group.sources)?;
-        sources::validate_points(&group.name, &group.points)?;
-        let mut direct = sources::direct_irradiance(&engine, &group.sources, g as u64);
-        if !group.points.is_empty() {
-            let from_points = sources::point_irradiance(&engine, &group.points, g as u64);
-            for (d, p) in direct.iter_mut().zip(from_points) {
-                for c in 0..3 {
-                    d[c] += p[c];
-                }
-            }
-        }
-        let b0: Vec<Rgb> = (0..n)
-            .map(|e| {
-                let node = mesh.element_node(e);
-                let surface = &mesh.surfaces[node.surface as usize];
-                std::array::from_fn(|c| {
-                    let emitted = if group.emission {
-                        surface.emission_rgb[c]
-                    } else {
-                        0.0
-                    };
-                    surface.reflectance_rgb[c] * direct[e][c] + emitted
-                })
-            })
-            .collect();
+        warnings.extend(sources::check_point_sources(
+            tracer,
+            &group.name,
+            &group.points,
+            &mesh.object_names,
+        ));
+        let direct = group_direct(&engine, group, g as u64, ground.as_ref())?;
+        b0s.push(initial_exitance(&mesh, &direct, group.emission));
         directs.push(direct);
-        b0s.push(b0);
     }
     let mut refinement = Vec::new();
     let mut solved = Vec::with_capacity(groups.len());
@@ -336,9 +329,104 @@ pub fn solve_on_mesh(
         )
         .collect();
     Ok(Solution {
-        mesh,
+        mesh: Arc::new(mesh),
         groups,
         interactions,
         refinement,
+        warnings,
+        locator: std::sync::OnceLock::new(),
     })
+}
+
+/// The ground below the horizon, ready to apply: its unit-radiance transfer per element.
+#[derive(Debug, Clone)]
+pub(crate) struct GroundTerm {
+    pub(crate) ground: GroundBelowHorizon,
+    /// The unit-radiance ground clusters ([`sources::ground_sources`]).
+    pub(crate) sources: Vec<DistantSource>,
+    /// Per element, irradiance from a unit-radiance ground below the horizon.
+    pub(crate) transfer: Vec<f64>,
+}
+
+impl GroundTerm {
+    /// Traces the ground transfer (once per mesh); `None` without a ground.
+    pub(crate) fn new(
+        engine: &FormFactorEngine<'_>,
+        ground: Option<&GroundBelowHorizon>,
+    ) -> Result<Option<Self>, RadiosityError> {
+        let Some(ground) = ground else {
+            return Ok(None);
+        };
+        ground.validate()?;
+        let dome = crate::sky_dome::icosahedral::IcosahedralDome::new(
+            &crate::sky_dome::icosahedral::IcosahedralParams {
+                frequencies: GROUND_DOME_FREQUENCIES.to_vec(),
+            },
+        )?;
+        let sources = sources::ground_sources(&dome, ground.cluster_tolerance)?;
+        Ok(Some(Self {
+            ground: *ground,
+            transfer: sources::ground_transfer(engine, &sources),
+            sources,
+        }))
+    }
+
+    /// Adds the ground's light for a group of distant `sources` to `direct`.
+    pub(crate) fn add(&self, sources: &[DistantSource], direct: &mut [Rgb]) {
+        let l = self.ground.radiance_rgb(sources);
+        if l.iter().all(|&v| v == 0.0) {
+            return;
+        }
+        for (d, t) in direct.iter_mut().zip(&self.transfer) {
+            for c in 0..3 {
+                d[c] += l[c] * t;
+            }
+        }
+    }
+}
+
+/// Dome of the ground's clusters: frequencies 4 × 2 (≈ 9° leaves; the ground is uniform, so the
+/// leaf size only sets how finely the clusters can follow a receiver's horizon).
+const GROUND_DOME_FREQUENCIES: [u32; 2] = [4, 2];
+
+/// A group's direct irradiance per element: its distant sources (and the ground they light),
+/// its point sources. `group_index` selects the random streams.
+pub(crate) fn group_direct(
+    engine: &FormFactorEngine<'_>,
+    group: &LightGroup,
+    group_index: u64,
+    ground: Option<&GroundTerm>,
+) -> Result<Vec<Rgb>, RadiosityError> {
+    sources::validate(&group.name, &group.sources)?;
+    sources::validate_points(&group.name, &group.points)?;
+    let mut direct = sources::direct_irradiance(engine, &group.sources, group_index);
+    if let Some(ground) = ground {
+        ground.add(&group.sources, &mut direct);
+    }
+    if !group.points.is_empty() {
+        let from_points = sources::point_irradiance(engine, &group.points, group_index);
+        for (d, p) in direct.iter_mut().zip(from_points) {
+            for c in 0..3 {
+                d[c] += p[c];
+            }
+        }
+    }
+    Ok(direct)
+}
+
+/// B₀ = ρ·E_direct (+ the emission when the group owns it), per element.
+pub(crate) fn initial_exitance(mesh: &Mesh, direct: &[Rgb], emission: bool) -> Vec<Rgb> {
+    (0..mesh.elements.len())
+        .map(|e| {
+            let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+            std::array::from_fn(|c| {
+                let emitted = if emission {
+                    surface.emission_rgb[c]
+                } else {
+                    0.0
+                };
+                surface.reflectance_rgb[c] * direct[e][c] + emitted
+            })
+        })
+        .collect()
 }

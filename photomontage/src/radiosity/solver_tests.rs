@@ -57,6 +57,7 @@ fn params(solver: Solver, element_edge_m: f64) -> SolveParams {
         solver,
         stop: TIGHT,
         row_cache_entries: 1 << 24,
+        ground: None,
     }
 }
 

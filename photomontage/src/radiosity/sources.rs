@@ -13,9 +13,18 @@
 //! A point source (a luminaire, [`PointSource`]) of intensity I(ω) gives E = I(ω)·cos θ/d² at
 //! each of the element's N points, with a shadow ray to the source, averaged over the points.
 //!
+//! **Ground below the horizon** ([`GroundBelowHorizon`]): where the site's ground is not modelled,
+//! the lower hemisphere is a uniform Lambertian ground of albedo a lit by the group's own distant
+//! sources, radiance L_g = a·E_h/π with E_h the group's unobstructed horizontal irradiance
+//! (Σ E_n·max(0, d_z)); it is discretised as the upper dome's uniform-radiance clusters mirrored
+//! below the horizon ([`ground_sources`]), each carrying its irradiance vector exactly as
+//! [`IcosahedralDome::cluster`] does, so a plane that sees the whole lower hemisphere (a vertical
+//! wall sees half of it) gets L_g·π·(1 − cos tilt)/2 to the clustering tolerance. Because L_g is
+//! linear in the group's sources, each group keeps its own ground term and groups still add.
+//!
 //! # Known limitations
-//! The sky is lit from above the horizon only; where the site's ground is not modelled, nothing
-//! lights from below (the issue's "ground below the horizon" choice is not made yet). The sun is
+//! The ground below the horizon is uniform (no shadow of the buildings on it, no view of the
+//! sky's horizon brightening from below); a modelled ground is used instead where there is one. The sun is
 //! a point in direction d (no penumbra from the 0.53° disc). Luminaires are point sources (the
 //! opening's size is ignored, as in the renderer).
 
@@ -201,6 +210,245 @@ pub fn sky_sources(
                 .map(|k| k * c.integrated_luminance / horizontal),
         })
         .collect())
+}
+
+/// The lower hemisphere as a uniform ground of the given albedo (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundBelowHorizon {
+    /// Diffuse albedo of the unmodelled ground per channel, in [0, 1] (0.2 is the usual value
+    /// for mixed urban ground, CIE 171:2006 test cases use 0.2–0.3).
+    pub albedo_rgb: Rgb,
+    /// Clustering tolerance of the mirrored uniform dome ([`IcosahedralDome::cluster`]).
+    pub cluster_tolerance: f64,
+}
+
+impl Default for GroundBelowHorizon {
+    /// Albedo 0.2, clustering tolerance 0.02.
+    fn default() -> Self {
+        Self {
+            albedo_rgb: [0.2; 3],
+            cluster_tolerance: 0.02,
+        }
+    }
+}
+
+impl GroundBelowHorizon {
+    /// Checks the albedo and tolerance.
+    ///
+    /// # Errors
+    /// [`RadiosityError::InvalidParameter`] outside [0, 1] or for a bad tolerance.
+    pub fn validate(&self) -> Result<(), RadiosityError> {
+        for &a in &self.albedo_rgb {
+            if !(0.0..=1.0).contains(&a) {
+                return Err(RadiosityError::InvalidParameter {
+                    name: "ground_albedo",
+                    value: a,
+                    reason: "must be in [0, 1]",
+                });
+            }
+        }
+        if !(self.cluster_tolerance.is_finite() && self.cluster_tolerance >= 0.0) {
+            return Err(RadiosityError::InvalidParameter {
+                name: "ground_cluster_tolerance",
+                value: self.cluster_tolerance,
+                reason: "must be finite and ≥ 0",
+            });
+        }
+        Ok(())
+    }
+
+    /// Ground radiance L_g = a·E_h/π per channel for a group of distant `sources`.
+    #[must_use]
+    pub fn radiance_rgb(&self, sources: &[DistantSource]) -> Rgb {
+        let e_h = horizontal_irradiance_rgb(sources);
+        std::array::from_fn(|c| self.albedo_rgb[c] * e_h[c] / std::f64::consts::PI)
+    }
+}
+
+/// Unobstructed horizontal irradiance of distant sources, Σ E_n·max(0, d_z).
+#[must_use]
+pub fn horizontal_irradiance_rgb(sources: &[DistantSource]) -> Rgb {
+    let mut e = [0.0; 3];
+    for s in sources {
+        let z = s.dir_in_world.z.max(0.0);
+        for c in 0..3 {
+            e[c] += s.normal_irradiance_rgb[c] * z;
+        }
+    }
+    e
+}
+
+/// The lower hemisphere as distant sources of unit radiance: the uniform-radiance clusters of
+/// `dome` under `tolerance`, mirrored below the horizon; a source's normal irradiance (all
+/// channels) is its cluster's |Σ Ω_i·d_i| (module doc).
+///
+/// # Errors
+/// Dome errors for a bad tolerance.
+pub fn ground_sources(
+    dome: &IcosahedralDome,
+    tolerance: f64,
+) -> Result<Vec<DistantSource>, RadiosityError> {
+    let flux: Vec<f64> = dome.leaves.iter().map(|f| f.solid_angle_sr).collect();
+    let (clusters, _bound) = dome.cluster(&flux, tolerance)?;
+    Ok(clusters
+        .into_iter()
+        .map(|c| {
+            let d = c.dir_in_world;
+            DistantSource {
+                dir_in_world: Vector3::new(d.x, d.y, -d.z),
+                normal_irradiance_rgb: [c.integrated_luminance; 3],
+            }
+        })
+        .collect())
+}
+
+/// Per element, the irradiance from a unit-radiance ground below the horizon, Σ_c |S_c|·cos·V
+/// (shadowed like any distant group; random streams apart from the light groups').
+#[must_use]
+pub fn ground_transfer(engine: &FormFactorEngine<'_>, ground: &[DistantSource]) -> Vec<f64> {
+    direct_irradiance(engine, ground, GROUND_STREAM)
+        .into_iter()
+        .map(|e| e[0])
+        .collect()
+}
+
+/// Group index of the ground term's random streams (far from any real group index).
+const GROUND_STREAM: u64 = 0xFFFF_0000;
+
+/// A light that does not do what it seems to (warnings, naming the light and the object).
+#[derive(Debug, Clone, PartialEq)]
+pub enum LightWarning {
+    /// More than [`INSIDE_PROBE_FRACTION`] of the probe rays from a point source meet the back of
+    /// a surface: it sits inside a closed object, and its light never reaches a front face.
+    LuminaireInsideObject {
+        /// Light group name.
+        group: String,
+        /// The object around it (the nearest back face's).
+        object: String,
+    },
+    /// A point source lies within [`LUMINAIRE_WALL_EPS_M`] behind a surface (it faces away from
+    /// the source): half of its light is lost in the wall.
+    LuminaireBehindSurface {
+        /// Light group name.
+        group: String,
+        /// The object whose surface faces away.
+        object: String,
+        /// Distance to that surface, metres.
+        distance_m: f64,
+    },
+    /// The sun is at or below the horizon: the sun group gives no light.
+    SunBelowHorizon {
+        /// Sun elevation, degrees.
+        elevation_deg: f64,
+    },
+}
+
+impl std::fmt::Display for LightWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::LuminaireInsideObject { group, object } => write!(
+                f,
+                "light `{group}` is inside object `{object}` (the rays from it meet the back of \
+                 its surfaces); it lights nothing"
+            ),
+            Self::LuminaireBehindSurface {
+                group,
+                object,
+                distance_m,
+            } => write!(
+                f,
+                "light `{group}` is {distance_m:.4} m behind a surface of object `{object}` (the \
+                 surface faces away from it); its light into that side is lost"
+            ),
+            Self::SunBelowHorizon { elevation_deg } => write!(
+                f,
+                "the sun is below the horizon (elevation {elevation_deg:.2}°): no sun light"
+            ),
+        }
+    }
+}
+
+/// A point source this close behind a surface is reported ([`LightWarning::LuminaireBehindSurface`]),
+/// metres (a luminaire's photometric centre sits in front of its mounting surface; 5 cm covers
+/// modelling slop without flagging lights recessed in a ceiling).
+pub const LUMINAIRE_WALL_EPS_M: f64 = 0.05;
+
+/// A point source is inside a closed object when more than this fraction of its 26 probe rays
+/// meet back faces (not all: a building standing on the ground is often open at the bottom, or
+/// shares its bottom face with the ground's plane, whose front face may be hit first; a light
+/// outside sees the sky or front faces in most directions).
+pub const INSIDE_PROBE_FRACTION: f64 = 0.5;
+
+/// Directions probed from a point source: the 26 neighbours of a cube cell.
+fn probe_directions() -> Vec<Vector3<f64>> {
+    let mut out = Vec::with_capacity(26);
+    for x in -1i32..=1 {
+        for y in -1i32..=1 {
+            for z in -1i32..=1 {
+                if (x, y, z) != (0, 0, 0) {
+                    out.push(Vector3::new(f64::from(x), f64::from(y), f64::from(z)).normalize());
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Checks where point sources sit: inside a closed object ([`INSIDE_PROBE_FRACTION`] of 26
+/// probe rays meet back faces)
+/// or within [`LUMINAIRE_WALL_EPS_M`] behind a surface (a probe ray meets a back face that
+/// close). `object_names` is indexed by [`crate::scene::ObjectId`].
+#[must_use]
+pub fn check_point_sources(
+    tracer: &crate::scene::SceneTracer,
+    group: &str,
+    points: &[PointSource],
+    object_names: &[String],
+) -> Vec<LightWarning> {
+    let dirs = probe_directions();
+    let mut out = Vec::new();
+    for p in points {
+        let mut back_hits = 0;
+        let mut nearest_back: Option<(f64, String)> = None;
+        for d in &dirs {
+            let ray = tracer.ray_from_world(&p.position_in_world_m, d, 0.0, DIRECT_RAY_LENGTH_M);
+            let Some(hit) = tracer.closest_hit(&ray) else {
+                continue;
+            };
+            let normal = Vector3::from(hit.hit.normal_geometric.map(f64::from));
+            let cos = normal.dot(d);
+            if cos > 0.0 {
+                back_hits += 1;
+                let distance = f64::from(hit.hit.t) * cos;
+                if nearest_back
+                    .as_ref()
+                    .is_none_or(|(best, _)| distance < *best)
+                {
+                    let object = object_names
+                        .get(hit.object.0 as usize)
+                        .cloned()
+                        .unwrap_or_else(|| format!("#{}", hit.object.0));
+                    nearest_back = Some((distance, object));
+                }
+            }
+        }
+        if let Some((distance_m, object)) = nearest_back {
+            #[allow(clippy::cast_precision_loss)]
+            if back_hits as f64 > INSIDE_PROBE_FRACTION * dirs.len() as f64 {
+                out.push(LightWarning::LuminaireInsideObject {
+                    group: group.to_owned(),
+                    object,
+                });
+            } else if distance_m <= LUMINAIRE_WALL_EPS_M {
+                out.push(LightWarning::LuminaireBehindSurface {
+                    group: group.to_owned(),
+                    object,
+                    distance_m,
+                });
+            }
+        }
+    }
+    out
 }
 
 /// A point source: an isotropic light or a luminaire with its photometric web.

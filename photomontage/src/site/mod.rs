@@ -19,6 +19,7 @@ pub mod luminaires;
 pub mod models;
 pub mod new;
 pub mod photo_points;
+pub mod radiosity_lighting;
 pub mod render;
 pub mod render_error;
 pub mod render_photo;

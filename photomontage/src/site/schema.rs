@@ -314,6 +314,14 @@ pub struct Lighting {
     /// Material library file, relative to the site file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub material_library: Option<String>,
+    /// Whether the scene models the ground (radiosity): `false` lights the lower hemisphere from
+    /// a uniform ground of `ground_albedo`; absent means modelled when a natural polygon faces
+    /// up (within 30° of the zenith).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ground_modelled: Option<bool>,
+    /// Albedo of the ground below the horizon where it is not modelled (default 0.2).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ground_albedo: Option<[f64; 3]>,
 }
 
 impl Default for Lighting {
@@ -327,6 +335,8 @@ impl Default for Lighting {
             sky_weight: [1.0; 3],
             atmosphere: Atmosphere::default(),
             material_library: None,
+            ground_modelled: None,
+            ground_albedo: None,
         }
     }
 }

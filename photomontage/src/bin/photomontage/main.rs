@@ -5,6 +5,7 @@ mod exchange;
 mod farm;
 mod fit;
 mod info;
+mod irradiance;
 mod luminaire;
 mod merge;
 mod radiosity;
@@ -97,6 +98,10 @@ enum Command {
     /// Lens calibration from chessboard photos (own corner detector, Zhang 2000): fx, fy,
     /// principal point, k1, k2, p1, p2, written as a camera profile (TOML) that sites reuse.
     Calibrate(calibrate::Args),
+    /// Irradiance at points (CSV rows `id,X,Y,Z,nx,ny,nz`) from the site's radiosity solution:
+    /// sun, sky, luminaires and interreflection, split into direct and indirect (JSON with
+    /// `--json`).
+    Irradiance(irradiance::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -129,5 +134,6 @@ fn main() -> anyhow::Result<()> {
         Command::ExportCameras(args) => exchange::export(&args),
         Command::ImportCameras(args) => exchange::import(&args),
         Command::Calibrate(args) => calibrate::run(&args),
+        Command::Irradiance(args) => irradiance::run(&args),
     }
 }

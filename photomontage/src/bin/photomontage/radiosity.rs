@@ -21,6 +21,7 @@ use photomontage::radiosity::{
 use photomontage::render::luminaire_light::ArtificialLight;
 use photomontage::site::SiteDocument;
 use photomontage::site::luminaires::site_luminaire_lights;
+use photomontage::site::radiosity_lighting::site_ground_below_horizon;
 use photomontage::site::render::{site_scene, site_sky_model, site_sun_dir};
 use photomontage::sky::SkyModel;
 use photomontage::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
@@ -41,44 +42,11 @@ pub enum SolverArg {
 pub struct Args {
     /// The site file (TOML).
     site: PathBuf,
-    /// Photo whose capture time places the sun (default: the first photo; not needed with
-    /// `sun_manual`).
-    #[arg(long, value_name = "PHOTO_ID")]
-    view: Option<String>,
     /// Solver.
     #[arg(long, value_enum, default_value_t = SolverArg::Hierarchical)]
     solver: SolverArg,
-    /// Longest patch edge in metres (the global size).
-    #[arg(long, default_value_t = 4.0)]
-    patch_edge_m: f64,
-    /// Longest element edge in metres, unless the object has its own.
-    #[arg(long, default_value_t = 1.0)]
-    element_edge_m: f64,
-    /// Element size of one object, `NAME=METRES` (repeatable; object names as `info` lists
-    /// polygons and models).
-    #[arg(long, value_name = "NAME=METRES")]
-    object_element_edge: Vec<String>,
-    /// Form-factor samples per axis (n² per pair).
-    #[arg(long, default_value_t = 4)]
-    samples: u32,
-    /// Random seed of the form factors and shadow rays.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// HR BF tolerance (fraction of the mean brightness).
-    #[arg(long, default_value_t = HierarchicalParams::default().bf_tolerance)]
-    bf_tolerance: f64,
-    /// Sky clustering tolerance of the icosahedral dome.
-    #[arg(long, default_value_t = 0.1)]
-    sky_tolerance: f64,
-    /// Stop when the mean brightness changes by less than this between passes (Üncü & Kayakuş: 0.01).
-    #[arg(long, default_value_t = StopRule::default().mean_change)]
-    mean_change: f64,
-    /// ... and the relative residual is below this.
-    #[arg(long, default_value_t = StopRule::default().residual)]
-    residual: f64,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    solve: SolveArgs,
     /// Write the elements with their radiosity colours as PLY.
     #[arg(long, value_name = "FILE.ply")]
     mesh_out: Option<PathBuf>,
@@ -93,7 +61,91 @@ pub struct Args {
     json: bool,
 }
 
-fn object_sizes(specs: &[String]) -> anyhow::Result<BTreeMap<String, f64>> {
+/// Meshing, quadrature, stop rule and lighting options shared by `radiosity` and `irradiance`.
+#[derive(clap::Args)]
+pub struct SolveArgs {
+    /// Photo whose capture time places the sun (default: the first photo; not needed with
+    /// `sun_manual`).
+    #[arg(long, value_name = "PHOTO_ID")]
+    pub view: Option<String>,
+    /// Longest patch edge in metres (the global size).
+    #[arg(long, default_value_t = 4.0)]
+    pub patch_edge_m: f64,
+    /// Longest element edge in metres, unless the object has its own.
+    #[arg(long, default_value_t = 1.0)]
+    pub element_edge_m: f64,
+    /// Element size of one object, `NAME=METRES` (repeatable; object names as `info` lists
+    /// polygons and models).
+    #[arg(long, value_name = "NAME=METRES")]
+    pub object_element_edge: Vec<String>,
+    /// Form-factor samples per axis (n² per pair).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
+    /// Random seed of the form factors and shadow rays.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// HR BF tolerance (fraction of the mean brightness).
+    #[arg(long, default_value_t = HierarchicalParams::default().bf_tolerance)]
+    pub bf_tolerance: f64,
+    /// Sky clustering tolerance of the icosahedral dome.
+    #[arg(long, default_value_t = 0.1)]
+    pub sky_tolerance: f64,
+    /// Stop when the mean brightness changes by less than this between passes (Üncü & Kayakuş: 0.01).
+    #[arg(long, default_value_t = StopRule::default().mean_change)]
+    pub mean_change: f64,
+    /// ... and the relative residual is below this.
+    #[arg(long, default_value_t = StopRule::default().residual)]
+    pub residual: f64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+impl SolveArgs {
+    /// The photo that places the sun.
+    pub fn view_id(&self, doc: &SiteDocument) -> String {
+        self.view
+            .clone()
+            .or_else(|| doc.site.photos.first().map(|p| p.id.clone()))
+            .unwrap_or_default()
+    }
+
+    /// Solve parameters with `solver`, and the ground below the horizon of the site.
+    pub fn params(
+        &self,
+        solver: Solver,
+        ground: Option<photomontage::radiosity::GroundBelowHorizon>,
+    ) -> anyhow::Result<SolveParams> {
+        Ok(SolveParams {
+            mesh: MeshParams {
+                max_patch_edge_m: self.patch_edge_m,
+                max_element_edge_m: self.element_edge_m,
+                object_element_edge_m: object_sizes(&self.object_element_edge)?,
+                ..MeshParams::default()
+            },
+            form_factors: FormFactorParams {
+                samples_per_axis: self.samples,
+                seed: self.seed,
+                visibility: true,
+            },
+            solver,
+            stop: self.stop(),
+            ground,
+            ..SolveParams::default()
+        })
+    }
+
+    /// The stop rule.
+    pub fn stop(&self) -> StopRule {
+        StopRule {
+            mean_change: self.mean_change,
+            residual: self.residual,
+            ..StopRule::default()
+        }
+    }
+}
+
+pub fn object_sizes(specs: &[String]) -> anyhow::Result<BTreeMap<String, f64>> {
     specs
         .iter()
         .map(|s| {
@@ -114,11 +166,7 @@ fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGrou
     let sun_weighted = l.sun_weight.iter().any(|&k| k != 0.0);
     let sky_weighted = l.sky_weight.iter().any(|&k| k != 0.0);
     let needs_sun = sun_weighted || (sky_weighted && matches!(model, SkyModel::CieGeneral(_)));
-    let view = args
-        .view
-        .clone()
-        .or_else(|| doc.site.photos.first().map(|p| p.id.clone()))
-        .unwrap_or_default();
+    let view = args.solve.view_id(doc);
     let sun_dir = if needs_sun {
         Some(site_sun_dir(doc, &view)?)
     } else {
@@ -139,7 +187,7 @@ fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGrou
             &sky_sun,
             l.sky_weight,
             &dome,
-            args.sky_tolerance,
+            args.solve.sky_tolerance,
         )?));
     }
     // One group per enabled [[luminaires]] entry, in the site's order (as the renderer lists them).
@@ -199,34 +247,25 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             args.site.display()
         );
     }
-    let stop = StopRule {
-        mean_change: args.mean_change,
-        residual: args.residual,
-        ..StopRule::default()
-    };
-    let params = SolveParams {
-        mesh: MeshParams {
-            max_patch_edge_m: args.patch_edge_m,
-            max_element_edge_m: args.element_edge_m,
-            object_element_edge_m: object_sizes(&args.object_element_edge)?,
-            ..MeshParams::default()
-        },
-        form_factors: FormFactorParams {
-            samples_per_axis: args.samples,
-            seed: args.seed,
-            visibility: true,
-        },
-        solver: match args.solver {
+    let stop = args.solve.stop();
+    let ground = site_ground_below_horizon(&doc, &site.scene)?;
+    if let Some(g) = &ground {
+        eprintln!(
+            "note: the site models no ground: the lower hemisphere is a uniform ground of albedo {:?}",
+            g.albedo_rgb
+        );
+    }
+    let params = args.solve.params(
+        match args.solver {
             SolverArg::Hierarchical => Solver::Hierarchical(HierarchicalParams {
-                bf_tolerance: args.bf_tolerance,
+                bf_tolerance: args.solve.bf_tolerance,
                 ..HierarchicalParams::default()
             }),
             SolverArg::Progressive => Solver::Progressive,
             SolverArg::Direct => Solver::Direct,
         },
-        stop,
-        ..SolveParams::default()
-    };
+        ground,
+    )?;
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")
@@ -240,7 +279,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         groups.len()
     );
     let start = Instant::now();
-    let result = with_threads(args.threads, || {
+    let result = with_threads(args.solve.threads, || {
         Ok(solve(&site.scene, &groups, &params, cancel, &|row| {
             bar.set_message(format!(
                 "{} pass {}: residual {:.2e}, mean change {:.2e}, {} interactions",
@@ -255,6 +294,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let solution = result?;
     let elapsed_s = start.elapsed().as_secs_f64();
     for w in &solution.mesh.warnings {
+        eprintln!("warning: {w}");
+    }
+    for w in &solution.warnings {
         eprintln!("warning: {w}");
     }
     let total = solution.total_radiosity_rgb();
@@ -294,7 +336,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "groups": groups_json,
         "converged": converged,
         "time_s": elapsed_s,
-        "warnings": solution.mesh.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
+        "warnings": solution
+            .mesh
+            .warnings
+            .iter()
+            .map(ToString::to_string)
+            .chain(solution.warnings.iter().map(ToString::to_string))
+            .collect::<Vec<_>>(),
     });
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

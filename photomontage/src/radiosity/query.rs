@@ -1,0 +1,538 @@
+//! Irradiance at any point of a solved scene: interpolated from the elements where a point lies
+//! on one ([`Solution::irradiance_at`]), with a final gather from the point itself where the
+//! mesh is coarse or the point lies on no element ([`Transfer::irradiance_at`]).
+//!
+//! **Interpolation.** Each element's irradiance (direct, and total H = (B − π·L_e)/ρ) is averaged
+//! at its vertices over the elements of the same plane that share the vertex (Cohen & Wallace,
+//! seed 002, §9.2 "nodal averaging"); a point is located on its element through a uniform grid
+//! of element bounding boxes (cells of the longest element edge) and takes the barycentric blend
+//! of the three vertex values. The lookup is built once per solution ([`std::sync::OnceLock`])
+//! and only read afterwards, so queries run from any number of threads.
+//!
+//! **Final gather** (Cohen & Wallace §9.3.2; the renderer's fallback): the direct term exactly
+//! at the point (one shadow ray per distant source and point source, and the ground below the
+//! horizon through its clusters), plus the interreflected term as the mean exitance B seen by
+//! cosine-distributed rays (E = ∫ L cos ω dω = π·mean L = mean B for that distribution), each hit
+//! located on its element. Rays come from a ChaCha8 stream seeded by the point's coordinates, so a
+//! query is repeatable and independent of threads.
+//!
+//! # Known limitations
+//! Vertex averaging smooths irradiance across an element's width (a shadow edge inside an element
+//! is blurred over it; finer elements or the final gather are the cure). Elements of zero
+//! reflectance carry no interreflected irradiance and are always gathered. The gathered indirect
+//! term is a Monte Carlo estimate (error ∝ 1/√rays).
+
+use std::collections::HashMap;
+
+use nalgebra::{Point3, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::sources::{DIRECT_RAY_OFFSET_M, DistantSource};
+use super::{RadiosityError, Rgb, Solution, Transfer};
+
+/// A query point lies on an element when it is within this distance of its plane, metres
+/// (survey points on a façade are good to a centimetre).
+pub const ON_SURFACE_TOL_M: f64 = 0.02;
+
+/// A query normal matches an element's when their angle is below acos of this (≈ 18°).
+pub const NORMAL_MATCH_COS: f64 = 0.95;
+
+/// Barycentric slack when locating a point on an element (points on shared edges).
+const BARYCENTRIC_SLACK: f64 = 1e-6;
+
+/// Irradiance at a point, per channel, in the site's linear units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IrradianceSample {
+    /// Direct irradiance (sun, sky, luminaires, ground below the horizon; shadowed).
+    pub direct_rgb: Rgb,
+    /// Interreflected irradiance.
+    pub indirect_rgb: Rgb,
+    /// direct + indirect.
+    pub total_rgb: Rgb,
+    /// The element the value was interpolated on, `None` for a final gather.
+    pub element: Option<usize>,
+}
+
+/// Query tunables of [`Transfer::irradiance_at`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QueryParams {
+    /// Elements with a longer edge are too coarse to interpolate: the point is gathered, metres.
+    pub max_interpolation_edge_m: f64,
+    /// Cosine-distributed rays of a final gather.
+    pub gather_rays: u32,
+}
+
+impl Default for QueryParams {
+    /// Interpolate on elements up to 2 m, 256 gather rays.
+    fn default() -> Self {
+        Self {
+            max_interpolation_edge_m: 2.0,
+            gather_rays: 256,
+        }
+    }
+}
+
+/// Element lookup grid and per-vertex irradiance of one solution.
+#[derive(Debug, Clone, Default)]
+pub struct ElementLocator {
+    cell_m: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+    /// Per element and vertex: (total, direct).
+    vertex_values: Vec<[(Rgb, Rgb); 3]>,
+    /// Per element, total radiosity B (for gathers).
+    radiosity: Vec<Rgb>,
+    /// Per element: reflects (ρ > 0 in some channel).
+    reflects: Vec<bool>,
+    /// Per element, longest edge, metres.
+    longest_edge_m: Vec<f64>,
+}
+
+fn longest_edge(v: &[Point3<f64>; 3]) -> f64 {
+    (v[1] - v[0])
+        .norm()
+        .max((v[2] - v[1]).norm())
+        .max((v[0] - v[2]).norm())
+}
+
+#[allow(clippy::cast_possible_truncation)]
+fn cell_of(p: &Point3<f64>, cell_m: f64) -> [i64; 3] {
+    [
+        (p.x / cell_m).floor() as i64,
+        (p.y / cell_m).floor() as i64,
+        (p.z / cell_m).floor() as i64,
+    ]
+}
+
+#[allow(clippy::cast_possible_truncation)]
+fn vertex_key(p: &Point3<f64>, n: &Vector3<f64>) -> [i64; 6] {
+    let q = |v: f64, s: f64| (v * s).round() as i64;
+    [
+        q(p.x, 1e5),
+        q(p.y, 1e5),
+        q(p.z, 1e5),
+        q(n.x, 1e3),
+        q(n.y, 1e3),
+        q(n.z, 1e3),
+    ]
+}
+
+impl ElementLocator {
+    fn new(solution: &Solution) -> Self {
+        let mesh = &solution.mesh;
+        let n = mesh.elements.len();
+        let mut total = vec![[0.0; 3]; n];
+        let mut direct = vec![[0.0; 3]; n];
+        for g in &solution.groups {
+            // The emitters group owns the emission (`LightGroup::emitters`).
+            let h = g.irradiance_rgb(mesh, g.name == "emitters");
+            for e in 0..n {
+                for c in 0..3 {
+                    total[e][c] += h[e][c];
+                    direct[e][c] += g.direct_irradiance_rgb[e][c];
+                }
+            }
+        }
+        let mut sums: HashMap<[i64; 6], (Rgb, Rgb, f64)> = HashMap::new();
+        for e in 0..n {
+            let node = mesh.element_node(e);
+            for v in &node.vertices_in_world_m {
+                let s = sums
+                    .entry(vertex_key(v, &node.normal_in_world))
+                    .or_insert(([0.0; 3], [0.0; 3], 0.0));
+                for c in 0..3 {
+                    s.0[c] += total[e][c];
+                    s.1[c] += direct[e][c];
+                }
+                s.2 += 1.0;
+            }
+        }
+        let vertex_values = (0..n)
+            .map(|e| {
+                let node = mesh.element_node(e);
+                node.vertices_in_world_m.map(|v| {
+                    let (t, d, k) = sums[&vertex_key(&v, &node.normal_in_world)];
+                    (t.map(|x| x / k), d.map(|x| x / k))
+                })
+            })
+            .collect();
+        let longest_edge_m: Vec<f64> = (0..n)
+            .map(|e| longest_edge(&mesh.element_node(e).vertices_in_world_m))
+            .collect();
+        let cell_m = longest_edge_m
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
+            .max(4.0 * ON_SURFACE_TOL_M);
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for e in 0..n {
+            let v = &mesh.element_node(e).vertices_in_world_m;
+            let lo = v.iter().fold(Point3::from([f64::MAX; 3]), |a, p| a.inf(p));
+            let hi = v.iter().fold(Point3::from([f64::MIN; 3]), |a, p| a.sup(p));
+            let pad = Vector3::repeat(ON_SURFACE_TOL_M);
+            let (a, b) = (cell_of(&(lo - pad), cell_m), cell_of(&(hi + pad), cell_m));
+            for x in a[0]..=b[0] {
+                for y in a[1]..=b[1] {
+                    for z in a[2]..=b[2] {
+                        #[allow(clippy::cast_possible_truncation)]
+                        cells.entry([x, y, z]).or_default().push(e as u32);
+                    }
+                }
+            }
+        }
+        let radiosity = solution.total_radiosity_rgb();
+        let reflects = (0..n)
+            .map(|e| {
+                mesh.surfaces[mesh.element_node(e).surface as usize]
+                    .reflectance_rgb
+                    .iter()
+                    .any(|&r| r > 0.0)
+            })
+            .collect();
+        Self {
+            cell_m,
+            cells,
+            vertex_values,
+            radiosity,
+            reflects,
+            longest_edge_m,
+        }
+    }
+
+    /// The element `point` lies on (normal within [`NORMAL_MATCH_COS`], plane within
+    /// [`ON_SURFACE_TOL_M`]) and its barycentric weights.
+    fn locate(
+        &self,
+        solution: &Solution,
+        point: &Point3<f64>,
+        normal: &Vector3<f64>,
+    ) -> Option<(usize, [f64; 3])> {
+        let candidates = self.cells.get(&cell_of(point, self.cell_m))?;
+        let mut best: Option<(f64, usize, [f64; 3])> = None;
+        for &e in candidates {
+            let node = solution.mesh.element_node(e as usize);
+            let n = &node.normal_in_world;
+            if n.dot(normal) < NORMAL_MATCH_COS {
+                continue;
+            }
+            let [a, b, c] = node.vertices_in_world_m;
+            let distance = (point - a).dot(n).abs();
+            if distance > ON_SURFACE_TOL_M {
+                continue;
+            }
+            let w = barycentric(point, &a, &b, &c, n);
+            let outside = w.iter().map(|&x| (-x).max(0.0)).sum::<f64>() * longest_edge(&[a, b, c]);
+            if outside > BARYCENTRIC_SLACK + ON_SURFACE_TOL_M {
+                continue;
+            }
+            let score = distance + outside;
+            if best.is_none_or(|(s, _, _)| score < s) {
+                let clamped = w.map(|x| x.max(0.0));
+                let sum: f64 = clamped.iter().sum();
+                best = Some((score, e as usize, clamped.map(|x| x / sum)));
+            }
+        }
+        best.map(|(_, e, w)| (e, w))
+    }
+}
+
+/// Barycentric weights of the projection of `p` on triangle `a b c` with normal `n`.
+fn barycentric(
+    p: &Point3<f64>,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    c: &Point3<f64>,
+    n: &Vector3<f64>,
+) -> [f64; 3] {
+    let area2 = (b - a).cross(&(c - a)).dot(n);
+    let wa = (b - p).cross(&(c - p)).dot(n) / area2;
+    let wb = (c - p).cross(&(a - p)).dot(n) / area2;
+    [wa, wb, 1.0 - wa - wb]
+}
+
+impl Solution {
+    fn locator(&self) -> &ElementLocator {
+        self.locator.get_or_init(|| ElementLocator::new(self))
+    }
+
+    /// Irradiance at `point_in_world_m` on a surface of outward unit normal `normal_in_world`,
+    /// interpolated from the element the point lies on (module doc); `None` when it lies on none.
+    #[must_use]
+    pub fn irradiance_at(
+        &self,
+        point_in_world_m: &Point3<f64>,
+        normal_in_world: &Vector3<f64>,
+    ) -> Option<IrradianceSample> {
+        let locator = self.locator();
+        let (e, w) = locator.locate(self, point_in_world_m, normal_in_world)?;
+        let values = &locator.vertex_values[e];
+        let mut total = [0.0; 3];
+        let mut direct = [0.0; 3];
+        for (k, (t, d)) in values.iter().enumerate() {
+            for c in 0..3 {
+                total[c] += w[k] * t[c];
+                direct[c] += w[k] * d[c];
+            }
+        }
+        let indirect: Rgb = std::array::from_fn(|c| (total[c] - direct[c]).max(0.0));
+        Some(IrradianceSample {
+            direct_rgb: direct,
+            indirect_rgb: indirect,
+            total_rgb: std::array::from_fn(|c| direct[c] + indirect[c]),
+            element: Some(e),
+        })
+    }
+}
+
+/// Cosine-distributed direction about `n` from two uniform numbers (Malley's method).
+fn cosine_direction(n: &Vector3<f64>, u1: f64, u2: f64) -> Vector3<f64> {
+    let r = u1.sqrt();
+    let phi = std::f64::consts::TAU * u2;
+    let t = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let a = n.cross(&t).normalize();
+    let b = n.cross(&a);
+    a * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()
+}
+
+impl Transfer {
+    /// Irradiance at a point on a surface (module doc): interpolated where the point lies on a
+    /// reflecting element no longer than [`QueryParams::max_interpolation_edge_m`], else a final
+    /// gather from the point.
+    ///
+    /// # Errors
+    /// [`RadiosityError::InvalidParameter`] for a non-finite point or a normal that is not a
+    /// unit vector.
+    pub fn irradiance_at(
+        &self,
+        point_in_world_m: &Point3<f64>,
+        normal_in_world: &Vector3<f64>,
+        params: &QueryParams,
+    ) -> Result<IrradianceSample, RadiosityError> {
+        if !point_in_world_m.coords.iter().all(|c| c.is_finite()) {
+            return Err(RadiosityError::InvalidParameter {
+                name: "point",
+                value: f64::NAN,
+                reason: "coordinates must be finite",
+            });
+        }
+        let norm = normal_in_world.norm();
+        if !(norm.is_finite() && (norm - 1.0).abs() <= 1e-3) {
+            return Err(RadiosityError::InvalidParameter {
+                name: "normal length",
+                value: norm,
+                reason: "the normal must be a unit vector (length 1 ± 0.001)",
+            });
+        }
+        let solution = self.solution();
+        if let Some(sample) = solution.irradiance_at(point_in_world_m, normal_in_world) {
+            let e = sample.element.unwrap_or(usize::MAX);
+            let locator = solution.locator();
+            if locator.reflects[e] && locator.longest_edge_m[e] <= params.max_interpolation_edge_m {
+                return Ok(sample);
+            }
+        }
+        Ok(self.gather(point_in_world_m, &normal_in_world.normalize(), params))
+    }
+
+    /// Final gather at a point (module doc).
+    fn gather(
+        &self,
+        point: &Point3<f64>,
+        normal: &Vector3<f64>,
+        params: &QueryParams,
+    ) -> IrradianceSample {
+        let tracer = self.tracer();
+        let solution = self.solution();
+        let locator = solution.locator();
+        #[allow(clippy::cast_possible_truncation)]
+        let offset = DIRECT_RAY_OFFSET_M as f32;
+        let origin = point + normal * DIRECT_RAY_OFFSET_M;
+        let visible = |dir: &Vector3<f64>, length: f32| {
+            !tracer.any_hit(&tracer.ray_from_world(&origin, dir, offset, length))
+        };
+        let distant = |sources: &[DistantSource]| -> Rgb {
+            let mut e = [0.0; 3];
+            for s in sources {
+                let cos = normal.dot(&s.dir_in_world);
+                if cos > 0.0 && visible(&s.dir_in_world, 1e7) {
+                    for c in 0..3 {
+                        e[c] += s.normal_irradiance_rgb[c] * cos;
+                    }
+                }
+            }
+            e
+        };
+        let mut direct = [0.0; 3];
+        let ground_sources = self.ground().map(|g| (g, g.sources.clone()));
+        for group in self.light_groups() {
+            let mut add = distant(&group.sources);
+            if let Some((g, sources)) = &ground_sources {
+                let l = g.ground.radiance_rgb(&group.sources);
+                let unit = distant(sources)[0];
+                for c in 0..3 {
+                    add[c] += l[c] * unit;
+                }
+            }
+            for p in &group.points {
+                let to_light = p.position_in_world_m - origin;
+                let d2 = to_light.norm_squared();
+                let d = d2.sqrt();
+                let cos = normal.dot(&to_light) / d;
+                #[allow(clippy::cast_possible_truncation)]
+                if d2 > 0.0 && cos > 0.0 && visible(&(to_light / d), (d * (1.0 - 1e-4)) as f32) {
+                    let i = p.intensity_toward_rgb(&(-to_light / d));
+                    for c in 0..3 {
+                        add[c] += i[c] * cos / d2;
+                    }
+                }
+            }
+            for c in 0..3 {
+                direct[c] += add[c];
+            }
+        }
+        // Interreflection: the mean exitance seen by cosine-distributed rays.
+        let seed = point
+            .coords
+            .iter()
+            .chain(normal.iter())
+            .fold(0xC0FF_EE00_u64, |h, v| {
+                (h ^ v.to_bits()).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            });
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut sum = [0.0; 3];
+        for _ in 0..params.gather_rays {
+            let dir = cosine_direction(normal, rng.random(), rng.random());
+            let ray = tracer.ray_from_world(&origin, &dir, offset, 1e7);
+            let Some(hit) = tracer.closest_hit(&ray) else {
+                continue;
+            };
+            let hit_normal = Vector3::from(hit.hit.normal_geometric.map(f64::from));
+            if hit_normal.dot(&dir) >= 0.0 {
+                continue; // the back of a one-sided surface emits nothing
+            }
+            let x = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+            if let Some((e, _)) = locator.locate(solution, &x, &hit_normal) {
+                for c in 0..3 {
+                    sum[c] += locator.radiosity[e][c];
+                }
+            }
+        }
+        let rays = f64::from(params.gather_rays.max(1));
+        let indirect = sum.map(|s| s / rays);
+        IrradianceSample {
+            direct_rgb: direct,
+            indirect_rgb: indirect,
+            total_rgb: std::array::from_fn(|c| direct[c] + indirect[c]),
+            element: None,
+        }
+    }
+}
+
+/// One row of a points file: `id,X,Y,Z,nx,ny,nz` (world metres, outward unit normal).
+#[derive(Debug, Clone, PartialEq)]
+pub struct QueryPoint {
+    /// The row's id.
+    pub id: String,
+    /// The point, world metres.
+    pub point_in_world_m: Point3<f64>,
+    /// Outward unit normal.
+    pub normal_in_world: Vector3<f64>,
+}
+
+/// A normal is a unit vector when its length is within this of 1 (six significant digits in a
+/// CSV give 1e-6; a hand-typed normal like 0.707,0.707 is 1.0001).
+pub const UNIT_NORMAL_TOL: f64 = 1e-3;
+
+/// Parses a points file (module doc of the `irradiance` command): one `id,X,Y,Z,nx,ny,nz` row
+/// per point; a first row starting with `id` is a header; blank lines and `#` comments are
+/// skipped.
+///
+/// # Errors
+/// [`RadiosityError::PointsRow`] naming the line: a missing or extra column, a value that is not
+/// a finite number, a normal that is not a unit vector, a repeated id.
+pub fn parse_query_points(text: &str) -> Result<Vec<QueryPoint>, RadiosityError> {
+    let mut out: Vec<QueryPoint> = Vec::new();
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        let row = raw.trim();
+        if row.is_empty() || row.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
+        if out.is_empty() && index == 0 && fields[0].eq_ignore_ascii_case("id") {
+            continue;
+        }
+        let bad = |message: String| RadiosityError::PointsRow { line, message };
+        if fields.len() != 7 {
+            return Err(bad(format!(
+                "{} columns, expected 7 (id,X,Y,Z,nx,ny,nz)",
+                fields.len()
+            )));
+        }
+        if fields[0].is_empty() {
+            return Err(bad("empty id".into()));
+        }
+        let names = ["X", "Y", "Z", "nx", "ny", "nz"];
+        let mut v = [0.0; 6];
+        for (k, name) in names.iter().enumerate() {
+            let text = fields[k + 1];
+            v[k] = text
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(format!("{name} = `{text}` is not a finite number")))?;
+        }
+        let normal = Vector3::new(v[3], v[4], v[5]);
+        let length = normal.norm();
+        if (length - 1.0).abs() > UNIT_NORMAL_TOL {
+            return Err(bad(format!(
+                "normal ({}, {}, {}) has length {length:.6}, not 1 (± {UNIT_NORMAL_TOL})",
+                v[3], v[4], v[5]
+            )));
+        }
+        if out.iter().any(|p| p.id == fields[0]) {
+            return Err(bad(format!("id `{}` repeats an earlier row", fields[0])));
+        }
+        out.push(QueryPoint {
+            id: fields[0].to_owned(),
+            point_in_world_m: Point3::new(v[0], v[1], v[2]),
+            normal_in_world: normal / length,
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_rows_are_parsed_and_bad_rows_named_by_line() {
+        let ok = parse_query_points(
+            "id,X,Y,Z,nx,ny,nz\np1,1,2,3,0,0,1\n\n# note\np2, 0,0,0, 0.6,0.8,0\n",
+        )
+        .unwrap();
+        assert_eq!(ok.len(), 2);
+        assert_eq!(ok[1].id, "p2");
+        assert_eq!(ok[1].normal_in_world, Vector3::new(0.6, 0.8, 0.0));
+        for (text, line, words) in [
+            ("p1,1,2,3,0,0\n", 1, "6 columns"),
+            ("id,X,Y,Z,nx,ny,nz\np1,1,2,3,0,0,2\n", 2, "length 2"),
+            ("p1,1,NaN,3,0,0,1\n", 1, "Y = `NaN`"),
+            ("p1,1,2,3,0,0,1\np2,1,2,x,0,0,1\n", 2, "Z = `x`"),
+            ("p1,1,2,3,0,0,1\np1,1,2,3,0,0,1\n", 2, "repeats"),
+            ("p1,1,2,3,0,0,1,9\n", 1, "8 columns"),
+        ] {
+            let err = parse_query_points(text).unwrap_err();
+            let msg = err.to_string();
+            assert!(
+                msg.contains(&format!("line {line}")) && msg.contains(words),
+                "{msg}"
+            );
+        }
+    }
+}

@@ -1,0 +1,926 @@
+//! Precomputed transfer and relighting (Tonn & Donath, seed 000: "the geometry-dependent part of
+//! the radiosity solution is calculated once … the lighting situation [sun position, sky type,
+//! artificial lights, materials] can then be changed interactively").
+//!
+//! [`Transfer::build`] does everything that depends on the geometry once: the mesh, the BVH, the
+//! hierarchical links with their form factors (Hanrahan, Salzman & Aupperle 1991, refined for the
+//! lighting it was built with), the ground-below-horizon transfer, and one solution per light
+//! group (sun, sky, each luminaire, the emitting materials). [`Transfer::relight`] then applies a
+//! [`LightingChange`] without computing a single form factor:
+//!
+//! - **Scalings** (the sun's normal irradiance with its direction unchanged, the sky's weights
+//!   with its type unchanged, a luminaire's dimming): the group's response is linear in its
+//!   sources, so with [`RelightStrategy::LinearResponses`] its direct irradiance and radiosity
+//!   are multiplied by the ratio, per channel, exactly and in O(elements).
+//! - **A sun move** re-traces only the sun's shadow rays (the same sample points and random
+//!   streams as [`super::solve`], so the direct term is the re-solve's bit for bit) and then
+//!   iterates the sun group on the stored links; a sky whose luminance follows the sun (CIE
+//!   general skies, Perez) is re-clustered and re-traced as well.
+//! - **A sky type change** re-clusters the dome and re-traces the sky group's direct light.
+//! - **A material's reflectance** changes ρ on its elements; every group is iterated again.
+//!
+//! Iterations start warm: B_start = B₀′ + (ρ′/ρ)·(B − B₀) per element, i.e. the previous
+//! interreflected part carried over (scaled by the ratio of the group's sources under
+//! `LinearResponses`), and run Gauss–Seidel sweeps (patch by patch, sequential) or Jacobi sweeps
+//! (parallel) on the stored links ([`Sweep`]) until the stop rule holds, its mean-change test
+//! measured from the warm start. [`RelightStrategy::WarmGaussSeidel`] is the issue's first way:
+//! every change, scalings included, re-iterates the groups it touches from their previous
+//! solution. Both are measured in docs/benchmarks.md.
+//!
+//! Links are stored as compressed rows per receiver node with `f32` factors (the factors'
+//! Monte Carlo error is ~1e-2, their rounding 6e-8); sweeps visit receivers in a fixed order,
+//! so relit solutions are bit-identical on any number of threads.
+//!
+//! # Known limitations
+//! The links keep the refinement made for the build's lighting: a sun moved far from where it
+//! was is solved on links refined for the old shadows (BF refinement is not redone; a full
+//! [`super::solve`] would refine differently, within the BF tolerance). Emission and geometry
+//! cannot change (a new scene needs a new transfer). A sky change re-traces every sky cluster
+//! (it is not an interactive-speed change for many clusters).
+
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_change};
+use super::form_factor::FormFactorEngine;
+use super::hierarchical::Hierarchy;
+use super::mesh::Mesh;
+use super::solve::{GroundTerm, group_direct, initial_exitance};
+use super::sources::{self, LightWarning, PointSource};
+use super::{
+    GroupSolution, LightGroup, RadiosityError, Rgb, Solution, SolveParams, Solver, luminance,
+};
+use crate::bvh::BuildQuality;
+use crate::scene::{Scene, SceneTracer};
+use crate::sky::SkyModel;
+use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
+
+/// The sun as a distant source.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sun {
+    /// Unit vector towards the sun, world frame (z up).
+    pub dir_in_world: Vector3<f64>,
+    /// Irradiance on a plane facing the sun, per channel.
+    pub normal_irradiance_rgb: Rgb,
+}
+
+/// The sky: a luminance model scaled to a horizontal irradiance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sky {
+    /// Any sky model of [`crate::sky`] (uniform, CIE overcast, CIE general 1–15, Perez).
+    pub model: SkyModel,
+    /// Unobstructed horizontal irradiance of the sky, per channel (the site's `sky_weight`).
+    pub horizontal_irradiance_rgb: Rgb,
+}
+
+/// A luminaire (or isotropic point light) with its dimming factor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedLuminaire {
+    /// Group name (`luminaire:ID` in the CLI).
+    pub name: String,
+    /// The source at full output.
+    pub source: PointSource,
+    /// Output factor, ≥ 0 (1 = full).
+    pub dimming: f64,
+}
+
+/// The lighting a transfer is built for and relit to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferLighting {
+    /// The sun, `None` when there is none.
+    pub sun: Option<Sun>,
+    /// The sky, `None` when there is none.
+    pub sky: Option<Sky>,
+    /// Luminaires, one light group each.
+    pub luminaires: Vec<NamedLuminaire>,
+    /// Whether the emitting materials form a group.
+    pub emitters: bool,
+}
+
+/// What [`Transfer::relight`] changes; `None`/empty fields keep the current value.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LightingChange {
+    /// A new sun (`Some(None)` switches it off).
+    pub sun: Option<Option<Sun>>,
+    /// A new sky (`Some(None)` switches it off).
+    pub sky: Option<Option<Sky>>,
+    /// New dimming factors by luminaire name.
+    pub luminaire_dimming: Vec<(String, f64)>,
+    /// New diffuse reflectance (RGB, each in [0, 1]) by material name.
+    pub material_reflectance: Vec<(String, Rgb)>,
+}
+
+/// How a relight re-solves (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RelightStrategy {
+    /// Every touched group is iterated from its previous solution.
+    WarmGaussSeidel,
+    /// Scalings are exact multiplications; only re-traced groups and material changes iterate.
+    LinearResponses,
+}
+
+/// The sweep of a relight iteration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sweep {
+    /// Patch by patch, each gathering the newest values (sequential).
+    GaussSeidel,
+    /// All receivers from the previous sweep's values (parallel).
+    Jacobi,
+}
+
+/// Transfer tunables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferParams {
+    /// Mesh, form factors, stop rule, ground; the solver must be hierarchical.
+    pub solve: SolveParams,
+    /// Clustering tolerance of the sky dome ([`sources::sky_sources`]).
+    pub sky_tolerance: f64,
+    /// How relights re-solve.
+    pub strategy: RelightStrategy,
+    /// The sweep of relight iterations.
+    pub sweep: Sweep,
+}
+
+impl Default for TransferParams {
+    /// Default solve parameters (hierarchical), sky tolerance 0.1, linear responses with
+    /// Gauss–Seidel sweeps (the faster pair measured in docs/benchmarks.md).
+    fn default() -> Self {
+        Self {
+            solve: SolveParams::default(),
+            sky_tolerance: 0.1,
+            strategy: RelightStrategy::LinearResponses,
+            sweep: Sweep::GaussSeidel,
+        }
+    }
+}
+
+/// Which light a group stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum GroupKind {
+    Sun,
+    Sky,
+    Luminaire(usize),
+    Emitters,
+}
+
+/// What a change does to one group.
+#[derive(Debug, Clone, PartialEq)]
+enum Action {
+    Keep,
+    Scale(Rgb),
+    Retrace,
+}
+
+/// The links as compressed rows per receiver node.
+#[derive(Debug, Clone)]
+struct LinkRows {
+    /// Row of node n: `start[n]..start[n + 1]`.
+    start: Vec<u32>,
+    source: Vec<u32>,
+    form_factor: Vec<f32>,
+}
+
+impl LinkRows {
+    #[allow(clippy::cast_possible_truncation)] // at most `max_links` (5·10⁶) links
+    fn new(nodes: usize, hierarchy: &Hierarchy) -> Self {
+        let mut start = vec![0u32; nodes + 1];
+        for l in &hierarchy.links {
+            start[l.receiver as usize + 1] += 1;
+        }
+        for n in 0..nodes {
+            start[n + 1] += start[n];
+        }
+        // Links are sorted by receiver (stable): rows keep the hierarchy's order.
+        Self {
+            start,
+            source: hierarchy.links.iter().map(|l| l.source).collect(),
+            form_factor: hierarchy
+                .links
+                .iter()
+                .map(|l| l.form_factor as f32)
+                .collect(),
+        }
+    }
+
+    fn gather(&self, n: usize, b: &[Rgb]) -> Rgb {
+        let mut g = [0.0; 3];
+        let (lo, hi) = (self.start[n] as usize, self.start[n + 1] as usize);
+        for (s, f) in self.source[lo..hi].iter().zip(&self.form_factor[lo..hi]) {
+            let bs = &b[*s as usize];
+            let f = f64::from(*f);
+            for c in 0..3 {
+                g[c] += f * bs[c];
+            }
+        }
+        g
+    }
+}
+
+/// Node topology for iterative push–pull (nodes are in pre-order per scene triangle).
+#[derive(Debug, Clone)]
+struct Topology {
+    /// Parent node, `u32::MAX` for a scene triangle's root.
+    parent: Vec<u32>,
+    /// Area of a node over its parent's.
+    weight: Vec<f64>,
+    /// Per patch, its subtree's node range.
+    patch_ranges: Vec<(usize, usize)>,
+    /// Element areas, m².
+    areas: Vec<f64>,
+}
+
+impl Topology {
+    fn new(mesh: &Mesh) -> Self {
+        let n = mesh.nodes.len();
+        let mut parent = vec![u32::MAX; n];
+        let mut weight = vec![1.0; n];
+        for (p, node) in mesh.nodes.iter().enumerate() {
+            if let Some(kids) = node.children {
+                for k in kids {
+                    #[allow(clippy::cast_possible_truncation)] // node ids are u32
+                    {
+                        parent[k as usize] = p as u32;
+                    }
+                    weight[k as usize] = mesh.nodes[k as usize].area_m2 / node.area_m2;
+                }
+            }
+        }
+        let mut last = (0..n).collect::<Vec<usize>>();
+        for i in (0..n).rev() {
+            if let Some(kids) = mesh.nodes[i].children {
+                last[i] = kids.iter().map(|&k| last[k as usize]).max().unwrap_or(i);
+            }
+        }
+        let patch_ranges = mesh
+            .patches
+            .iter()
+            .map(|&p| (p as usize, last[p as usize] + 1))
+            .collect();
+        let areas = (0..mesh.elements.len())
+            .map(|e| mesh.element_node(e).area_m2)
+            .collect();
+        Self {
+            parent,
+            weight,
+            patch_ranges,
+            areas,
+        }
+    }
+}
+
+/// The geometry-dependent part of a radiosity solution, and the current lighting on it.
+#[derive(Debug, Clone)]
+pub struct Transfer {
+    tracer: SceneTracer,
+    params: TransferParams,
+    rows: LinkRows,
+    topology: Topology,
+    ground: Option<GroundTerm>,
+    dome: IcosahedralDome,
+    /// Material index per mesh surface, and the material names.
+    surface_material: Vec<usize>,
+    material_names: Vec<String>,
+    lighting: TransferLighting,
+    kinds: Vec<GroupKind>,
+    /// The current light groups (sources as traced).
+    groups: Vec<LightGroup>,
+    /// Per group, the initial exitance of the current solution.
+    b0s: Vec<Vec<Rgb>>,
+    solution: Solution,
+}
+
+fn sky_needs_sun(model: &SkyModel) -> bool {
+    matches!(model, SkyModel::CieGeneral(_) | SkyModel::Perez(_))
+}
+
+/// The ratio new/old per channel, `None` when an old channel is 0 and the new is not.
+fn ratio(new: Rgb, old: Rgb) -> Option<Rgb> {
+    let mut k = [0.0; 3];
+    for c in 0..3 {
+        if old[c] > 0.0 {
+            k[c] = new[c] / old[c];
+        } else if new[c] != 0.0 {
+            return None;
+        }
+    }
+    Some(k)
+}
+
+fn check_rgb(name: &str, what: &str, rgb: Rgb, max: f64) -> Result<(), RadiosityError> {
+    if rgb.iter().all(|v| v.is_finite() && *v >= 0.0 && *v <= max) {
+        Ok(())
+    } else {
+        Err(RadiosityError::InvalidSource {
+            group: name.to_owned(),
+            reason: format!("{what} {rgb:?} must be finite and in [0, {max}]"),
+        })
+    }
+}
+
+impl TransferLighting {
+    /// The light groups in transfer order: sun, sky, each luminaire, emitters (sun and sky are
+    /// always present, empty when off), with the warnings of the sun's position.
+    ///
+    /// # Errors
+    /// Invalid sources, sky models without light.
+    pub fn light_groups(
+        &self,
+        dome: &IcosahedralDome,
+        sky_tolerance: f64,
+    ) -> Result<(Vec<LightGroup>, Vec<LightWarning>), RadiosityError> {
+        let mut warnings = Vec::new();
+        let sun_group = self.sun_group(&mut warnings)?;
+        let mut groups = vec![sun_group, self.sky_group(dome, sky_tolerance)?];
+        for l in &self.luminaires {
+            groups.push(luminaire_group(l)?);
+        }
+        if self.emitters {
+            groups.push(LightGroup::emitters());
+        }
+        Ok((groups, warnings))
+    }
+
+    fn sun_group(&self, warnings: &mut Vec<LightWarning>) -> Result<LightGroup, RadiosityError> {
+        let mut group = LightGroup::sun(Vector3::z(), [0.0; 3]);
+        group.sources.clear();
+        if let Some(sun) = &self.sun {
+            check_rgb(
+                "sun",
+                "normal irradiance",
+                sun.normal_irradiance_rgb,
+                f64::MAX,
+            )?;
+            let norm = sun.dir_in_world.norm();
+            if !(norm.is_finite() && (norm - 1.0).abs() < 1e-6) {
+                return Err(RadiosityError::InvalidSource {
+                    group: "sun".into(),
+                    reason: format!("direction {:?} is not a unit vector", sun.dir_in_world),
+                });
+            }
+            if sun.dir_in_world.z <= 0.0 {
+                warnings.push(LightWarning::SunBelowHorizon {
+                    elevation_deg: sun.dir_in_world.z.clamp(-1.0, 1.0).asin().to_degrees(),
+                });
+            } else {
+                group = LightGroup::sun(sun.dir_in_world, sun.normal_irradiance_rgb);
+            }
+        }
+        Ok(group)
+    }
+
+    fn sky_group(
+        &self,
+        dome: &IcosahedralDome,
+        tolerance: f64,
+    ) -> Result<LightGroup, RadiosityError> {
+        let Some(sky) = &self.sky else {
+            return Ok(LightGroup::sky(Vec::new()));
+        };
+        check_rgb(
+            "sky",
+            "horizontal irradiance",
+            sky.horizontal_irradiance_rgb,
+            f64::MAX,
+        )?;
+        if sky.horizontal_irradiance_rgb.iter().all(|&v| v == 0.0) {
+            return Ok(LightGroup::sky(Vec::new()));
+        }
+        let sun_dir = self
+            .sun
+            .as_ref()
+            .map_or_else(Vector3::z, |s| s.dir_in_world);
+        Ok(LightGroup::sky(sources::sky_sources(
+            &sky.model,
+            &sun_dir,
+            sky.horizontal_irradiance_rgb,
+            dome,
+            tolerance,
+        )?))
+    }
+}
+
+fn luminaire_group(l: &NamedLuminaire) -> Result<LightGroup, RadiosityError> {
+    if !(l.dimming.is_finite() && l.dimming >= 0.0) {
+        return Err(RadiosityError::InvalidSource {
+            group: l.name.clone(),
+            reason: format!("dimming {} must be finite and ≥ 0", l.dimming),
+        });
+    }
+    let mut source = l.source.clone();
+    source.intensity_rgb = source.intensity_rgb.map(|v| v * l.dimming);
+    Ok(LightGroup::luminaire(&l.name, source))
+}
+
+impl Transfer {
+    /// Precomputes the transfer of `scene` and solves `lighting` on it (module doc). The
+    /// initial solution is [`super::solve`]'s for the same groups and parameters.
+    ///
+    /// # Errors
+    /// Meshing, tracing and parameter errors (the solver must be hierarchical),
+    /// [`RadiosityError::Cancelled`].
+    pub fn build(
+        scene: &Scene,
+        lighting: &TransferLighting,
+        params: &TransferParams,
+        cancel: &AtomicBool,
+        on_pass: &dyn Fn(&ConvergenceRow),
+    ) -> Result<Self, RadiosityError> {
+        params.solve.stop.validate()?;
+        let Solver::Hierarchical(h) = params.solve.solver else {
+            return Err(RadiosityError::InvalidParameter {
+                name: "solver",
+                value: f64::NAN,
+                reason: "a transfer needs the hierarchical solver (its links are what is stored)",
+            });
+        };
+        let mesh = Mesh::build(scene, &params.solve.mesh)?;
+        let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
+        let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
+        let (groups, mut warnings) = lighting.light_groups(&dome, params.sky_tolerance)?;
+        let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?;
+        let ground = GroundTerm::new(&engine, params.solve.ground.as_ref())?;
+        let n = mesh.elements.len();
+        let mut directs = Vec::with_capacity(groups.len());
+        let mut b0s = Vec::with_capacity(groups.len());
+        for (g, group) in groups.iter().enumerate() {
+            warnings.extend(sources::check_point_sources(
+                &tracer,
+                &group.name,
+                &group.points,
+                &mesh.object_names,
+            ));
+            let direct = group_direct(&engine, group, g as u64, ground.as_ref())?;
+            b0s.push(initial_exitance(&mesh, &direct, group.emission));
+            directs.push(direct);
+        }
+        let mut b0_all = vec![[0.0; 3]; n];
+        for b0 in &b0s {
+            for (t, b) in b0_all.iter_mut().zip(b0) {
+                for c in 0..3 {
+                    t[c] += b[c];
+                }
+            }
+        }
+        let hierarchy =
+            Hierarchy::build(&engine, &h, &b0_all, &params.solve.stop, cancel, on_pass)?;
+        let mut solved = Vec::with_capacity(groups.len());
+        for ((group, b0), direct) in groups.iter().zip(&b0s).zip(directs) {
+            let (radiosity, convergence) =
+                hierarchy.solve(&mesh, b0, &group.name, &params.solve.stop, cancel, on_pass)?;
+            solved.push(GroupSolution {
+                name: group.name.clone(),
+                direct_irradiance_rgb: direct,
+                radiosity_rgb: radiosity,
+                convergence,
+            });
+        }
+        let mut kinds = vec![GroupKind::Sun, GroupKind::Sky];
+        kinds.extend((0..lighting.luminaires.len()).map(GroupKind::Luminaire));
+        if lighting.emitters {
+            kinds.push(GroupKind::Emitters);
+        }
+        let material_names: Vec<String> =
+            scene.materials().iter().map(|m| m.name.clone()).collect();
+        let surface_material = mesh
+            .surfaces
+            .iter()
+            .map(|s| scene.triangles()[s.scene_triangle].material.0 as usize)
+            .collect();
+        let rows = LinkRows::new(mesh.nodes.len(), &hierarchy);
+        let topology = Topology::new(&mesh);
+        Ok(Self {
+            tracer,
+            params: params.clone(),
+            rows,
+            topology,
+            ground,
+            dome,
+            surface_material,
+            material_names,
+            lighting: lighting.clone(),
+            kinds,
+            groups,
+            b0s,
+            solution: Solution {
+                mesh: Arc::new(mesh),
+                groups: solved,
+                interactions: hierarchy.links.len() as u64,
+                refinement: hierarchy.refinement,
+                warnings,
+                locator: std::sync::OnceLock::new(),
+            },
+        })
+    }
+
+    /// The same transfer relighting with another strategy and sweep.
+    #[must_use]
+    pub fn with_strategy(mut self, strategy: RelightStrategy, sweep: Sweep) -> Self {
+        self.params.strategy = strategy;
+        self.params.sweep = sweep;
+        self
+    }
+
+    /// The current solution.
+    #[must_use]
+    pub fn solution(&self) -> &Solution {
+        &self.solution
+    }
+
+    /// The current lighting.
+    #[must_use]
+    pub fn lighting(&self) -> &TransferLighting {
+        &self.lighting
+    }
+
+    /// The current light groups, in solution order (as [`super::solve`] would take them).
+    #[must_use]
+    pub fn light_groups(&self) -> &[LightGroup] {
+        &self.groups
+    }
+
+    /// The tracer of the scene.
+    #[must_use]
+    pub fn tracer(&self) -> &SceneTracer {
+        &self.tracer
+    }
+
+    /// The parameters.
+    #[must_use]
+    pub fn params(&self) -> &TransferParams {
+        &self.params
+    }
+
+    /// The ground-below-horizon term, if any.
+    pub(crate) fn ground(&self) -> Option<&GroundTerm> {
+        self.ground.as_ref()
+    }
+
+    /// The lighting after `change`, checked, and the new reflectance per surface (if any
+    /// material changes).
+    fn apply_to_lighting(
+        &self,
+        change: &LightingChange,
+    ) -> Result<(TransferLighting, Option<Vec<Rgb>>), RadiosityError> {
+        let mut lighting = self.lighting.clone();
+        if let Some(sun) = &change.sun {
+            lighting.sun = *sun;
+        }
+        if let Some(sky) = &change.sky {
+            lighting.sky.clone_from(sky);
+        }
+        for (name, dimming) in &change.luminaire_dimming {
+            let l = lighting
+                .luminaires
+                .iter_mut()
+                .find(|l| l.name == *name)
+                .ok_or_else(|| RadiosityError::InvalidSource {
+                    group: name.clone(),
+                    reason: "no luminaire of that name in the transfer".into(),
+                })?;
+            l.dimming = *dimming;
+        }
+        let reflectance = if change.material_reflectance.is_empty() {
+            None
+        } else {
+            let mut rho: Vec<Rgb> = self
+                .solution
+                .mesh
+                .surfaces
+                .iter()
+                .map(|s| s.reflectance_rgb)
+                .collect();
+            for (name, value) in &change.material_reflectance {
+                check_rgb(name, "reflectance", *value, 1.0)?;
+                let Some(m) = self.material_names.iter().position(|n| n == name) else {
+                    return Err(RadiosityError::UnknownMaterial {
+                        material: name.clone(),
+                    });
+                };
+                for (r, &sm) in rho.iter_mut().zip(&self.surface_material) {
+                    if sm == m {
+                        *r = *value;
+                    }
+                }
+            }
+            Some(rho)
+        };
+        Ok((lighting, reflectance))
+    }
+
+    /// What `lighting` does to each group, relative to the current lighting.
+    fn actions(&self, lighting: &TransferLighting) -> Vec<Action> {
+        let sun_moved =
+            lighting.sun.map(|s| s.dir_in_world) != self.lighting.sun.map(|s| s.dir_in_world);
+        self.kinds
+            .iter()
+            .map(|kind| match kind {
+                GroupKind::Sun => match (&lighting.sun, &self.lighting.sun) {
+                    (a, b) if a == b => Action::Keep,
+                    (Some(a), Some(b)) if !sun_moved && a.dir_in_world.z > 0.0 => {
+                        ratio(a.normal_irradiance_rgb, b.normal_irradiance_rgb)
+                            .map_or(Action::Retrace, Action::Scale)
+                    }
+                    _ => Action::Retrace,
+                },
+                GroupKind::Sky => match (&lighting.sky, &self.lighting.sky) {
+                    (Some(a), Some(b))
+                        if a.model == b.model && !(sun_moved && sky_needs_sun(&a.model)) =>
+                    {
+                        if a == b {
+                            Action::Keep
+                        } else {
+                            ratio(a.horizontal_irradiance_rgb, b.horizontal_irradiance_rgb)
+                                .map_or(Action::Retrace, Action::Scale)
+                        }
+                    }
+                    (None, None) => Action::Keep,
+                    _ => Action::Retrace,
+                },
+                GroupKind::Luminaire(i) => {
+                    let (a, b) = (
+                        lighting.luminaires[*i].dimming,
+                        self.lighting.luminaires[*i].dimming,
+                    );
+                    if a.to_bits() == b.to_bits() {
+                        Action::Keep
+                    } else {
+                        ratio([a; 3], [b; 3]).map_or(Action::Retrace, Action::Scale)
+                    }
+                }
+                GroupKind::Emitters => Action::Keep,
+            })
+            .collect()
+    }
+
+    /// Relights the transfer (module doc) and returns the new solution; on error nothing
+    /// changes.
+    ///
+    /// # Errors
+    /// [`RadiosityError::InvalidSource`] for a bad or unknown light,
+    /// [`RadiosityError::UnknownMaterial`] for a material the scene does not have.
+    pub fn relight(&mut self, change: &LightingChange) -> Result<Solution, RadiosityError> {
+        let (lighting, reflectance) = self.apply_to_lighting(change)?;
+        let (new_groups, warnings) =
+            lighting.light_groups(&self.dome, self.params.sky_tolerance)?;
+        let actions = self.actions(&lighting);
+        // Re-trace what needs it (only the changed groups' rays; never a form factor).
+        let mut retraced: Vec<Option<Vec<Rgb>>> = vec![None; actions.len()];
+        {
+            let engine = FormFactorEngine::new(
+                &self.solution.mesh,
+                &self.tracer,
+                self.params.solve.form_factors,
+            )?;
+            for (g, action) in actions.iter().enumerate() {
+                if *action == Action::Retrace {
+                    retraced[g] = Some(group_direct(
+                        &engine,
+                        &new_groups[g],
+                        g as u64,
+                        self.ground.as_ref(),
+                    )?);
+                }
+            }
+        }
+        // Nothing fails past this point: commit.
+        let old_rho: Option<Vec<Rgb>> = reflectance.as_ref().map(|_| self.element_reflectance());
+        if let Some(rho) = reflectance {
+            let mesh = Arc::make_mut(&mut self.solution.mesh);
+            for (s, r) in mesh.surfaces.iter_mut().zip(rho) {
+                s.reflectance_rgb = r;
+            }
+        }
+        let material_changed = old_rho.is_some();
+        let new_rho = self.element_reflectance();
+        let mut solution_warnings: Vec<LightWarning> = self
+            .solution
+            .warnings
+            .iter()
+            .filter(|w| !matches!(w, LightWarning::SunBelowHorizon { .. }))
+            .cloned()
+            .collect();
+        solution_warnings.extend(warnings);
+        let linear = self.params.strategy == RelightStrategy::LinearResponses;
+        for (g, action) in actions.into_iter().enumerate() {
+            let emission = self.groups[g].emission;
+            let group = &mut self.solution.groups[g];
+            let scale = match &action {
+                Action::Scale(k) => Some(*k),
+                _ => None,
+            };
+            if let Some(direct) = retraced[g].take() {
+                group.direct_irradiance_rgb = direct;
+            } else if let Some(k) = scale {
+                for d in &mut group.direct_irradiance_rgb {
+                    for c in 0..3 {
+                        d[c] *= k[c];
+                    }
+                }
+            }
+            if action == Action::Keep && !material_changed {
+                continue;
+            }
+            if let (Some(k), true, false) = (scale, linear, material_changed) {
+                // The response is linear in the group's sources: scale it, exactly.
+                for (b, b0) in group.radiosity_rgb.iter_mut().zip(&mut self.b0s[g]) {
+                    for c in 0..3 {
+                        b[c] *= k[c];
+                        b0[c] *= k[c];
+                    }
+                }
+                group.convergence.clear();
+                continue;
+            }
+            let mesh = &self.solution.mesh;
+            let b0_new = initial_exitance(mesh, &group.direct_irradiance_rgb, emission);
+            if b0_new.iter().flatten().all(|&v| v == 0.0) {
+                // A dark group (sun down, sky off, light off): B = 0 exactly.
+                group.radiosity_rgb.clone_from(&b0_new);
+                group.convergence.clear();
+                self.b0s[g] = b0_new;
+                continue;
+            }
+            let carry = if linear {
+                scale.unwrap_or([1.0; 3])
+            } else {
+                [1.0; 3]
+            };
+            let start: Vec<Rgb> = (0..b0_new.len())
+                .map(|e| {
+                    let (b, b0_old) = (group.radiosity_rgb[e], self.b0s[g][e]);
+                    let rho_old = old_rho.as_ref().map_or(new_rho[e], |r| r[e]);
+                    std::array::from_fn(|c| {
+                        let gathered = b[c] - b0_old[c];
+                        let k = if rho_old[c] > 0.0 {
+                            new_rho[e][c] / rho_old[c]
+                        } else {
+                            0.0
+                        };
+                        b0_new[e][c] + k * carry[c] * gathered
+                    })
+                })
+                .collect();
+            let (radiosity, rows) = iterate(
+                mesh,
+                &self.rows,
+                &self.topology,
+                &new_rho,
+                &b0_new,
+                &start,
+                &group.name,
+                &self.params.solve.stop,
+                self.params.sweep,
+            );
+            group.radiosity_rgb = radiosity;
+            group.convergence = rows;
+            self.b0s[g] = b0_new;
+        }
+        self.groups = new_groups;
+        self.lighting = lighting;
+        self.solution.warnings = solution_warnings;
+        self.solution.locator = std::sync::OnceLock::new();
+        Ok(self.solution.clone())
+    }
+
+    fn element_reflectance(&self) -> Vec<Rgb> {
+        let mesh = &self.solution.mesh;
+        (0..mesh.elements.len())
+            .map(|e| mesh.surfaces[mesh.element_node(e).surface as usize].reflectance_rgb)
+            .collect()
+    }
+}
+
+/// Iterates B = B₀ + ρ·F·B on the stored links from `start` (per element) until the stop rule
+/// holds (its mean change measured from the start). Returns the leaves and the rows.
+#[allow(clippy::too_many_arguments)]
+fn iterate(
+    mesh: &Mesh,
+    rows: &LinkRows,
+    topology: &Topology,
+    rho: &[Rgb],
+    b0: &[Rgb],
+    start: &[Rgb],
+    group: &str,
+    stop: &StopRule,
+    sweep: Sweep,
+) -> (Vec<Rgb>, Vec<ConvergenceRow>) {
+    /// Receivers gathered per parallel task of a Jacobi sweep (fixed, so the split does not
+    /// depend on the thread count).
+    const JACOBI_CHUNK: usize = 4096;
+    let areas = &topology.areas;
+    let mut previous_mean = Some(mean_brightness(start, areas));
+    let mut b = vec![[0.0; 3]; mesh.nodes.len()];
+    for (e, &node) in mesh.elements.iter().enumerate() {
+        b[node as usize] = start[e];
+    }
+    pull_all(mesh, topology, &mut b);
+    let mut out_rows = Vec::new();
+    let mut acc = vec![[0.0; 3]; mesh.nodes.len()];
+    let leaves = |b: &[Rgb]| -> Vec<Rgb> { mesh.elements.iter().map(|&n| b[n as usize]).collect() };
+    for pass in 1..=stop.max_passes {
+        let update = match sweep {
+            Sweep::GaussSeidel => {
+                let mut update = 0.0;
+                for &(lo, hi) in &topology.patch_ranges {
+                    for (n, a) in acc.iter_mut().enumerate().take(hi).skip(lo) {
+                        *a = rows.gather(n, &b);
+                    }
+                    update += push_pull(mesh, topology, rho, b0, &mut acc, &mut b, lo, hi);
+                }
+                update
+            }
+            Sweep::Jacobi => {
+                acc.par_chunks_mut(JACOBI_CHUNK)
+                    .enumerate()
+                    .for_each(|(chunk, out)| {
+                        for (i, a) in out.iter_mut().enumerate() {
+                            *a = rows.gather(chunk * JACOBI_CHUNK + i, &b);
+                        }
+                    });
+                let mut update = 0.0;
+                for &(lo, hi) in &topology.patch_ranges {
+                    update += push_pull(mesh, topology, rho, b0, &mut acc, &mut b, lo, hi);
+                }
+                update
+            }
+        };
+        let now = leaves(&b);
+        let mean = mean_brightness(&now, areas);
+        let total: f64 = now.iter().zip(areas).map(|(v, a)| luminance(v) * a).sum();
+        let row = ConvergenceRow {
+            group: group.to_owned(),
+            pass,
+            residual: if total > 0.0 { update / total } else { 0.0 },
+            mean_change: relative_change(previous_mean, mean),
+            mean_brightness: mean,
+            interactions: rows.source.len() as u64,
+        };
+        previous_mean = Some(mean);
+        let done = stop.met(&row) || mean <= 0.0;
+        out_rows.push(row);
+        if done {
+            return (now, out_rows);
+        }
+    }
+    (leaves(&b), out_rows)
+}
+
+/// Push (gathered values down to the leaves, B = B₀ + ρ·G) and pull (area-weighted means up)
+/// over the subtree in nodes `lo..hi` (pre-order); `acc` holds each node's own gather on entry.
+/// Returns Σ A·|ΔB|_Y over its leaves.
+#[allow(clippy::too_many_arguments)]
+fn push_pull(
+    mesh: &Mesh,
+    topology: &Topology,
+    rho: &[Rgb],
+    b0: &[Rgb],
+    acc: &mut [Rgb],
+    b: &mut [Rgb],
+    lo: usize,
+    hi: usize,
+) -> f64 {
+    let mut update = 0.0;
+    for n in lo..hi {
+        if n > lo {
+            let down = acc[topology.parent[n] as usize];
+            for c in 0..3 {
+                acc[n][c] += down[c];
+            }
+        }
+        if let Some(e) = mesh.nodes[n].element {
+            let e = e as usize;
+            let v: Rgb = std::array::from_fn(|c| b0[e][c] + rho[e][c] * acc[n][c]);
+            let diff: Rgb = std::array::from_fn(|c| (v[c] - b[n][c]).abs());
+            update += luminance(&diff) * topology.areas[e];
+            b[n] = v;
+        }
+    }
+    for n in (lo..hi).rev() {
+        pull_node(mesh, topology, n, b);
+    }
+    update
+}
+
+/// An inner node takes the area-weighted mean of its children.
+fn pull_node(mesh: &Mesh, topology: &Topology, n: usize, b: &mut [Rgb]) {
+    if let Some(kids) = mesh.nodes[n].children {
+        let mut sum = [0.0; 3];
+        for k in kids {
+            let w = topology.weight[k as usize];
+            for c in 0..3 {
+                sum[c] += w * b[k as usize][c];
+            }
+        }
+        b[n] = sum;
+    }
+}
+
+/// Inner nodes take the area-weighted mean of their children (leaves already set).
+fn pull_all(mesh: &Mesh, topology: &Topology, b: &mut [Rgb]) {
+    for n in (0..mesh.nodes.len()).rev() {
+        pull_node(mesh, topology, n, b);
+    }
+}
