@@ -37,6 +37,7 @@ pub fn photo_site(dir: &Path, name: &str) -> PathBuf {
             id: "BIG".into(),
             file: "photos/big.png".into(),
             taken_at: None,
+            profile: None,
             interior: Some(Interior {
                 focal_px: 5000.0,
                 principal_point_px: None,

@@ -315,7 +315,7 @@ mod tests {
         assert_eq!(
             calibrate(
                 &board,
-                &[one.clone()],
+                std::slice::from_ref(&one),
                 [640, 480],
                 &CalibrationOptions::default()
             )
