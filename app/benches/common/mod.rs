@@ -46,7 +46,6 @@ pub fn photo_site(dir: &Path, name: &str) -> PathBuf {
             }),
             self_calibration: Default::default(),
             exterior: None,
-            profile: None,
         }],
         ..Site::default()
     };
