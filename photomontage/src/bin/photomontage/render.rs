@@ -64,7 +64,7 @@ pub struct Args {
 }
 
 /// The view geometry as EXIF for 8-bit outputs; a warning (and no EXIF) when it cannot be had.
-fn exif_of(doc: &SiteDocument, view: &str) -> Option<Vec<u8>> {
+pub fn exif_of(doc: &SiteDocument, view: &str) -> Option<Vec<u8>> {
     match view_exif(doc, view) {
         Ok(exif) => Some(exif),
         Err(e) => {
