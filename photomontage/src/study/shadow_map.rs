@@ -284,3 +284,7 @@ pub fn shadow_map_image(map: &ShadowMap, title: &str) -> RgbImage {
     text(&mut img, to_i64(margin), to_i64(y), &note, [0, 0, 0]);
     img
 }
+
+#[cfg(test)]
+#[path = "shadow_map_tests.rs"]
+mod tests;
