@@ -248,3 +248,36 @@ fn ctrl_c_leaves_no_output_folder() {
     assert!(rest.iter().any(|l| l.contains("cancelled")), "{rest:?}");
     assert!(!out.exists(), "a cancelled study wrote {}", out.display());
 }
+
+#[test]
+fn shadow_maps_are_written_beside_the_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = zurich_site(dir.path(), Some("Europe/Zurich"), common::SIZE_PX);
+    let out = dir.path().join("study");
+    let o = study(
+        &site,
+        &out,
+        "2026-06-21",
+        "15:00",
+        &["--json", "--shadow-maps", "--cell-m", "0.5"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let name = json["frames"][0]["shadow_map"].as_str().unwrap();
+    assert_eq!(name, "p1_2026-06-21_1500_shadow.png");
+    let map = image::open(out.join(name)).unwrap().to_rgb8();
+    // The 20 m ground at 0.5 m cells is 40 cells, drawn at least 480 px wide plus margins.
+    assert!(map.width() >= 480, "{}", map.width());
+    // The box's shadow: some pixels have the added-shadow colour.
+    assert!(map.pixels().any(|p| p.0 == [214, 40, 40]));
+
+    let bad = study(
+        &site,
+        &dir.path().join("bad"),
+        "2026-06-21",
+        "15:00",
+        &["--shadow-maps", "--cell-m", "0"],
+    );
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("--cell-m"), "{}", stderr(&bad));
+}
