@@ -405,6 +405,7 @@ mod tests {
             elevation_m: 0.0,
             crs: Some("EPSG:32633".into()),
             grid_convergence_deg: 0.0,
+            time_zone: None,
         });
         let Command::Batch(b) = import_file(&site, &gcp, None).expect("import") else {
             panic!("a batch");

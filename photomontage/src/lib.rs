@@ -29,5 +29,7 @@ pub mod scene;
 pub mod site;
 pub mod sky;
 pub mod sky_dome;
+pub mod study;
 pub mod sun;
+pub mod time_zone;
 pub mod verified;

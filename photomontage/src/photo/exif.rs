@@ -67,6 +67,30 @@ impl ExifInfo {
         self.capture_time().map(|c| c.time.to_rfc3339())
     }
 
+    /// The original capture time: with its own offset (`OffsetTimeOriginal`) when EXIF has one,
+    /// else read as local time in `zone` (daylight saving time applied); `None` without a
+    /// `DateTimeOriginal` that parses, or without an offset and a zone.
+    ///
+    /// # Errors
+    /// [`crate::time_zone::TimeZoneError`] when the local time is ambiguous or skipped in `zone`.
+    pub fn taken_at_in_zone(
+        &self,
+        zone: Option<&crate::time_zone::SiteTimeZone>,
+    ) -> Result<Option<chrono::DateTime<chrono::FixedOffset>>, crate::time_zone::TimeZoneError>
+    {
+        if let Some(text) = self.taken_at_rfc3339() {
+            return Ok(chrono::DateTime::parse_from_rfc3339(&text).ok());
+        }
+        let (Some(dt), Some(zone)) = (self.date_time_original.as_ref(), zone) else {
+            return Ok(None);
+        };
+        let Ok(naive) = chrono::NaiveDateTime::parse_from_str(dt.trim(), "%Y:%m:%d %H:%M:%S")
+        else {
+            return Ok(None);
+        };
+        zone.resolve(naive).map(Some)
+    }
+
     /// `make model` for display.
     #[must_use]
     pub fn camera_name(&self) -> Option<String> {
@@ -407,6 +431,26 @@ mod tests {
             exif.taken_at_rfc3339().as_deref(),
             Some("2008-05-30T15:56:01+02:00")
         );
+    }
+
+    #[test]
+    fn offset_less_time_is_read_in_the_site_zone() {
+        let zurich = crate::time_zone::SiteTimeZone::parse("Europe/Zurich").unwrap();
+        let mut exif = ExifInfo {
+            date_time_original: Some("2024:06:21 15:00:00".into()),
+            ..ExifInfo::default()
+        };
+        assert_eq!(exif.taken_at_in_zone(None).unwrap(), None);
+        let t = exif.taken_at_in_zone(Some(&zurich)).unwrap().unwrap();
+        assert_eq!(t.to_utc().to_rfc3339(), "2024-06-21T13:00:00+00:00");
+        // EXIF's own offset wins over the zone.
+        exif.offset_time_original = Some("+05:00".into());
+        let t = exif.taken_at_in_zone(Some(&zurich)).unwrap().unwrap();
+        assert_eq!(t.to_utc().to_rfc3339(), "2024-06-21T10:00:00+00:00");
+        // The skipped spring-forward hour is an error, not a guess.
+        exif.offset_time_original = None;
+        exif.date_time_original = Some("2024:03:31 02:30:00".into());
+        assert!(exif.taken_at_in_zone(Some(&zurich)).is_err());
     }
 
     #[test]

@@ -164,6 +164,9 @@ fn glyph(c: char) -> [&'static str; 7] {
         '<' => [
             "   # ", "  #  ", " #   ", "#    ", " #   ", "  #  ", "   # ",
         ],
+        ':' => [
+            "     ", "  #  ", "  #  ", "     ", "  #  ", "  #  ", "     ",
+        ],
         _ => ["     "; 7],
     }
 }
@@ -177,7 +180,9 @@ fn put(img: &mut RgbImage, x: i64, y: i64, colour: [u8; 3]) {
     }
 }
 
-fn text(img: &mut RgbImage, x: i64, y: i64, s: &str, colour: [u8; 3]) {
+/// Draws `s` in the 5 × 7 font (6 px advance) with its top-left corner at (`x`, `y`); characters
+/// without a glyph are blank. Also used by the sun-study contact sheet.
+pub(crate) fn text(img: &mut RgbImage, x: i64, y: i64, s: &str, colour: [u8; 3]) {
     for (k, c) in s.chars().enumerate() {
         let rows = glyph(c.to_ascii_lowercase());
         for (dy, row) in rows.iter().enumerate() {

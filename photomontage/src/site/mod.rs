@@ -25,6 +25,7 @@ pub mod render_error;
 pub mod render_photo;
 mod schema;
 pub mod site_scene;
+pub mod site_time;
 pub mod solve;
 pub mod toml_merge;
 mod validate;

@@ -14,7 +14,8 @@
 //!
 //! # Known limitations
 //! EXIF GPS positions are not turned into the site's `[location]` (the survey frame is unknown
-//! here); a capture time without a UTC offset is not used (the sun position needs one). The
+//! here); a capture time without a UTC offset is left out of `taken_at` (renders read it in the
+//! site's `location.time_zone` when one is set, see [`super::site_time`]). The
 //! site file's folder must exist. Photo ids are file stems made unique with `_2`, `_3`, … in the
 //! order given.
 
@@ -90,7 +91,8 @@ impl fmt::Display for NewSiteWarning {
             Self::TimeWithoutOffset { photo, date_time } => write!(
                 f,
                 "photo `{photo}`: EXIF time {date_time} has no UTC offset, so taken_at is not \
-                 set (set lighting.time or the photo's taken_at for the sun position)"
+                 set (set location.time_zone to read it as local time there, or lighting.time or \
+                 the photo's taken_at for the sun position)"
             ),
         }
     }

@@ -11,7 +11,8 @@
 //! - `ambient_weight` k_u: ambient radiance (eq. 4), irradiance π·k_u on any surface.
 //!
 //! The sun direction is `lighting.sun_manual` if given, else the NREL SPA ([`crate::sun`]) at
-//! `lighting.time`, else the photo's `taken_at`, else its EXIF capture time, at `[location]`.
+//! `lighting.time`, else the photo's `taken_at`, else its EXIF capture time, at `[location]`
+//! (local times without an offset are read in `location.time_zone`, see [`super::site_time`]).
 //! Azimuths (manual or SPA) are from true north; they are turned into the survey frame (+Y = grid
 //! north, Z up) with `location.grid_convergence_deg`. A sun at or below the horizon gives no
 //! sunlight.
@@ -33,7 +34,6 @@ use crate::colour::Colour;
 use crate::render::{Daylight, DistantLight, Lighting, RenderSettings};
 use crate::sky::SkyModel;
 use crate::sky_dome::durisch_facets::durisch_dome;
-use crate::sun::{SpaParams, solar_position};
 
 pub use super::render_error::{SiteRenderError, SiteWarning};
 pub use super::site_scene::{
@@ -156,35 +156,8 @@ pub fn site_sun_dir(doc: &SiteDocument, photo_id: &str) -> Result<Vector3<f64>, 
             convergence,
         ));
     }
-    let no_sun = |reason: &str| SiteRenderError::NoSunDirection {
-        photo: photo_id.to_owned(),
-        reason: reason.to_owned(),
-    };
-    let photo = site.photos.iter().find(|p| p.id == photo_id);
-    let time = site
-        .lighting
-        .time
-        .clone()
-        .or_else(|| photo.and_then(|p| p.taken_at.clone()))
-        .or_else(|| {
-            photo.and_then(|p| {
-                crate::photo::read_exif(&doc.resolve(&p.file))
-                    .ok()?
-                    .taken_at_rfc3339()
-            })
-        })
-        .ok_or_else(|| no_sun("no time (lighting.time, photos.taken_at or EXIF with offset)"))?;
-    let time = chrono::DateTime::parse_from_rfc3339(&time)
-        .map_err(|e| no_sun(&format!("time `{time}` is not RFC 3339: {e}")))?;
-    let loc = site
-        .location
-        .as_ref()
-        .ok_or_else(|| no_sun("the site has no [location]"))?;
-    let params = SpaParams {
-        elevation_m: loc.elevation_m,
-        ..SpaParams::at(loc.latitude_deg, loc.longitude_deg)
-    };
-    let pos = solar_position(&time, &params)?;
+    let time = super::site_time::site_sun_time(doc, photo_id)?;
+    let pos = super::site_time::site_solar_position(site, &time, photo_id)?;
     Ok(survey_dir_from_true_azimuth(
         pos.azimuth_deg,
         pos.elevation_deg,

@@ -45,6 +45,8 @@ pub enum SiteRenderError {
          (or photos.taken_at) and [location]"
     )]
     NoSunDirection { photo: String, reason: String },
+    #[error("location.time_zone: {0}")]
+    TimeZone(crate::time_zone::TimeZoneError),
     #[error("sun position: {0}")]
     Sun(#[from] SunError),
     #[error("sky: {reason}")]

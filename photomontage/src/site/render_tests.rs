@@ -6,6 +6,7 @@ use crate::site::{
     Atmosphere, ControlPoint, Exterior, Interior, Location, Photo, Polygon, Site, SunManual,
 };
 use crate::site::{ModelUnits, ModelUpAxis};
+use crate::sun::{SpaParams, solar_position};
 use std::path::Path;
 
 /// Σ L_i Δω_i cos Z_i is normalised to k_h by construction; only rounding remains.
@@ -206,6 +207,7 @@ fn spa_sun_matches_crate_sun_and_nrel_test_case_with_grid_convergence() {
         elevation_m: 1830.14,
         crs: None,
         grid_convergence_deg: 0.0,
+        time_zone: None,
     });
     let d = site_sun_dir(&doc, "p1").unwrap();
     let time = chrono::DateTime::parse_from_rfc3339("2003-10-17T12:30:30-07:00").unwrap();

@@ -129,6 +129,10 @@ pub struct Location {
     /// convergence); 0 when the survey Y axis points to true north.
     #[serde(default)]
     pub grid_convergence_deg: f64,
+    /// IANA time zone of the site (e.g. `Europe/Zurich`): local times without a UTC offset (EXIF
+    /// capture times, sun-study times) are read in it, daylight saving time included.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_zone: Option<String>,
 }
 
 /// How cameras are solved.

@@ -338,6 +338,11 @@ impl Site {
                     format!("{} is outside −180…180", loc.longitude_deg),
                 ));
             }
+            if let Some(zone) = &loc.time_zone
+                && let Err(e) = crate::time_zone::SiteTimeZone::parse(zone)
+            {
+                issues.push(issue("location.time_zone".into(), e.to_string()));
+            }
         }
         issues
     }

@@ -16,6 +16,7 @@ mod sheet;
 mod sky;
 mod solve;
 mod standard_view;
+mod study;
 mod sun;
 mod view_report;
 
@@ -50,6 +51,9 @@ enum Command {
     /// Render the site's planned models into one solved photo (differential ray tracing) and
     /// write EXR (linear, alpha, optional layers) or 8-bit sRGB PNG/JPEG/TIFF.
     Render(render::Args),
+    /// Sun and shadow study: render a view at every date × local time (SPA sun at [location],
+    /// times in location.time_zone) into a folder, with a contact sheet.
+    Study(study::Args),
     /// Solve one photo from a control-point file (CSV or OpenDroneMap gcp_list.txt).
     Resect(resect::Args),
     /// Solar position (NREL SPA), sunrise and sunset.
@@ -116,6 +120,7 @@ fn main() -> anyhow::Result<()> {
         Command::Info(args) => info::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Study(args) => study::run(&args),
         Command::Resect(args) => resect::run(&args),
         Command::Sun(args) => sun::run(&args),
         Command::Sky(args) => sky::run(&args),

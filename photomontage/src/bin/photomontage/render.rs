@@ -65,7 +65,7 @@ pub struct Args {
 
 /// The view geometry the output carries (EXIF and XMP, EXR attributes); a warning (and none)
 /// when it cannot be had.
-fn view_of(doc: &SiteDocument, view: &str) -> Option<ViewMetadata> {
+pub fn view_of(doc: &SiteDocument, view: &str) -> Option<ViewMetadata> {
     match view_metadata(doc, view) {
         Ok(m) => Some(m),
         Err(e) => {

@@ -117,6 +117,7 @@ pub(crate) fn base_site() -> Site {
             elevation_m: 400.0,
             crs: None,
             grid_convergence_deg: 0.0,
+            time_zone: None,
         }),
         ..Site::default()
     };
