@@ -396,6 +396,7 @@ mod tests {
             elevation_m: 0.0,
             crs: None,
             grid_convergence_deg: 0.0,
+            time_zone: None,
         });
         let e = import_file(&site, &gcp, None).expect_err("no crs");
         assert!(e.to_string().contains("location.crs"), "{e}");

@@ -98,6 +98,7 @@ pub fn location_from_points(
         elevation_m: height_m,
         crs: Some(crs_name.to_owned()),
         grid_convergence_deg,
+        time_zone: None,
     })
 }
 
