@@ -159,6 +159,8 @@ fn planar_and_cylindrical_views_and_the_sheet_paper_from_the_studio() {
     assert_eq!(montage.geometry.as_ref(), Some(&library.geometry));
 
     // P1 and P2 stand metres apart: refused, naming the rule, and the panorama stays.
+    h.get_by_label("panorama photos").click();
+    h.run();
     h.get_by_label("panorama photos").type_text(",P2");
     h.run();
     run_until_made(&mut h, "refused panorama");
