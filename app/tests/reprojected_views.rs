@@ -159,8 +159,20 @@ fn planar_and_cylindrical_views_and_the_sheet_paper_from_the_studio() {
     assert_eq!(montage.geometry.as_ref(), Some(&library.geometry));
 
     // P1 and P2 stand metres apart: refused, naming the rule, and the panorama stays.
-    h.get_by_label("panorama photos").type_text(",P2");
+    h.state_mut()
+        .render_panel_mut()
+        .view_choice
+        .panorama_photos
+        .clear();
     h.run();
+    h.get_by_label("panorama photos").click();
+    h.run();
+    h.get_by_label("panorama photos").type_text("P1,P2");
+    h.run();
+    assert_eq!(
+        h.state().render_panel().view_choice.panorama_photos,
+        "P1,P2"
+    );
     run_until_made(&mut h, "refused panorama");
     let last = h.state().messages().last().unwrap();
     assert!(last.is_error, "{}", last.text);

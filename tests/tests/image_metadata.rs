@@ -122,11 +122,7 @@ fn xmp_properties(packet: &str) -> BTreeMap<String, String> {
                 out.insert(format!("{prop}[{i}]"), t.decode().unwrap().into_owned());
                 *i += 1;
             }
-            Event::End(e) => {
-                if e.name().as_ref() == b"rdf:li" {
-                    in_li = false;
-                }
-            }
+            Event::End(e) if e.name().as_ref() == b"rdf:li" => in_li = false,
             Event::Eof => break,
             _ => {}
         }

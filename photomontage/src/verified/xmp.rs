@@ -14,7 +14,7 @@
 //!
 //! # Known limitations
 //! A JPEG APP1 segment holds at most 65 502 bytes of packet (no extended XMP); the packet here
-//! is about 4 kB. No padding is reserved for in-place editing.
+//! holds about 40 properties (a few kilobytes). No padding is reserved for in-place editing.
 
 use std::fmt::Write as _;
 
