@@ -43,6 +43,8 @@ pub mod sources;
 #[cfg(test)]
 mod form_factor_tests;
 #[cfg(test)]
+mod peer_tests;
+#[cfg(test)]
 mod radiance_tests;
 #[cfg(test)]
 mod solver_tests;
