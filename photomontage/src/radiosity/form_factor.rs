@@ -334,7 +334,13 @@ impl<'a> FormFactorEngine<'a> {
             }
             sum += f;
         }
-        sum * inv_n * inv_n
+        // q's radiosity is its mean over its whole area, but only its open part emits (the
+        // part under a solid standing on it is dark and hidden): the open part's exitance is
+        // B_q / open_q, and the factor carries that (super::covered).
+        if nq.open_fraction <= 0.0 {
+            return 0.0;
+        }
+        sum * inv_n * inv_n / nq.open_fraction
     }
 
     /// F from `p` to each of `targets`, computed in parallel (order of `targets`).

@@ -32,6 +32,7 @@
 
 pub mod convergence;
 pub mod convergence_plot;
+pub mod covered;
 pub mod direct;
 pub mod form_factor;
 pub mod hierarchical;
