@@ -45,7 +45,11 @@ fn every_caller_builds_the_same_natural_scene() {
             render.scene.triangles().len() - natural.len()
         );
         // The renderer's scene starts with exactly the natural scene …
-        assert_eq!(&render.scene.triangles()[..natural.len()], natural, "{label}");
+        assert_eq!(
+            &render.scene.triangles()[..natural.len()],
+            natural,
+            "{label}"
+        );
         let n_objects = fits.scene.objects().len();
         assert_eq!(
             &render.scene.objects()[..n_objects],
@@ -68,7 +72,10 @@ fn every_caller_builds_the_same_natural_scene() {
         }
         // Same polygon for every triangle: the fits' index, the picker's, and the renderer's
         // object sources.
-        assert_eq!(picker.polygon_of_triangle(), fits.polygon_of_triangle.as_slice());
+        assert_eq!(
+            picker.polygon_of_triangle(),
+            fits.polygon_of_triangle.as_slice()
+        );
         for (t, &poly) in natural.iter().zip(&fits.polygon_of_triangle) {
             let id = &doc.site.polygons[poly].id;
             assert_eq!(

@@ -73,8 +73,7 @@ impl PolygonPicker {
     /// # Errors
     /// [`PickError::Scene`] when a polygon is degenerate or the scene is empty.
     pub fn new(site: &Site, library: Option<&MaterialLibrary>) -> Result<Self, PickError> {
-        let natural =
-            natural_scene(site, library).map_err(|e| PickError::Scene(e.to_string()))?;
+        let natural = natural_scene(site, library).map_err(|e| PickError::Scene(e.to_string()))?;
         let warnings = natural.skipped_warnings();
         let polygon_of_triangle = natural.polygon_of_triangle;
         let tracer = SceneTracer::new(&natural.scene, BuildQuality::default())

@@ -320,12 +320,9 @@ impl<'a> FormFactorEngine<'a> {
                 // tangent plane): a point of q behind that plane is hidden by p's own surface
                 // and would count the clipped part twice (a bias at junctions, where a
                 // receiver's element straddles the footprint of a wall standing on it).
-                let Some(y) = point_above_plane(
-                    &x,
-                    &np.normal_in_world,
-                    &nq.vertices_in_world_m,
-                    (u_q, v_q),
-                ) else {
+                let Some(y) =
+                    point_above_plane(&x, &np.normal_in_world, &nq.vertices_in_world_m, (u_q, v_q))
+                else {
                     continue;
                 };
                 if !self.visible(&x, &y) {

@@ -11,8 +11,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
-use crate::fit::site::tests::{HORIZON, K_H, K_S, K_U, RHO, SIZE_PX, base_site};
 use crate::fit::natural_scene::natural_scene;
+use crate::fit::site::tests::{HORIZON, K_H, K_S, K_U, RHO, SIZE_PX, base_site};
 use crate::fit::site::{SiteFitOptions, fit_site};
 use crate::scene::SceneTracer;
 use crate::site::render::site_material_library;
