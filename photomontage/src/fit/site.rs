@@ -36,7 +36,7 @@ pub use super::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport
 use super::sun_check::DEFAULT_TOLERANCE_DEG;
 use crate::atmosphere::AtmosphereError;
 use crate::photo::PhotoImage;
-use crate::scene::{Scene, SceneTracer};
+use crate::scene::SceneTracer;
 use crate::site::render::site_material_library;
 use crate::site::{SamplePurpose, Site, SiteDocument};
 use crate::sun::SpaParams;

@@ -7,7 +7,7 @@ use super::*;
 use crate::fit::daylight::{irradiance_components, normalised_sky_facets};
 use crate::fit::natural_scene::natural_scene;
 use crate::scene::Material;
-use crate::scene::{ObjectKind, SceneObject};
+use crate::scene::{ObjectKind, Scene, SceneObject};
 use crate::site::render::site_sun_dir;
 use crate::site::stored_camera;
 use crate::site::{
