@@ -31,6 +31,7 @@ pub mod atmosphere;
 pub mod colour;
 pub mod daylight;
 pub mod interreflection;
+pub mod natural_scene;
 pub mod pick;
 pub mod report;
 pub mod site;

@@ -1,6 +1,6 @@
 //! Which scene polygon a pixel of a photo shows: the ray through the pixel of the photo's solved
-//! camera, cast into the site's natural scene (its polygons, as [`super::site::natural_scene`]
-//! builds it for the fits), gives the polygon, its material and the world point hit. This is
+//! camera, cast into the site's natural scene (its polygons, as [`super::natural_scene::natural_scene`]
+//! builds it for every caller), gives the polygon, its material and the world point hit. This is
 //! how a colour sample picked on the photo gets its material (Durisch 1992 §4.2–4.3: a sample is
 //! a point on a scene polygon whose material attribute names its reflectance), and it is the
 //! same ray the fit casts for a pixel sample, so a sample picked here is located on the same
@@ -11,12 +11,11 @@
 //! vertices have no coordinates yet are skipped. The picker is rebuilt when the site changes
 //! (the caller decides when); no subpixel snapping to polygon edges.
 
-use std::collections::HashMap;
+use nalgebra::Point2;
 
-use nalgebra::{Point2, Point3};
-
+use super::natural_scene::natural_scene;
 use crate::bvh::BuildQuality;
-use crate::scene::{Material, MaterialLibrary, ObjectKind, Scene, SceneObject, SceneTracer};
+use crate::scene::{MaterialLibrary, SceneTracer};
 use crate::site::{Site, stored_camera};
 
 /// What can go wrong picking a polygon on a photo.
@@ -58,57 +57,6 @@ pub struct PolygonHit {
     pub distance_m: f64,
 }
 
-/// The natural scene of a site with, for each triangle, the index of its site polygon, and the
-/// warnings of polygons skipped (a vertex without coordinates).
-///
-/// # Errors
-/// A message when a polygon cannot be added (degenerate).
-pub fn natural_scene_indexed(
-    site: &Site,
-    library: Option<&MaterialLibrary>,
-) -> Result<(Scene, Vec<usize>, Vec<String>), String> {
-    let mut coords: HashMap<&str, [f64; 3]> = HashMap::new();
-    for t in &site.tie_points {
-        coords.insert(t.id.as_str(), t.xyz);
-    }
-    for c in &site.control_points {
-        coords.insert(c.id.as_str(), c.xyz);
-    }
-    let mut scene = Scene::new();
-    let mut warnings = Vec::new();
-    let mut polygon_of_triangle = Vec::new();
-    let object = scene
-        .add_object(SceneObject {
-            name: "natural polygons".into(),
-            kind: ObjectKind::Natural,
-            image_attribute: None,
-        })
-        .map_err(|e| e.to_string())?;
-    for (index, poly) in site.polygons.iter().enumerate() {
-        let Some(vertices) = poly
-            .vertices
-            .iter()
-            .map(|v| coords.get(v.as_str()).map(|p| Point3::from(*p)))
-            .collect::<Option<Vec<_>>>()
-        else {
-            warnings.push(format!(
-                "polygon `{}` skipped: a vertex has no coordinates yet (run `solve`)",
-                poly.id
-            ));
-            continue;
-        };
-        let material = library
-            .and_then(|l| l.get(&poly.material).cloned())
-            .unwrap_or_else(|| Material::diffuse(&poly.material, [0.5; 3]));
-        let id = scene.add_material(material).map_err(|e| e.to_string())?;
-        let added = scene
-            .add_polygon(&vertices, id, object)
-            .map_err(|e| format!("polygon `{}`: {e}", poly.id))?;
-        polygon_of_triangle.extend(std::iter::repeat_n(index, added));
-    }
-    Ok((scene, polygon_of_triangle, warnings))
-}
-
 /// The natural scene of a site ready for picking.
 #[derive(Debug)]
 pub struct PolygonPicker {
@@ -125,9 +73,10 @@ impl PolygonPicker {
     /// # Errors
     /// [`PickError::Scene`] when a polygon is degenerate or the scene is empty.
     pub fn new(site: &Site, library: Option<&MaterialLibrary>) -> Result<Self, PickError> {
-        let (scene, polygon_of_triangle, warnings) =
-            natural_scene_indexed(site, library).map_err(PickError::Scene)?;
-        let tracer = SceneTracer::new(&scene, BuildQuality::default())
+        let natural = natural_scene(site, library).map_err(|e| PickError::Scene(e.to_string()))?;
+        let warnings = natural.skipped_warnings();
+        let polygon_of_triangle = natural.polygon_of_triangle;
+        let tracer = SceneTracer::new(&natural.scene, BuildQuality::default())
             .map_err(|e| PickError::Scene(e.to_string()))?;
         Ok(Self {
             tracer,
@@ -139,6 +88,13 @@ impl PolygonPicker {
                 .collect(),
             warnings,
         })
+    }
+
+    /// For every triangle of the picker's scene, the index of its polygon in `site.polygons`
+    /// (the natural scene of [`natural_scene`], the same for every caller).
+    #[must_use]
+    pub fn polygon_of_triangle(&self) -> &[usize] {
+        &self.polygon_of_triangle
     }
 
     /// The polygon shown at `pixel_px` of photo `photo` of `site` (the site the picker was
@@ -185,6 +141,7 @@ impl PolygonPicker {
 mod tests {
     use super::*;
     use crate::fit::site::tests::base_site;
+    use nalgebra::Point3;
 
     /// The hit point is computed in f32 relative to a local origin (metres from it ≲ 100 here,
     /// f32 steps ≈ 1e-5 m) along a ray of ≈ 30 m: 1 mm is far above that and far below any
@@ -240,7 +197,9 @@ mod tests {
     fn polygons_without_coordinates_are_skipped_with_a_warning() {
         let mut site = base_site();
         site.polygons[0].vertices[0] = "nowhere".into();
-        let (_, index, warnings) = natural_scene_indexed(&site, None).expect("scene");
+        let natural = natural_scene(&site, None).expect("scene");
+        let warnings = natural.skipped_warnings();
+        let index = natural.polygon_of_triangle;
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains(&site.polygons[0].id));
         assert!(index.iter().all(|i| *i != 0), "polygon 0 has no triangles");

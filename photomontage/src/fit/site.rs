@@ -36,7 +36,7 @@ pub use super::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport
 use super::sun_check::DEFAULT_TOLERANCE_DEG;
 use crate::atmosphere::AtmosphereError;
 use crate::photo::PhotoImage;
-use crate::scene::{MaterialLibrary, Scene, SceneTracer};
+use crate::scene::SceneTracer;
 use crate::site::render::site_material_library;
 use crate::site::{SamplePurpose, Site, SiteDocument};
 use crate::sun::SpaParams;
@@ -157,18 +157,6 @@ fn check_cancel(observer: Option<&Arc<dyn FitObserver>>) -> Result<(), SiteFitEr
     Ok(())
 }
 
-/// The natural scene of a site: its polygons with their materials (library definitions where
-/// the library has them). Polygons whose vertices are not yet located are skipped with a warning.
-///
-/// # Errors
-/// A message when a polygon cannot be added (degenerate).
-pub fn natural_scene(
-    site: &Site,
-    library: Option<&MaterialLibrary>,
-) -> Result<(Scene, Vec<String>), String> {
-    super::pick::natural_scene_indexed(site, library).map(|(scene, _, warnings)| (scene, warnings))
-}
-
 /// The capture time of a photo: `taken_at`, else its EXIF time with offset.
 #[must_use]
 pub fn photo_time(doc: &SiteDocument, photo_id: &str) -> Option<DateTime<FixedOffset>> {
@@ -249,8 +237,10 @@ pub fn fit_site(
     };
     let mut located = Vec::new();
     if !enabled.is_empty() {
-        let (scene, w) = natural_scene(site, library.as_ref()).map_err(SiteFitError::Scene)?;
-        warnings.extend(w);
+        let natural = super::natural_scene::natural_scene(site, library.as_ref())
+            .map_err(|e| SiteFitError::Scene(e.to_string()))?;
+        warnings.extend(natural.skipped_warnings());
+        let scene = natural.scene;
         let tracer = SceneTracer::new(&scene, crate::bvh::BuildQuality::default())
             .map_err(|e| SiteFitError::Scene(e.to_string()))?;
         for s in &enabled {

@@ -83,21 +83,14 @@ impl FormFactorParams {
     }
 }
 
-/// The unoccluded form factor from a differential area at `x` with unit normal `n` to the
-/// triangle `tri` whose front has unit normal `tri_normal` (0 when `x` is behind it): Lambert's
-/// contour integral over the part of the triangle above the tangent plane at `x`.
-#[must_use]
-pub fn point_to_triangle(
+/// The part of triangle `tri` in the half-space n·(y − x) ≥ 0 above the tangent plane at `x`
+/// (Sutherland–Hodgman; a triangle or a quadrilateral), as vectors from `x`; `count` < 3 when
+/// nothing is left.
+fn clip_above_plane(
     x: &Point3<f64>,
     n: &Vector3<f64>,
     tri: &[Point3<f64>; 3],
-    tri_normal: &Vector3<f64>,
-) -> f64 {
-    // Light leaves the triangle through its front only.
-    if tri_normal.dot(&(x - tri[0])) <= 0.0 {
-        return 0.0;
-    }
-    // Clip to the half-space n·(y − x) ≥ 0 (Sutherland–Hodgman; at most 4 vertices).
+) -> ([Vector3<f64>; 4], usize) {
     let mut poly = [Vector3::zeros(); 4];
     let mut count = 0;
     for k in 0..3 {
@@ -114,6 +107,24 @@ pub fn point_to_triangle(
             count += 1;
         }
     }
+    (poly, count)
+}
+
+/// The unoccluded form factor from a differential area at `x` with unit normal `n` to the
+/// triangle `tri` whose front has unit normal `tri_normal` (0 when `x` is behind it): Lambert's
+/// contour integral over the part of the triangle above the tangent plane at `x`.
+#[must_use]
+pub fn point_to_triangle(
+    x: &Point3<f64>,
+    n: &Vector3<f64>,
+    tri: &[Point3<f64>; 3],
+    tri_normal: &Vector3<f64>,
+) -> f64 {
+    // Light leaves the triangle through its front only.
+    if tri_normal.dot(&(x - tri[0])) <= 0.0 {
+        return 0.0;
+    }
+    let (poly, count) = clip_above_plane(x, n, tri);
     if count < 3 {
         return 0.0;
     }
@@ -134,6 +145,37 @@ pub fn point_to_triangle(
         sum += angle * n.dot(&cross) / cn;
     }
     (sum / std::f64::consts::TAU).abs()
+}
+
+/// A point of the part of `tri` above the tangent plane at `x` (the part
+/// [`point_to_triangle`] integrates over), from the unit-square sample `(u, v)`: uniform in
+/// area over that part, so that a shadow ray to it never tests a part of the triangle the
+/// factor has already left out. `None` when nothing of `tri` is above the plane.
+fn point_above_plane(
+    x: &Point3<f64>,
+    n: &Vector3<f64>,
+    tri: &[Point3<f64>; 3],
+    (u, v): (f64, f64),
+) -> Option<Point3<f64>> {
+    let (poly, count) = clip_above_plane(x, n, tri);
+    if count < 3 {
+        return None;
+    }
+    // Fan (0, k, k + 1): one or two triangles; choose one by area with u, reuse u inside it.
+    let area = |k: usize| (poly[k] - poly[0]).cross(&(poly[k + 1] - poly[0])).norm();
+    let first = area(1);
+    let total = first + if count == 4 { area(2) } else { 0.0 };
+    let (k, u) = if count == 4 && total > 0.0 && u * total >= first {
+        (2, ((u * total - first) / (total - first)).clamp(0.0, 1.0))
+    } else if total > 0.0 && count == 4 {
+        (1, (u * total / first).clamp(0.0, 1.0))
+    } else {
+        (1, u)
+    };
+    // Uniform in the triangle (a, b, c) from the square (Shirley's square-root map).
+    let su = u.sqrt();
+    let (a, b, c) = (poly[0], poly[k], poly[k + 1]);
+    Some(x + a * (1.0 - su) + b * (su * (1.0 - v)) + c * (su * v))
 }
 
 /// Form factors between mesh nodes, with visibility on the scene's BVH.
@@ -273,12 +315,29 @@ impl<'a> FormFactorEngine<'a> {
             if f <= 0.0 {
                 continue;
             }
-            if self.params.visibility && !self.visible(&x, &nq.point_at(u_q, v_q)) {
-                continue;
+            if self.params.visibility {
+                // The shadow ray goes to the part of q that the factor counts (above x's
+                // tangent plane): a point of q behind that plane is hidden by p's own surface
+                // and would count the clipped part twice (a bias at junctions, where a
+                // receiver's element straddles the footprint of a wall standing on it).
+                let Some(y) =
+                    point_above_plane(&x, &np.normal_in_world, &nq.vertices_in_world_m, (u_q, v_q))
+                else {
+                    continue;
+                };
+                if !self.visible(&x, &y) {
+                    continue;
+                }
             }
             sum += f;
         }
-        sum * inv_n * inv_n
+        // q's radiosity is its mean over its whole area, but only its open part emits (the
+        // part under a solid standing on it is dark and hidden): the open part's exitance is
+        // B_q / open_q, and the factor carries that (super::covered).
+        if nq.open_fraction <= 0.0 {
+            return 0.0;
+        }
+        sum * inv_n * inv_n / nq.open_fraction
     }
 
     /// F from `p` to each of `targets`, computed in parallel (order of `targets`).

@@ -119,6 +119,9 @@ pub struct MeshNode {
     pub children: Option<[u32; 4]>,
     /// For an element: its index in [`Mesh::elements`].
     pub element: Option<u32>,
+    /// Fraction of the node's area outside closed solids (not under a wall or block standing
+    /// on it), [`super::covered`]; 1 until [`super::covered::mark_covered`] runs.
+    pub open_fraction: f64,
 }
 
 impl MeshNode {
@@ -315,6 +318,7 @@ impl Mesh {
             surface,
             children: None,
             element: None,
+            open_fraction: 1.0,
         });
         if level == patch_level {
             self.patches.push(id);

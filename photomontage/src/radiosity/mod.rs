@@ -36,6 +36,7 @@
 
 pub mod convergence;
 pub mod convergence_plot;
+pub mod covered;
 pub mod direct;
 pub mod form_factor;
 pub mod hierarchical;
@@ -48,6 +49,8 @@ pub mod transfer;
 
 #[cfg(test)]
 mod form_factor_tests;
+#[cfg(test)]
+mod peer_tests;
 #[cfg(test)]
 mod radiance_tests;
 #[cfg(test)]

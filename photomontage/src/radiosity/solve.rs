@@ -234,13 +234,16 @@ pub fn solve(
 /// # Errors
 /// As [`solve`].
 pub fn solve_on_mesh(
-    mesh: Mesh,
+    mut mesh: Mesh,
     tracer: &SceneTracer,
     groups: &[LightGroup],
     params: &SolveParams,
     cancel: &AtomicBool,
     on_pass: &dyn Fn(&ConvergenceRow),
 ) -> Result<Solution, RadiosityError> {
+    if params.form_factors.visibility {
+        super::covered::mark_covered(&mut mesh, tracer, &params.form_factors);
+    }
     let engine = FormFactorEngine::new(&mesh, tracer, params.form_factors)?;
     let n = mesh.elements.len();
     let ground = GroundTerm::new(&engine, params.ground.as_ref())?;

@@ -1,26 +1,21 @@
-//! The scene of a site (Durisch 1992 §4.1 natural polygons and §5 CAD objects): one natural
-//! object per scene polygon and one artificial object per visible model, the one builder the
-//! renderer, the fits and the studio share.
+//! The scene of a site (Durisch 1992 §4.1 natural polygons and §5 CAD objects): the natural
+//! scene of [`crate::fit::natural_scene::natural_scene`] (the one builder and rule set the
+//! renderer, the fits, the picker, the radiosity CLI and the studio share) plus what only the
+//! renderer needs: one artificial object per visible model, the library's definitions of CAD
+//! materials, model scale checks, and a refusal of polygons without coordinates.
 //!
 //! # Known limitations
 //! Polygons are single-sided triangles of their vertex points (no holes). CAD materials named in
 //! the material library take the library's definition; the others keep their file's definition.
-
-use std::collections::HashMap;
 
 use nalgebra::Point3;
 use serde::Serialize;
 
 use super::render_error::{SiteRenderError, SiteWarning};
 use super::{CadModel, SiteDocument};
-use crate::scene::{
-    ImportOptions, Material, MaterialLibrary, ObjectKind, Placement, Scene, SceneObject,
-};
-
-/// Diffuse reflectance of a polygon whose material is not in the library (or when the site has
-/// no library): ρ_d = 0.5, mid-grey, [`Material::default`]. The name is kept so the warning and
-/// the material list show what was meant.
-pub const DEFAULT_POLYGON_ALBEDO: [f64; 3] = [0.5; 3];
+pub use crate::fit::natural_scene::DEFAULT_POLYGON_ALBEDO;
+use crate::fit::natural_scene::{NaturalSceneError, natural_scene};
+use crate::scene::{ImportOptions, MaterialLibrary, ObjectKind, Placement, Scene};
 
 /// A CAD model whose largest bounding-box side is above this gets a scale warning: 10 km, larger
 /// than any single planned development (probably millimetres read as metres).
@@ -59,20 +54,6 @@ pub struct SiteScene {
     pub object_sources: Vec<ObjectSource>,
     /// Problems that did not stop the build.
     pub warnings: Vec<SiteWarning>,
-}
-
-fn point_table(doc: &SiteDocument) -> HashMap<&str, [f64; 3]> {
-    let mut points: HashMap<&str, [f64; 3]> = doc
-        .site
-        .tie_points
-        .iter()
-        .map(|t| (t.id.as_str(), t.xyz))
-        .collect();
-    // Control points win over tie points of the same id.
-    for c in &doc.site.control_points {
-        points.insert(c.id.as_str(), c.xyz);
-    }
-    points
 }
 
 fn import_options(model: &CadModel) -> ImportOptions {
@@ -118,54 +99,31 @@ pub fn site_material_library(
 /// or CAD file (no faces, non-finite vertices, a size above 100 km), a bad unit or up axis.
 pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
     let library = site_material_library(doc)?;
-    let points = point_table(doc);
-    let mut scene = Scene::new();
-    let mut object_sources = Vec::new();
-    let mut warnings = Vec::new();
-    let mut missing: Vec<(String, Vec<String>)> = Vec::new();
-    for poly in &doc.site.polygons {
-        let vertices = poly
-            .vertices
-            .iter()
-            .map(|v| {
-                points
-                    .get(v.as_str())
-                    .map(|&xyz| Point3::from(xyz))
-                    .ok_or_else(|| SiteRenderError::UnknownPoint {
-                        polygon: poly.id.clone(),
-                        point: v.clone(),
-                    })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let material = match library.as_ref().and_then(|l| l.get(&poly.material)) {
-            Some(m) => m.clone(),
-            None => {
-                match missing.iter_mut().find(|(m, _)| *m == poly.material) {
-                    Some((_, polys)) => polys.push(poly.id.clone()),
-                    None => missing.push((poly.material.clone(), vec![poly.id.clone()])),
-                }
-                Material::diffuse(&poly.material, DEFAULT_POLYGON_ALBEDO)
-            }
-        };
-        let material = scene.add_material(material)?;
-        let object = scene.add_object(SceneObject {
-            name: poly.id.clone(),
-            kind: ObjectKind::Natural,
-            image_attribute: poly.image.clone(),
-        })?;
-        object_sources.push(ObjectSource::Polygon(poly.id.clone()));
-        scene
-            .add_polygon(&vertices, material, object)
-            .map_err(|source| SiteRenderError::Polygon {
-                polygon: poly.id.clone(),
-                source,
-            })?;
+    let natural = natural_scene(&doc.site, library.as_ref()).map_err(|e| match e {
+        NaturalSceneError::Polygon { polygon, source } => {
+            SiteRenderError::Polygon { polygon, source }
+        }
+        NaturalSceneError::Scene(source) => SiteRenderError::Scene(source),
+    })?;
+    // The renderer needs every polygon: one left out for a vertex without coordinates is an
+    // error here (the fits and the picker go on without it).
+    if let Some(s) = natural.skipped.first() {
+        return Err(SiteRenderError::UnknownPoint {
+            polygon: s.polygon.clone(),
+            point: s.point.clone(),
+        });
     }
-    warnings.extend(
-        missing
-            .into_iter()
-            .map(|(material, polygons)| SiteWarning::MissingMaterial { material, polygons }),
-    );
+    let mut scene = natural.scene;
+    let mut object_sources: Vec<ObjectSource> = natural
+        .polygon_of_object
+        .iter()
+        .map(|&k| ObjectSource::Polygon(doc.site.polygons[k].id.clone()))
+        .collect();
+    let mut warnings: Vec<SiteWarning> = natural
+        .missing_materials
+        .into_iter()
+        .map(|(material, polygons)| SiteWarning::MissingMaterial { material, polygons })
+        .collect();
     for model in doc.site.models.iter().filter(|m| m.visible) {
         let options = import_options(model);
         let path = doc.resolve(&model.file);

@@ -11,8 +11,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
+use crate::fit::natural_scene::natural_scene;
 use crate::fit::site::tests::{HORIZON, K_H, K_S, K_U, RHO, SIZE_PX, base_site};
-use crate::fit::site::{SiteFitOptions, fit_site, natural_scene};
+use crate::fit::site::{SiteFitOptions, fit_site};
 use crate::scene::SceneTracer;
 use crate::site::render::site_material_library;
 use crate::site::{Sample, SamplePurpose};
@@ -85,7 +86,7 @@ fn weights_of_a_photo_with_interreflection_are_recovered() {
         site: site.clone(),
     };
     let library = site_material_library(&doc).unwrap();
-    let (natural, _) = natural_scene(&site, library.as_ref()).unwrap();
+    let natural = natural_scene(&site, library.as_ref()).unwrap().scene;
     // The photo, direct light only: the same triangles as artificial objects (case C).
     let mut scene = Scene::new();
     let object = scene

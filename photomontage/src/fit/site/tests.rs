@@ -5,8 +5,9 @@
 
 use super::*;
 use crate::fit::daylight::{irradiance_components, normalised_sky_facets};
+use crate::fit::natural_scene::natural_scene;
 use crate::scene::Material;
-use crate::scene::{ObjectKind, SceneObject};
+use crate::scene::{ObjectKind, Scene, SceneObject};
 use crate::site::render::site_sun_dir;
 use crate::site::stored_camera;
 use crate::site::{
@@ -194,7 +195,7 @@ fn synthetic_site(seed: u64, corrupt_every: Option<usize>) -> Synthetic {
         format!("[[material]]\nname = \"stone\"\ndiffuse_rgb = {RHO:?}\n"),
     )
     .unwrap();
-    let (scene, _) = natural_scene(&site, None).unwrap();
+    let scene = natural_scene(&site, None).unwrap().scene;
     let tracer = SceneTracer::new(&scene, crate::bvh::BuildQuality::default()).unwrap();
     let doc0 = SiteDocument {
         path: dir.path().join("site.toml"),
@@ -587,7 +588,7 @@ fn weights_rendered_by_the_renderer_are_recovered() {
     };
     let (lighting, _) = site_lighting(&doc, "P1", &options).unwrap();
     // The same polygons as artificial objects, so the renderer shades them (case C).
-    let (natural, _) = natural_scene(&site, None).unwrap();
+    let natural = natural_scene(&site, None).unwrap().scene;
     let mut scene = Scene::new();
     let object = scene
         .add_object(SceneObject {
