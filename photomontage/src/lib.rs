@@ -15,6 +15,7 @@ pub mod bvh;
 pub mod camera;
 pub mod colour;
 pub mod farm;
+pub mod features;
 pub mod fit;
 pub mod geo;
 pub mod luminaire;

@@ -24,6 +24,9 @@ pub mod render_photo;
 mod schema;
 pub mod site_scene;
 pub mod solve;
+#[cfg(feature = "opencv")]
+pub mod tie_matching;
+pub mod tie_points;
 pub mod toml_merge;
 mod validate;
 

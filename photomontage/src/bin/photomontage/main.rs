@@ -1,5 +1,6 @@
 //! The `photomontage` command-line tool.
 
+mod calibrate;
 mod farm;
 mod fit;
 mod info;
@@ -14,6 +15,7 @@ mod sky;
 mod solve;
 mod standard_view;
 mod sun;
+mod tie_match;
 mod view_report;
 
 use clap::{Parser, Subcommand};
@@ -86,6 +88,14 @@ enum Command {
     /// progressive or direct); report patches, links, passes, time and residual, optionally
     /// write the mesh (PLY) and the convergence record (CSV). Not yet used by `render`.
     Radiosity(radiosity::Args),
+    /// Tie points by feature matching (SIFT, ratio test, fundamental-matrix RANSAC, tracks),
+    /// written into the site atomically; `solve` then uses them. Needs a build with the
+    /// `opencv` feature.
+    Match(tie_match::Args),
+    /// Lens calibration from chessboard photos (OpenCV's findChessboardCorners, cornerSubPix,
+    /// calibrateCamera): fx, fy, cx, cy, k1, k2, p1, p2, k3 and RMS; the corners as CSV. Needs
+    /// a build with the `opencv` feature.
+    Calibrate(calibrate::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -115,5 +125,7 @@ fn main() -> anyhow::Result<()> {
         Command::View(args) => standard_view::run(&args),
         Command::Sheet(args) => sheet::run(&args),
         Command::Radiosity(args) => radiosity::run(&args),
+        Command::Match(args) => tie_match::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
     }
 }
