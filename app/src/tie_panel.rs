@@ -52,7 +52,11 @@ pub fn ordered(mut tracks: Vec<TrackSummary>) -> Vec<TrackSummary> {
     tracks.sort_by(|a, b| {
         a.rejected
             .cmp(&b.rejected)
-            .then(b.rms_px.unwrap_or(-1.0).total_cmp(&a.rms_px.unwrap_or(-1.0)))
+            .then(
+                b.rms_px
+                    .unwrap_or(-1.0)
+                    .total_cmp(&a.rms_px.unwrap_or(-1.0)),
+            )
             .then(a.id.cmp(&b.id))
     });
     tracks
@@ -94,7 +98,10 @@ impl Panel for TiePointsPanel {
                         } else {
                             t.photos.join(", ")
                         });
-                        ui.label(t.rms_px.map_or_else(|| "–".to_owned(), |v| format!("{v:.2}")));
+                        ui.label(
+                            t.rms_px
+                                .map_or_else(|| "–".to_owned(), |v| format!("{v:.2}")),
+                        );
                         let (text, name) = if t.rejected {
                             ("Restore", format!("Restore {}", t.id))
                         } else {
@@ -103,7 +110,8 @@ impl Panel for TiePointsPanel {
                         let b = ui.button(text);
                         name_widget(ui, &b, &name);
                         if b.clicked()
-                            && let Some(command) = set_rejected_command(&doc.site, &t.id, !t.rejected)
+                            && let Some(command) =
+                                set_rejected_command(&doc.site, &t.id, !t.rejected)
                         {
                             actions.push(Action::Edit {
                                 command: Box::new(command),

@@ -3,7 +3,9 @@
 //! the intrinsics OpenCV ships for exactly these photos (`left_intrinsics.yml`, flags 2 =
 //! CALIB_FIX_ASPECT_RATIO): fx = fy = 535.91573, cx = 342.28315, cy = 235.57083, RMS 0.39259 px.
 //! Also checks that `tests/data/calib/left_corners_opencv.csv` (the corners for the calibration
-//! without OpenCV; written by `photomontage calibrate … --corners-csv`) matches what is found now.
+//! without OpenCV) matches what is found now. It is written by `photomontage calibrate
+//! ../shared/data/real/calib/left*.jpg --board 9x6 --fix-aspect-ratio --corners-csv …`, or by
+//! this test with `UPDATE_CORNERS=true` (as kittest's `UPDATE_SNAPSHOTS`).
 #![cfg(feature = "opencv")]
 
 use photomontage::features::calibration::{
@@ -67,13 +69,17 @@ fn opencv_calibration_of_the_left_set_matches_the_published_intrinsics() {
     assert!((c.cy_px - CY_PX).abs() < PRINCIPAL_POINT_TOLERANCE_PX);
     assert!((c.rms_px - RMS_PX).abs() < RMS_TOLERANCE_PX);
 
-    let committed = std::fs::read_to_string(
-        photomontage_tests::repo_root().join("tests/data/calib/left_corners_opencv.csv"),
-    )
-    .expect("committed corners");
+    let csv_path = photomontage_tests::repo_root().join("tests/data/calib/left_corners_opencv.csv");
     let now = corners_csv(&c.views);
+    if std::env::var("UPDATE_CORNERS").is_ok_and(|v| v == "true") {
+        std::fs::create_dir_all(csv_path.parent().expect("folder")).expect("folder");
+        std::fs::write(&csv_path, &now).expect("written");
+    }
+    let committed = std::fs::read_to_string(&csv_path).expect("committed corners");
     let rows = |t: &str| -> Vec<Vec<String>> {
-        t.lines().map(|l| l.split(',').map(str::to_owned).collect()).collect()
+        t.lines()
+            .map(|l| l.split(',').map(str::to_owned).collect())
+            .collect()
     };
     let (a, b) = (rows(&committed), rows(&now));
     assert_eq!(a.len(), b.len());
@@ -81,7 +87,10 @@ fn opencv_calibration_of_the_left_set_matches_the_published_intrinsics() {
     for (ra, rb) in a.iter().zip(&b).skip(1) {
         assert_eq!(ra[..3], rb[..3]);
         for k in 3..5 {
-            let (x, y): (f64, f64) = (ra[k].parse().expect("number"), rb[k].parse().expect("number"));
+            let (x, y): (f64, f64) = (
+                ra[k].parse().expect("number"),
+                rb[k].parse().expect("number"),
+            );
             assert!((x - y).abs() <= CSV_TOLERANCE_PX, "{ra:?} vs {rb:?}");
         }
     }
@@ -103,5 +112,8 @@ fn a_photo_without_the_board_is_named() {
         CalibrationFlags::default(),
     )
     .expect_err("no chessboard in the webcam photo");
-    assert!(err.to_string().contains("2019-05-24_12-00_ori.jpg"), "{err}");
+    assert!(
+        err.to_string().contains("2019-05-24_12-00_ori.jpg"),
+        "{err}"
+    );
 }

@@ -72,7 +72,10 @@ pub fn calibrate_chessboard(
     flags: CalibrationFlags,
 ) -> Result<Calibration, FeatureError> {
     let [bw, bh] = board.inner_corners;
-    let pattern = Size::new(i32::try_from(bw).unwrap_or(0), i32::try_from(bh).unwrap_or(0));
+    let pattern = Size::new(
+        i32::try_from(bw).unwrap_or(0),
+        i32::try_from(bh).unwrap_or(0),
+    );
     let mut object_points = Vector::<Vector<Point3f>>::new();
     let mut image_points = Vector::<Vector<Point2f>>::new();
     let mut views = Vec::new();
@@ -126,7 +129,10 @@ pub fn calibrate_chessboard(
             .enumerate()
             .map(|(i, p)| {
                 let i = u32::try_from(i).unwrap_or(0);
-                ([i % bw, i / bw], Point2::new(f64::from(p.x), f64::from(p.y)))
+                (
+                    [i % bw, i / bw],
+                    Point2::new(f64::from(p.x), f64::from(p.y)),
+                )
             })
             .collect();
         views.push(BoardCorners {
@@ -157,7 +163,11 @@ pub fn calibrate_chessboard(
         &mut rvecs,
         &mut tvecs,
         cv_flags,
-        TermCriteria::new(core::TermCriteria_COUNT + core::TermCriteria_EPS, 30, f64::EPSILON)?,
+        TermCriteria::new(
+            core::TermCriteria_COUNT + core::TermCriteria_EPS,
+            30,
+            f64::EPSILON,
+        )?,
     )?;
     let at = |r: i32, c: i32| -> Result<f64, FeatureError> { Ok(*k.at_2d::<f64>(r, c)?) };
     let d = |i: i32| -> Result<f64, FeatureError> { Ok(*dist.at::<f64>(i)?) };
@@ -180,8 +190,10 @@ pub fn calibrate_chessboard(
 }
 
 fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }
 
 /// The photo as an 8-bit luma Mat (BT.601 weights on the sRGB-encoded values).

@@ -104,14 +104,19 @@ fn detection_image(image: &PhotoImage, max_side: u32) -> (GrayImage, f64) {
 }
 
 fn to_mat(gray: &GrayImage) -> Result<Mat, FeatureError> {
-    let rows = i32::try_from(gray.height()).map_err(|_| FeatureError::Geometry("image too tall".into()))?;
+    let rows = i32::try_from(gray.height())
+        .map_err(|_| FeatureError::Geometry("image too tall".into()))?;
     let flat = Mat::from_slice(gray.as_raw())?;
     let shaped = flat.reshape(1, rows)?;
     Ok(shaped.try_clone()?)
 }
 
 /// SIFT keypoints and descriptors of one photo.
-fn detect(input: &MatchInput, options: &MatchOptions, limits: &DecodeLimits) -> Result<PhotoFeatures, FeatureError> {
+fn detect(
+    input: &MatchInput,
+    options: &MatchOptions,
+    limits: &DecodeLimits,
+) -> Result<PhotoFeatures, FeatureError> {
     let image = photo::load_with_limits(&input.path, limits)?;
     let (gray, scale) = detection_image(&image, options.max_image_side_px);
     drop(image);
@@ -120,7 +125,13 @@ fn detect(input: &MatchInput, options: &MatchOptions, limits: &DecodeLimits) -> 
     let mut sift = features2d::SIFT::create(nfeatures, 3, 0.04, 10.0, 1.6)?;
     let mut keypoints = Vector::<KeyPoint>::new();
     let mut descriptors = Mat::default();
-    sift.detect_and_compute(&mat, &core::no_array(), &mut keypoints, &mut descriptors, false)?;
+    sift.detect_and_compute(
+        &mat,
+        &core::no_array(),
+        &mut keypoints,
+        &mut descriptors,
+        false,
+    )?;
     if keypoints.is_empty() {
         return Err(FeatureError::NoKeypoints {
             photo: input.id.clone(),
@@ -147,7 +158,11 @@ fn detect(input: &MatchInput, options: &MatchOptions, limits: &DecodeLimits) -> 
 }
 
 /// Ratio-tested nearest neighbours of every descriptor of `query` in `train`: index pairs.
-fn ratio_matches(query: &Mat, train: &Mat, ratio: f64) -> Result<Vec<(usize, usize)>, FeatureError> {
+fn ratio_matches(
+    query: &Mat,
+    train: &Mat,
+    ratio: f64,
+) -> Result<Vec<(usize, usize)>, FeatureError> {
     let matcher = features2d::BFMatcher::create(core::NORM_L2, false)?;
     let mut knn = Vector::<Vector<DMatch>>::new();
     matcher.knn_train_match(query, train, &mut knn, 2, &core::no_array(), false)?;
@@ -270,7 +285,11 @@ pub fn match_photos(
                 .filter(|s| s.photo_a == p.id || s.photo_b == p.id)
                 .max_by_key(|s| s.verified.max(s.mutual.min(options.min_pair_matches - 1)));
             let (best_other, best_matches) = best.map_or((String::new(), 0), |s| {
-                let other = if s.photo_a == p.id { &s.photo_b } else { &s.photo_a };
+                let other = if s.photo_a == p.id {
+                    &s.photo_b
+                } else {
+                    &s.photo_a
+                };
                 (other.clone(), s.verified)
             });
             return Err(FeatureError::NoOverlap {

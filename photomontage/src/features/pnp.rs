@@ -46,7 +46,11 @@ fn mat3(m: &Mat) -> Result<Matrix3<f64>, FeatureError> {
 }
 
 fn vec3(m: &Mat) -> Result<Vector3<f64>, FeatureError> {
-    Ok(Vector3::new(*m.at::<f64>(0)?, *m.at::<f64>(1)?, *m.at::<f64>(2)?))
+    Ok(Vector3::new(
+        *m.at::<f64>(0)?,
+        *m.at::<f64>(1)?,
+        *m.at::<f64>(2)?,
+    ))
 }
 
 /// Re-solves `camera`'s pose with OpenCV from world points and their pixels, starting from
@@ -64,7 +68,10 @@ pub fn pnp_check(
             points.len()
         )));
     }
-    let origin = points.iter().fold(Vector3::zeros(), |a, (x, _)| a + x.coords) / points.len() as f64;
+    let origin = points
+        .iter()
+        .fold(Vector3::zeros(), |a, (x, _)| a + x.coords)
+        / points.len() as f64;
     let object: Vector<Point3d> = points
         .iter()
         .map(|(x, _)| {
@@ -91,8 +98,19 @@ pub fn pnp_check(
         [r_cw[(2, 0)], r_cw[(2, 1)], r_cw[(2, 2)]],
     ])?;
     calib3d::rodrigues_def(&r_mat, &mut rvec)?;
-    let mut tvec = Mat::from_slice(&[t.x, t.y, t.z])?.reshape(1, 3)?.try_clone()?;
-    let ok = calib3d::solve_pnp(&object, &image, &k, &dist, &mut rvec, &mut tvec, true, calib3d::SOLVEPNP_ITERATIVE)?;
+    let mut tvec = Mat::from_slice(&[t.x, t.y, t.z])?
+        .reshape(1, 3)?
+        .try_clone()?;
+    let ok = calib3d::solve_pnp(
+        &object,
+        &image,
+        &k,
+        &dist,
+        &mut rvec,
+        &mut tvec,
+        true,
+        calib3d::SOLVEPNP_ITERATIVE,
+    )?;
     if !ok {
         return Err(FeatureError::Geometry("solvePnP did not converge".into()));
     }
@@ -135,7 +153,15 @@ mod tests {
 
     #[test]
     fn opencv_solve_pnp_agrees_with_our_resection() {
-        for (layout, seed) in [(Layout::Volume { depth_fraction: 0.3 }, 3), (Layout::Ground, 4)] {
+        for (layout, seed) in [
+            (
+                Layout::Volume {
+                    depth_fraction: 0.3,
+                },
+                3,
+            ),
+            (Layout::Ground, 4),
+        ] {
             let mut scene = single_photo(&SceneSpec {
                 focal_px: 3000.0,
                 image_size_px: [4000, 3000],
@@ -150,17 +176,29 @@ mod tests {
             for c in &mut scene.control {
                 c.sigma_m = [0.0; 3];
             }
-            let ours = resect(&scene.control, &scene.observations, &ResectionOptions::new(scene.camera.intrinsics)).expect("solvable");
+            let ours = resect(
+                &scene.control,
+                &scene.observations,
+                &ResectionOptions::new(scene.camera.intrinsics),
+            )
+            .expect("solvable");
             let pairs: Vec<_> = scene
                 .observations
                 .iter()
                 .map(|o| {
-                    let c = scene.control.iter().find(|c| c.id == o.point_id).expect("control");
+                    let c = scene
+                        .control
+                        .iter()
+                        .find(|c| c.id == o.point_id)
+                        .expect("control");
                     (c.point_in_world, o.pixel)
                 })
                 .collect();
             let check = pnp_check(&ours.camera, &pairs).expect("OpenCV solves");
-            println!("{layout:?}: centre {:.3e} m, rotation {:.3e}°", check.center_difference_m, check.rotation_difference_deg);
+            println!(
+                "{layout:?}: centre {:.3e} m, rotation {:.3e}°",
+                check.center_difference_m, check.rotation_difference_deg
+            );
             assert!(check.center_difference_m < AGREEMENT_M, "{check:?}");
             assert!(check.rotation_difference_deg < AGREEMENT_DEG, "{check:?}");
         }

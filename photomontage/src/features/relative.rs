@@ -14,9 +14,9 @@
 //! intersection gate rather than detected here.
 
 use nalgebra::{Matrix3, Point2, Rotation3, Vector3};
+use opencv::calib3d;
 use opencv::core::{self, Mat, Point2d, Vector};
 use opencv::prelude::*;
-use opencv::calib3d;
 
 use crate::photogrammetry::PhotogrammetryError;
 use crate::photogrammetry::block_start::{RelativePose, StartPhoto};
@@ -27,7 +27,10 @@ pub const RELATIVE_THRESHOLD_PX: f64 = 2.0;
 
 fn degenerate(a: &StartPhoto, b: &StartPhoto, what: &str) -> PhotogrammetryError {
     PhotogrammetryError::Degenerate {
-        reason: format!("relative orientation of photos {} and {}: {what}", a.id, b.id),
+        reason: format!(
+            "relative orientation of photos {} and {}: {what}",
+            a.id, b.id
+        ),
     }
 }
 
@@ -63,7 +66,10 @@ pub fn relative_orientation(
         })
         .collect();
     let focal = 0.5 * (a.intrinsics.focal_px + b.intrinsics.focal_px);
-    let identity = Mat::eye(3, 3, core::CV_64F).map_err(cv)?.to_mat().map_err(cv)?;
+    let identity = Mat::eye(3, 3, core::CV_64F)
+        .map_err(cv)?
+        .to_mat()
+        .map_err(cv)?;
     core::set_rng_seed(0).map_err(cv)?;
     let mut mask = Mat::default();
     let e = calib3d::find_essential_mat(
@@ -81,13 +87,23 @@ pub fn relative_orientation(
     if e.rows() < 3 || e.cols() != 3 {
         return Err(degenerate(a, b, "no essential matrix found"));
     }
-    let e3 = e.row_range(&core::Range::new(0, 3).map_err(cv)?).map_err(cv)?.try_clone().map_err(cv)?;
+    let e3 = e
+        .row_range(&core::Range::new(0, 3).map_err(cv)?)
+        .map_err(cv)?
+        .try_clone()
+        .map_err(cv)?;
     let mut r = Mat::default();
     let mut t = Mat::default();
-    let in_front = calib3d::recover_pose_estimated(&e3, &norm_a, &norm_b, &identity, &mut r, &mut t, &mut mask)
-        .map_err(cv)?;
+    let in_front = calib3d::recover_pose_estimated(
+        &e3, &norm_a, &norm_b, &identity, &mut r, &mut t, &mut mask,
+    )
+    .map_err(cv)?;
     if in_front < 5 {
-        return Err(degenerate(a, b, &format!("only {in_front} matches lie in front of both cameras")));
+        return Err(degenerate(
+            a,
+            b,
+            &format!("only {in_front} matches lie in front of both cameras"),
+        ));
     }
     let mut rm = Matrix3::zeros();
     for i in 0..3 {

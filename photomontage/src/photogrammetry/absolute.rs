@@ -148,7 +148,10 @@ pub fn similarity_from_two_points_and_rays(
     let scale = ab_w.norm() / ab_m.norm();
     let base = Rotation3::rotation_between(&ab_m, &ab_w).unwrap_or_else(|| {
         // Antiparallel: a half turn about any axis normal to the line.
-        let normal = ab_m.cross(&Vector3::x()).try_normalize(1e-9).unwrap_or(Vector3::y());
+        let normal = ab_m
+            .cross(&Vector3::x())
+            .try_normalize(1e-9)
+            .unwrap_or(Vector3::y());
         Rotation3::from_axis_angle(&Unit::new_normalize(normal), std::f64::consts::PI)
     });
     let axis = Unit::new_normalize(ab_w);

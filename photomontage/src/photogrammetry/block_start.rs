@@ -121,10 +121,11 @@ pub fn start_block(
             required: 2,
             found: world_solved,
         })?;
-        let (a, b, shared) = best_pair(photos, &is_tie).ok_or(PhotogrammetryError::NotEnoughPoints {
-            required: MIN_RELATIVE_TIES,
-            found: 0,
-        })?;
+        let (a, b, shared) =
+            best_pair(photos, &is_tie).ok_or(PhotogrammetryError::NotEnoughPoints {
+                required: MIN_RELATIVE_TIES,
+                found: 0,
+            })?;
         if shared.len() < MIN_RELATIVE_TIES {
             return Err(PhotogrammetryError::NotEnoughPoints {
                 required: MIN_RELATIVE_TIES,
@@ -294,8 +295,7 @@ fn intersect_ties<'p>(
         }
         match intersect(r) {
             Ok(x)
-                if x
-                    .residuals_px
+                if x.residuals_px
                     .iter()
                     .zip(r)
                     .all(|(v, (_, o))| v[0].hypot(v[1]) <= TIE_GATE_SIGMA * o.sigma_px) =>
@@ -317,6 +317,7 @@ fn absolute_orientation(
     control: &[ControlPoint],
 ) -> Result<Similarity, PhotogrammetryError> {
     let mut pairs = Vec::new();
+    let mut pair_ids = Vec::new();
     let mut single = Vec::new();
     for c in control {
         let rays: Vec<(Camera, ImageObservation)> = photos
@@ -334,13 +335,20 @@ fn absolute_orientation(
             _ => {
                 if let Ok(x) = intersect(&rays) {
                     pairs.push((x.point_in_world, c.point_in_world));
+                    pair_ids.push(c.id.as_str());
                 }
             }
         }
     }
+    let datum = |what: String| PhotogrammetryError::Degenerate {
+        reason: format!(
+            "the control cannot fix the block's position, scale and rotation: {what}; a third \
+             control point seen in two placed photos, or one more control point seen in one, is needed"
+        ),
+    };
     match pairs.len() {
         n if n >= 3 => similarity_from_points(&pairs),
-        2 => {
+        2 if !single.is_empty() => {
             let rays: Vec<ControlRay> = single
                 .iter()
                 .map(|(c, (cam, o))| ControlRay {
@@ -351,10 +359,16 @@ fn absolute_orientation(
                 .collect();
             similarity_from_two_points_and_rays([pairs[0], pairs[1]], &rays)
         }
-        n => Err(PhotogrammetryError::NotEnoughPoints {
-            required: 3,
-            found: n + single.len().min(1),
-        }),
+        2 => Err(datum(format!(
+            "only {} and {} are seen in the placed photos, and the block can turn about their line",
+            pair_ids[0], pair_ids[1]
+        ))),
+        _ => Err(datum(format!(
+            "{} control point(s) seen in two placed photos ({}), {} in one",
+            pairs.len(),
+            pair_ids.join(", "),
+            single.len()
+        ))),
     }
 }
 

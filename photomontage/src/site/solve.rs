@@ -427,7 +427,10 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
         } else {
             "placed by tie points, but solve.bundle_adjustment is off and only the bundle adjustment can refine it"
         };
-        for s in photos.iter().filter(|s| s.solved_by == tie_start::SOLVED_BY_TIES) {
+        for s in photos
+            .iter()
+            .filter(|s| s.solved_by == tie_start::SOLVED_BY_TIES)
+        {
             failures.push(PhotoFailure {
                 id: s.id.clone(),
                 error: reason.to_owned(),
@@ -469,10 +472,21 @@ fn opencv_pose_check(
                 .iter()
                 .find(|c| c.id == r.point_id)
                 .map(|c| c.point_in_world)
-                .or_else(|| points.iter().find(|p| p.id == r.point_id).map(|p| p.point_in_world))?;
+                .or_else(|| {
+                    points
+                        .iter()
+                        .find(|p| p.id == r.point_id)
+                        .map(|p| p.point_in_world)
+                })?;
             let projected = s.camera.project(&x)?;
             // The residual is projected − observed.
-            Some((x, Point2::new(projected.x - r.residual_px[0], projected.y - r.residual_px[1])))
+            Some((
+                x,
+                Point2::new(
+                    projected.x - r.residual_px[0],
+                    projected.y - r.residual_px[1],
+                ),
+            ))
         })
         .collect();
     crate::features::pnp::pnp_check(&s.camera, &pairs)

@@ -10,7 +10,7 @@ use std::collections::{HashMap, HashSet};
 
 use super::{PhotoSolution, PhotoSolveError, Prepared};
 use crate::photogrammetry::block_start::{StartPhoto, start_block};
-use crate::photogrammetry::{ControlPoint, PhotogrammetryError, SelfCalibration};
+use crate::photogrammetry::{ControlPoint, PhotogrammetryError};
 use crate::site::Site;
 
 /// `solved_by` of a photo placed by tie points and not (yet) adjusted.
@@ -142,7 +142,9 @@ pub(super) fn place_by_tie_points(
         ));
     }
     for (id, reason) in &start.unplaced {
-        placed.unplaced.insert(id.clone(), format!("not placed by tie points: it {reason}"));
+        placed
+            .unplaced
+            .insert(id.clone(), format!("not placed by tie points: it {reason}"));
     }
     for (prep, _) in unresected {
         let index = start_photos.iter().position(|p| p.id == prep.id);
@@ -153,7 +155,9 @@ pub(super) fn place_by_tie_points(
         let used = prep
             .observations
             .iter()
-            .filter(|o| !outliers.contains(&o.point_id) && !start.rejected_ties.contains(&o.point_id))
+            .filter(|o| {
+                !outliers.contains(&o.point_id) && !start.rejected_ties.contains(&o.point_id)
+            })
             .count();
         photos.push(PhotoSolution {
             id: prep.id.clone(),
@@ -169,7 +173,8 @@ pub(super) fn place_by_tie_points(
                 "placed by tie points: resection from its control alone failed ({})",
                 errors.get(&prep.id).map_or("", String::as_str)
             )],
-            estimated: SelfCalibration::default(),
+            // What the user asked to estimate: the bundle adjustment frees what the block supports.
+            estimated: prep.self_calibration,
             solved_by: SOLVED_BY_TIES,
             focal_source: prep.focal_source,
             opencv_check: None,
@@ -191,7 +196,11 @@ pub(super) fn which_label_fits(s: &PhotoSolution, a: &str, b: &str) -> String {
     };
     match (residual(a), residual(b)) {
         (Some(ra), Some(rb)) => {
-            let (fits, fr, wrong, wr) = if ra <= rb { (a, ra, b, rb) } else { (b, rb, a, ra) };
+            let (fits, fr, wrong, wr) = if ra <= rb {
+                (a, ra, b, rb)
+            } else {
+                (b, rb, a, ra)
+            };
             format!(
                 "photo {}: of the pair left out, {fits} fits the adjusted camera ({fr:.1} px) and {wrong} does not ({wr:.1} px): the label {wrong} is wrong",
                 s.id

@@ -54,7 +54,11 @@ pub fn match_site(
         })
         .collect();
     let report = match_photos(&inputs, options, limits)?;
-    let cameras: Vec<_> = site.photos.iter().map(|p| stored_camera(site, &p.id)).collect();
+    let cameras: Vec<_> = site
+        .photos
+        .iter()
+        .map(|p| stored_camera(site, &p.id))
+        .collect();
     let mut tracks = Vec::new();
     let (mut checked, mut rejected) = (0, 0);
     for t in &report.tracks {

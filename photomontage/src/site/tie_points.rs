@@ -90,7 +90,11 @@ pub fn track_summaries(site: &Site) -> Vec<TrackSummary> {
         .into_iter()
         .map(|(id, obs)| {
             let enabled: Vec<&&Observation> = obs.iter().filter(|o| o.enabled).collect();
-            let xyz = site.tie_points.iter().find(|t| t.id == id).map(|t| Point3::from(t.xyz));
+            let xyz = site
+                .tie_points
+                .iter()
+                .find(|t| t.id == id)
+                .map(|t| Point3::from(t.xyz));
             let rms_px = xyz.and_then(|x| {
                 let squares: Vec<f64> = enabled
                     .iter()
@@ -180,11 +184,15 @@ mod tests {
             sigma_px: 0.5,
             enabled: true,
         });
-        let first = replace_matched_tracks(&mut site, &[vec![obs("a", 1.0, 1.0), obs("b", 2.0, 2.0)]]);
+        let first =
+            replace_matched_tracks(&mut site, &[vec![obs("a", 1.0, 1.0), obs("b", 2.0, 2.0)]]);
         assert_eq!(first, ["sift_00001"]);
         let second = replace_matched_tracks(
             &mut site,
-            &[vec![obs("a", 3.0, 3.0), obs("b", 4.0, 4.0)], vec![obs("a", 5.0, 5.0), obs("b", 6.0, 6.0)]],
+            &[
+                vec![obs("a", 3.0, 3.0), obs("b", 4.0, 4.0)],
+                vec![obs("a", 5.0, 5.0), obs("b", 6.0, 6.0)],
+            ],
         );
         assert_eq!(second, ["sift_00001", "sift_00002"]);
         assert_eq!(site.observations.len(), 1 + 4);
@@ -195,7 +203,10 @@ mod tests {
     #[test]
     fn summaries_give_the_reprojection_rms_and_rejection_is_reversible() {
         let mut site = site_with_a_solved_photo();
-        replace_matched_tracks(&mut site, &[vec![obs("a", 103.0, 46.0), obs("b", 0.0, 0.0)]]);
+        replace_matched_tracks(
+            &mut site,
+            &[vec![obs("a", 103.0, 46.0), obs("b", 0.0, 0.0)]],
+        );
         // 10 m north, 1 m east, 0.5 m up: projects to (110, 45); observed (103, 46).
         site.tie_points.push(TiePoint {
             id: "sift_00001".into(),
@@ -206,7 +217,10 @@ mod tests {
         assert_eq!(s.len(), 1);
         assert_eq!(s[0].photos, ["a", "b"]);
         // Only photo a is solved: residual (7, −1) → RMS per coordinate √(50/2) = 5.
-        assert!((s[0].rms_px.expect("solved") - 5.0).abs() < EXACT_PX, "{s:?}");
+        assert!(
+            (s[0].rms_px.expect("solved") - 5.0).abs() < EXACT_PX,
+            "{s:?}"
+        );
         assert!(!s[0].rejected);
         assert_eq!(set_track_rejected(&mut site, "sift_00001", true), 2);
         let s = track_summaries(&site);

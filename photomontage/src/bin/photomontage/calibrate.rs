@@ -36,7 +36,10 @@ fn parse_board(text: &str) -> anyhow::Result<[u32; 2]> {
             .trim()
             .parse()
             .map_err(|_| anyhow::anyhow!("--board {text:?}: {s:?} is not a whole number"))?;
-        anyhow::ensure!(v >= 2, "--board {text:?}: at least 2 inner corners per side");
+        anyhow::ensure!(
+            v >= 2,
+            "--board {text:?}: at least 2 inner corners per side"
+        );
         Ok(v)
     };
     Ok([parse(w)?, parse(h)?])
@@ -45,7 +48,13 @@ fn parse_board(text: &str) -> anyhow::Result<[u32; 2]> {
 #[cfg(not(feature = "opencv"))]
 pub fn run(args: &Args) -> anyhow::Result<()> {
     parse_board(&args.board)?;
-    let _ = (&args.photos, args.square_m, args.fix_aspect_ratio, &args.corners_csv, args.json);
+    let _ = (
+        &args.photos,
+        args.square_m,
+        args.fix_aspect_ratio,
+        &args.corners_csv,
+        args.json,
+    );
     anyhow::bail!(
         "this build of photomontage has no OpenCV, and `calibrate` needs it: install \
          libopencv-dev, clang and libclang-dev, then build with `cargo build --release --features \
@@ -88,7 +97,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             c.image_size_px[0],
             c.image_size_px[1]
         );
-        println!("fx {:.4} px  fy {:.4} px  cx {:.4} px  cy {:.4} px", c.fx_px, c.fy_px, c.cx_px, c.cy_px);
+        println!(
+            "fx {:.4} px  fy {:.4} px  cx {:.4} px  cy {:.4} px",
+            c.fx_px, c.fy_px, c.cx_px, c.cy_px
+        );
         println!(
             "k1 {:.6}  k2 {:.6}  p1 {:.6}  p2 {:.6}  k3 {:.6}",
             d.k1, d.k2, d.p1, d.p2, d.k3

@@ -116,7 +116,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 );
             }
             if ties.len() > MAX_TIE_LINES {
-                println!("  … and {} more (all in --json)", ties.len() - MAX_TIE_LINES);
+                println!(
+                    "  … and {} more (all in --json)",
+                    ties.len() - MAX_TIE_LINES
+                );
             }
         }
         if let Some(rms) = solution.bundle_rms_px {
