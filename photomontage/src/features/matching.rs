@@ -283,7 +283,7 @@ pub fn match_photos(
             let best = pairs
                 .iter()
                 .filter(|s| s.photo_a == p.id || s.photo_b == p.id)
-                .max_by_key(|s| s.verified.max(s.mutual.min(options.min_pair_matches - 1)));
+                .max_by_key(|s| (s.verified, s.mutual));
             let (best_other, best_matches) = best.map_or((String::new(), 0), |s| {
                 let other = if s.photo_a == p.id {
                     &s.photo_b

@@ -240,12 +240,15 @@ pub fn start_block(
     })
 }
 
+/// Pixels of the tie points two photos share: (in a, in b).
+type SharedPixels = Vec<(Point2<f64>, Point2<f64>)>;
+
 /// The pair of photos sharing the most tie points, with the shared pixels (a, b).
 fn best_pair(
     photos: &[StartPhoto],
     is_tie: &dyn Fn(&str) -> bool,
-) -> Option<(usize, usize, Vec<(Point2<f64>, Point2<f64>)>)> {
-    let mut best: Option<(usize, usize, Vec<(Point2<f64>, Point2<f64>)>)> = None;
+) -> Option<(usize, usize, SharedPixels)> {
+    let mut best: Option<(usize, usize, SharedPixels)> = None;
     for a in 0..photos.len() {
         let by_id: HashMap<&str, Point2<f64>> = photos[a]
             .observations

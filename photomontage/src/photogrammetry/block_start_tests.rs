@@ -24,6 +24,7 @@ fn spec() -> BlockSpec {
 }
 
 /// The relative orientation of the true cameras (what a perfect five-point solver returns).
+#[allow(clippy::type_complexity)] // the closure type of `RelativeOrientation`, spelled out
 fn true_relative(
     cameras: &[Camera],
     ids: &[String],
