@@ -117,7 +117,7 @@ pub fn start_block(
             *slot = p.camera;
         }
     } else {
-        let relative = relative.ok_or_else(|| PhotogrammetryError::NotEnoughPoints {
+        let relative = relative.ok_or(PhotogrammetryError::NotEnoughPoints {
             required: 2,
             found: world_solved,
         })?;
