@@ -58,6 +58,7 @@ pub mod scene_pick;
 pub mod solve;
 pub mod state;
 pub mod table_sort;
+pub mod tie_panel;
 pub mod viewport;
 pub mod widgets;
 pub mod window;
@@ -148,6 +149,7 @@ enum SideTab {
     Models,
     Scene,
     Fit,
+    Ties,
 }
 
 /// The studio app.
@@ -192,6 +194,7 @@ pub struct Studio {
     /// The window clears to the panel colour, so panels need not fill their backgrounds.
     host_clears_to_panel_fill: bool,
     fit: fit_panel::FitPanel,
+    ties: tie_panel::TiePointsPanel,
 }
 
 impl Studio {
@@ -238,6 +241,7 @@ impl Studio {
             photo_settings: photo_settings::PhotoSettings::default(),
             host_clears_to_panel_fill: false,
             fit: fit_panel::FitPanel::default(),
+            ties: tie_panel::TiePointsPanel,
         };
         s.open(&options.site_path);
         s
@@ -578,6 +582,8 @@ impl Studio {
             ui.selectable_value(&mut self.tab, SideTab::Scene, "Scene");
             let r = ui.selectable_value(&mut self.tab, SideTab::Fit, "Fit");
             widgets::name_widget(ui, &r, "Fit tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Ties, "Tie points");
+            widgets::name_widget(ui, &r, "Tie points tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -588,6 +594,7 @@ impl Studio {
             SideTab::Models => &mut self.models,
             SideTab::Scene => &mut self.scene,
             SideTab::Fit => &mut self.fit,
+            SideTab::Ties => &mut self.ties,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);

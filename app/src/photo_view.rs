@@ -88,7 +88,8 @@ impl Studio {
             crate::SideTab::Fit if !space => {
                 self.fit_pick_interaction(&response, &t, &id, size_px);
             }
-            crate::SideTab::Scene | crate::SideTab::Fit => {}
+            // The Tie points tab selects from its list; the photo only shows the tracks.
+            crate::SideTab::Scene | crate::SideTab::Fit | crate::SideTab::Ties => {}
             _ => self.observation_interaction(&response, &t, &id, space),
         }
 
@@ -311,6 +312,12 @@ impl Studio {
                 Color32::from_rgb(60, 255, 120)
             };
             let s = egui::Stroke::new(if selected { 2.0 } else { 1.5 }, colour);
+            // Matched tie points come by the thousand: a dot each, the selected track marked
+            // and labelled like any point.
+            if !selected && photomontage::site::tie_points::is_matched(&o.point) {
+                painter.circle_filled(c, 2.0, colour);
+                continue;
+            }
             painter.circle_stroke(c, 6.0, s);
             painter.line_segment([c - egui::vec2(10.0, 0.0), c - egui::vec2(3.0, 0.0)], s);
             painter.line_segment([c + egui::vec2(3.0, 0.0), c + egui::vec2(10.0, 0.0)], s);

@@ -17,6 +17,7 @@ pub mod camera;
 pub mod colour;
 pub mod exchange;
 pub mod farm;
+pub mod features;
 pub mod fit;
 pub mod geo;
 pub mod luminaire;

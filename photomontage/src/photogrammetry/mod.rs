@@ -45,6 +45,8 @@
 //! points behind the camera are explained exactly by the camera mirrored across their plane,
 //! which is returned (see [`resection`]).
 
+pub mod absolute;
+pub mod block_start;
 pub mod bundle;
 pub mod control_crs;
 pub mod control_io;

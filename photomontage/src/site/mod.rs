@@ -27,6 +27,9 @@ mod schema;
 pub mod site_scene;
 pub mod site_time;
 pub mod solve;
+#[cfg(feature = "opencv")]
+pub mod tie_matching;
+pub mod tie_points;
 pub mod toml_merge;
 mod validate;
 

@@ -17,6 +17,8 @@ use nalgebra::{Point2, Point3, Rotation3};
 use serde::Serialize;
 
 use super::{Exterior, Interior, Site, SiteDocument, TiePoint};
+#[path = "solve_ties.rs"]
+mod tie_start;
 use crate::camera::{Camera, Intrinsics};
 use crate::photo::{self, FocalSource};
 use crate::photogrammetry::{
@@ -82,6 +84,20 @@ pub struct PhotoSolution {
     /// Radial residual pattern of the resection (k1 warning; see
     /// [`crate::photogrammetry::radial_pattern`]).
     pub radial_pattern: Option<crate::photogrammetry::radial_pattern::RadialPattern>,
+    /// OpenCV's `solvePnP` started from this camera on the same points (only with the
+    /// `opencv` feature).
+    pub opencv_check: Option<PoseCheck>,
+}
+
+/// An independent solution of a photo's pose compared with ours.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PoseCheck {
+    /// Points used (control, and tie points with adjusted coordinates).
+    pub points: usize,
+    /// Distance between the two camera centres (metres).
+    pub center_difference_m: f64,
+    /// Angle between the two rotations (degrees).
+    pub rotation_difference_deg: f64,
 }
 
 /// A photo that could not be solved.
@@ -103,11 +119,12 @@ pub struct SiteSolution {
     pub warnings: Vec<String>,
 }
 
-struct Prepared {
-    intrinsics: Intrinsics,
-    focal_source: &'static str,
-    observations: Vec<ImageObservation>,
-    self_calibration: SelfCalibration,
+pub(crate) struct Prepared {
+    pub(crate) id: String,
+    pub(crate) intrinsics: Intrinsics,
+    pub(crate) focal_source: &'static str,
+    pub(crate) observations: Vec<ImageObservation>,
+    pub(crate) self_calibration: SelfCalibration,
 }
 
 fn prepare(
@@ -196,6 +213,7 @@ fn prepare(
     }
     let f = p.self_calibration;
     Ok(Prepared {
+        id: p.id.clone(),
         intrinsics,
         focal_source,
         observations,
@@ -254,23 +272,32 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
     let mut failures = Vec::new();
     let mut prepared_by_id: HashMap<String, Prepared> = HashMap::new();
 
+    // Photos whose resection from control failed although they were prepared: the tie points
+    // may still place them (`place_by_tie_points`).
+    let mut unresected: Vec<(Prepared, PhotoSolveError)> = Vec::new();
     for (index, p) in site.photos.iter().enumerate() {
-        let result = prepare(doc, index, &mut warnings).and_then(|prep| {
-            let control_obs: Vec<ImageObservation> = prep
-                .observations
-                .iter()
-                .filter(|o| control_ids.contains(o.point_id.as_str()))
-                .cloned()
-                .collect();
-            let mut options = ResectionOptions::new(prep.intrinsics);
-            options.self_calibration = prep.self_calibration;
-            options.outlier_threshold_sigma = site.solve.outlier_threshold_sigma;
-            options.seed = site.solve.seed;
-            let r = pg::resect(&control, &control_obs, &options)?;
-            Ok((prep, r))
-        });
-        match result {
-            Ok((prep, r)) => {
+        let prep = match prepare(doc, index, &mut warnings) {
+            Ok(prep) => prep,
+            Err(e) => {
+                failures.push(PhotoFailure {
+                    id: p.id.clone(),
+                    error: e.to_string(),
+                });
+                continue;
+            }
+        };
+        let control_obs: Vec<ImageObservation> = prep
+            .observations
+            .iter()
+            .filter(|o| control_ids.contains(o.point_id.as_str()))
+            .cloned()
+            .collect();
+        let mut options = ResectionOptions::new(prep.intrinsics);
+        options.self_calibration = prep.self_calibration;
+        options.outlier_threshold_sigma = site.solve.outlier_threshold_sigma;
+        options.seed = site.solve.seed;
+        match pg::resect(&control, &control_obs, &options) {
+            Ok(r) => {
                 photos.push(PhotoSolution {
                     id: p.id.clone(),
                     camera: r.camera,
@@ -286,14 +313,45 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
                     solved_by: "resection",
                     focal_source: prep.focal_source,
                     radial_pattern: r.radial_pattern,
+                    opencv_check: None,
                 });
                 prepared_by_id.insert(p.id.clone(), prep);
             }
-            Err(e) => failures.push(PhotoFailure {
-                id: p.id.clone(),
-                error: e.to_string(),
-            }),
+            Err(e) => {
+                failures.push(PhotoFailure {
+                    id: p.id.clone(),
+                    error: e.to_string(),
+                });
+                unresected.push((
+                    Prepared {
+                        id: p.id.clone(),
+                        ..prep
+                    },
+                    e.into(),
+                ));
+            }
         }
+    }
+    let mut rejected_ties = HashSet::new();
+    let mut mislabelled: Vec<(String, String, String)> = Vec::new();
+    if !unresected.is_empty() {
+        let placed = tie_start::place_by_tie_points(
+            site,
+            &control,
+            &mut photos,
+            &prepared_by_id,
+            unresected,
+            &mut warnings,
+        );
+        for f in &mut failures {
+            if let Some(reason) = placed.unplaced.get(&f.id) {
+                f.error = format!("{}; {reason}", f.error);
+            }
+        }
+        failures.retain(|f| !placed.prepared.contains_key(&f.id));
+        prepared_by_id.extend(placed.prepared);
+        rejected_ties = placed.rejected_ties;
+        mislabelled = placed.mislabelled;
     }
 
     let mut points = Vec::new();
@@ -311,7 +369,10 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
                     observations: prep
                         .observations
                         .iter()
-                        .filter(|o| !outliers.contains(o.point_id.as_str()))
+                        .filter(|o| {
+                            !outliers.contains(o.point_id.as_str())
+                                && !rejected_ties.contains(&o.point_id)
+                        })
                         .cloned()
                         .collect(),
                     self_calibration: s.estimated,
@@ -378,6 +439,33 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
             )),
         }
     }
+    // A photo placed by tie points has only its start camera unless the bundle adjusted it.
+    if bundle_rms_px.is_none() {
+        let reason = if site.solve.bundle_adjustment {
+            "placed by tie points, but the bundle adjustment that must refine it did not run or failed"
+        } else {
+            "placed by tie points, but solve.bundle_adjustment is off and only the bundle adjustment can refine it"
+        };
+        for s in photos
+            .iter()
+            .filter(|s| s.solved_by == tie_start::SOLVED_BY_TIES)
+        {
+            failures.push(PhotoFailure {
+                id: s.id.clone(),
+                error: reason.to_owned(),
+            });
+        }
+        photos.retain(|s| s.solved_by != tie_start::SOLVED_BY_TIES);
+    }
+    for (photo, a, b) in &mislabelled {
+        if let Some(s) = photos.iter().find(|s| &s.id == photo) {
+            warnings.push(tie_start::which_label_fits(s, a, b));
+        }
+    }
+    #[cfg(feature = "opencv")]
+    for s in &mut photos {
+        s.opencv_check = opencv_pose_check(s, &control, &points);
+    }
     SiteSolution {
         photos,
         failures,
@@ -385,6 +473,48 @@ pub(crate) fn solve_site_with(doc: &SiteDocument, adjust: BundleAdjust) -> SiteS
         bundle_rms_px,
         warnings,
     }
+}
+
+/// OpenCV's `solvePnP` from the adjusted camera on its enabled control and tie observations.
+#[cfg(feature = "opencv")]
+fn opencv_pose_check(
+    s: &PhotoSolution,
+    control: &[ControlPoint],
+    points: &[BundlePointReport],
+) -> Option<PoseCheck> {
+    let pairs: Vec<(Point3<f64>, Point2<f64>)> = s
+        .residuals
+        .iter()
+        .filter(|r| !r.outlier)
+        .filter_map(|r| {
+            let x = control
+                .iter()
+                .find(|c| c.id == r.point_id)
+                .map(|c| c.point_in_world)
+                .or_else(|| {
+                    points
+                        .iter()
+                        .find(|p| p.id == r.point_id)
+                        .map(|p| p.point_in_world)
+                })?;
+            let projected = s.camera.project(&x)?;
+            // The residual is projected − observed.
+            Some((
+                x,
+                Point2::new(
+                    projected.x - r.residual_px[0],
+                    projected.y - r.residual_px[1],
+                ),
+            ))
+        })
+        .collect();
+    crate::features::pnp::pnp_check(&s.camera, &pairs)
+        .ok()
+        .map(|c| PoseCheck {
+            points: c.points,
+            center_difference_m: c.center_difference_m,
+            rotation_difference_deg: c.rotation_difference_deg,
+        })
 }
 
 /// Writes a solution into the site: exterior orientations, refined interiors and tie points.

@@ -1,6 +1,7 @@
 //! The `photomontage` command-line tool.
 
 mod calibrate;
+mod calibrate_opencv;
 mod exchange;
 mod farm;
 mod fit;
@@ -18,6 +19,7 @@ mod solve;
 mod standard_view;
 mod study;
 mod sun;
+mod tie_match;
 mod view_report;
 
 use clap::{Parser, Subcommand};
@@ -106,6 +108,14 @@ enum Command {
     /// sun, sky, luminaires and interreflection, split into direct and indirect (JSON with
     /// `--json`).
     Irradiance(irradiance::Args),
+    /// Tie points by feature matching (SIFT, ratio test, fundamental-matrix RANSAC, tracks),
+    /// written into the site atomically; `solve` then uses them. Needs a build with the
+    /// `opencv` feature.
+    Match(tie_match::Args),
+    /// Lens calibration from chessboard photos (OpenCV's findChessboardCorners, cornerSubPix,
+    /// calibrateCamera): fx, fy, cx, cy, k1, k2, p1, p2, k3 and RMS; the corners as CSV. Needs
+    /// a build with the `opencv` feature.
+    CalibrateOpencv(calibrate_opencv::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -140,5 +150,7 @@ fn main() -> anyhow::Result<()> {
         Command::ImportCameras(args) => exchange::import(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Irradiance(args) => irradiance::run(&args),
+        Command::Match(args) => tie_match::run(&args),
+        Command::CalibrateOpencv(args) => calibrate_opencv::run(&args),
     }
 }

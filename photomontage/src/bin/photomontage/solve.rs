@@ -6,6 +6,9 @@ use photomontage::site::{SiteDocument, apply_solution, solve_site};
 use serde::Serialize;
 use std::path::PathBuf;
 
+/// Tie points listed in the text report.
+const MAX_TIE_LINES: usize = 30;
+
 #[derive(clap::Args)]
 pub struct Args {
     /// The site file (TOML).
@@ -24,6 +27,8 @@ pub struct Args {
 #[derive(Serialize)]
 struct Output<'a> {
     photos: Vec<PhotoRecord<'a>>,
+    /// Per solved photo, OpenCV's solvePnP compared (null without the `opencv` feature).
+    opencv_checks: Vec<Option<photomontage::site::solve::PoseCheck>>,
     failures: &'a [photomontage::site::solve::PhotoFailure],
     tie_points: Vec<&'a photomontage::photogrammetry::BundlePointReport>,
     bundle_rms_px: Option<f64>,
@@ -75,6 +80,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.json {
         let out = Output {
             photos: records,
+            opencv_checks: solution.photos.iter().map(|s| s.opencv_check).collect(),
             failures: &solution.failures,
             tie_points: ties,
             bundle_rms_px: solution.bundle_rms_px,
@@ -83,13 +89,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         };
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        for r in &records {
+        for (r, s) in records.iter().zip(&solution.photos) {
             print_photo(r);
+            if let Some(c) = &s.opencv_check {
+                println!(
+                    "  OpenCV solvePnP check ({} points): centre differs by {:.3e} m, rotation by {:.3e}°",
+                    c.points, c.center_difference_m, c.rotation_difference_deg
+                );
+            }
             println!();
         }
         if !ties.is_empty() {
             println!("tie points:");
-            for t in &ties {
+            // Matched tie points come by the thousand: the first ones and a count in text, all
+            // of them in --json.
+            for t in ties.iter().take(MAX_TIE_LINES) {
                 println!(
                     "  {:<12} X {:.4}  Y {:.4}  Z {:.4}   σ {:.4} {:.4} {:.4} m  ({} rays, RMS {:.2} px)",
                     t.id,
@@ -101,6 +115,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     t.sigma_m[2],
                     t.rays,
                     t.rms_px
+                );
+            }
+            if ties.len() > MAX_TIE_LINES {
+                println!(
+                    "  … and {} more (all in --json)",
+                    ties.len() - MAX_TIE_LINES
                 );
             }
         }
