@@ -177,6 +177,7 @@ pub(super) fn place_by_tie_points(
             estimated: prep.self_calibration,
             solved_by: SOLVED_BY_TIES,
             focal_source: prep.focal_source,
+            radial_pattern: None,
             opencv_check: None,
         });
         placed.prepared.insert(prep.id.clone(), prep);

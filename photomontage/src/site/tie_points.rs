@@ -154,6 +154,7 @@ mod tests {
             id: "a".into(),
             file: "a.jpg".into(),
             taken_at: None,
+            profile: None,
             interior: Some(Interior {
                 focal_px: 100.0,
                 principal_point_px: Some([100.0, 50.0]),
