@@ -61,6 +61,7 @@ fn site_from_list(
             id: id.clone(),
             file: folder.join(image).to_str().expect("UTF-8 path").into(),
             taken_at: None,
+            profile: None,
             interior: None,
             self_calibration: Default::default(),
             exterior: None,
