@@ -436,8 +436,12 @@ impl Transfer {
                 reason: "a transfer needs the hierarchical solver (its links are what is stored)",
             });
         };
-        let mesh = Mesh::build(scene, &params.solve.mesh)?;
+        let mut mesh = Mesh::build(scene, &params.solve.mesh)?;
         let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
+        // As `solve_on_mesh`: element parts covered by a solid standing on them do not emit.
+        if params.solve.form_factors.visibility {
+            super::covered::mark_covered(&mut mesh, &tracer, &params.solve.form_factors);
+        }
         let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
         let (groups, mut warnings) = lighting.light_groups(&dome, params.sky_tolerance)?;
         let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?;
