@@ -217,6 +217,14 @@ fn a_new_site_from_the_sample_photos_calibrates_to_the_cli_cameras() {
             }
             h.run();
             assert_eq!(h.state().selected_point(), Some(o.point.as_str()));
+            // Zoom in on the spot as a user does: A3 and A4 on P2 are 1 px apart, and a click
+            // on a mark selects it instead of placing.
+            *h.state_mut().viewport_mut() = photomontage_studio::viewport::Viewport {
+                zoom: 16.0,
+                centre_px: [o.x_px, o.y_px],
+                fitted: false,
+            };
+            h.run();
             click_photo_px(&mut h, [o.x_px, o.y_px]);
         }
     }
