@@ -156,6 +156,9 @@ fn build(p: &TransferParams) -> Transfer {
     .unwrap()
 }
 
+/// A relight's change, alternating between two states.
+type Change = fn(bool) -> LightingChange;
+
 /// CPU time of this process (all its threads, from each thread's `/proc/self/task/*/schedstat`,
 /// nanosecond resolution), seconds; `None` where there is no such file.
 fn cpu_s() -> Option<f64> {
@@ -268,7 +271,6 @@ fn bench_transfer(c: &mut Criterion) {
         b.iter(|| pool.install(|| direct_irradiance(&engine, &moved, 0)));
     });
     let mut summary = Vec::new();
-    type Change = fn(bool) -> LightingChange;
     for (label, strategy, sweep) in [
         (
             "linear_shooting",

@@ -62,6 +62,7 @@ impl SourceRows {
     }
 }
 
+#[cfg(test)]
 impl SourceRows {
     /// Links whose source is node `n`.
     pub(super) fn row_len(&self, n: usize) -> u64 {

@@ -876,7 +876,7 @@ fn iterate(
     let mut acc = vec![[0.0; 3]; mesh.nodes.len()];
     let leaves = |b: &[Rgb]| -> Vec<Rgb> { mesh.elements.iter().map(|&n| b[n as usize]).collect() };
     for pass in 1..=stop.max_passes {
-            let update = match sweep {
+        let update = match sweep {
             // (Shooting relights do not come here; a full sweep is its fallback.)
             Sweep::GaussSeidel | Sweep::Shooting => {
                 let mut update = 0.0;

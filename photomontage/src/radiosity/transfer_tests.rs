@@ -309,7 +309,11 @@ fn shooting_a_material_change_reads_only_that_materials_links_first() {
     for g in &relit.groups {
         let first = &g.convergence[0];
         assert_eq!(first.interactions, block_links, "{}", g.name);
-        assert!(first.interactions < links / 2, "{} of {links}", first.interactions);
+        assert!(
+            first.interactions < links / 2,
+            "{} of {links}",
+            first.interactions
+        );
     }
     assert!(relit.converged(&STOP));
 }
