@@ -21,11 +21,12 @@
 //!
 //! Iterations start warm: B_start = B₀′ + (ρ′/ρ)·(B − B₀) per element, i.e. the previous
 //! interreflected part carried over (scaled by the ratio of the group's sources under
-//! `LinearResponses`), and run Gauss–Seidel sweeps (patch by patch, sequential) or Jacobi sweeps
-//! (parallel) on the stored links ([`Sweep`]) until the stop rule holds, its mean-change test
-//! measured from the warm start. [`RelightStrategy::WarmGaussSeidel`] is the first way:
-//! every change, scalings included, re-iterates the groups it touches from their previous
-//! solution. Both are measured in docs/benchmarks.md.
+//! `LinearResponses`), and run Gauss–Seidel sweeps (patch by patch, sequential), Jacobi sweeps
+//! (parallel) or ΔB shooting (only the difference from the old solution is passed on, through
+//! the links by source; the default) on the stored links ([`Sweep`]) until the stop rule holds,
+//! its mean-change test measured from the warm start. [`RelightStrategy::WarmGaussSeidel`] is
+//! the first way: every change, scalings included, re-iterates the groups it touches from
+//! their previous solution. All are measured in docs/benchmarks.md.
 //!
 //! Links are stored as compressed rows per receiver node with `f32` factors (the factors'
 //! Monte Carlo error is ~1e-2, their rounding 6e-8); sweeps visit receivers in a fixed order,
@@ -150,14 +151,14 @@ pub struct TransferParams {
 }
 
 impl Default for TransferParams {
-    /// Default solve parameters (hierarchical), sky tolerance 0.1, linear responses with
-    /// Gauss–Seidel sweeps (the faster pair measured in docs/benchmarks.md).
+    /// Default solve parameters (hierarchical), sky tolerance 0.1, linear responses with ΔB
+    /// shooting (the fastest pair measured in docs/benchmarks.md).
     fn default() -> Self {
         Self {
             solve: SolveParams::default(),
             sky_tolerance: 0.1,
             strategy: RelightStrategy::LinearResponses,
-            sweep: Sweep::GaussSeidel,
+            sweep: Sweep::Shooting,
         }
     }
 }
