@@ -17,7 +17,8 @@
 //! stops when its unshot power over its total power is below the residual (a bound on what one
 //! more round would add) and its mean brightness changed by less than the stop rule's mean
 //! change. Rounds are sequential in a fixed order: the result does not depend on the thread
-//! count.
+//! count. A round's convergence row counts the links it read (`interactions`), the same in every
+//! group's row; its residual is the group's unshot power over its total.
 
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
 use super::hierarchical::Link;
