@@ -1,7 +1,8 @@
 //! Precomputed transfer on a city block of ≈ 50 000 elements (16 buildings of 20 × 20 × 15 m on a
 //! 200 m ground): the precompute (mesh, links, form factors, every group's first solve) timed
-//! three times, then relight latency on 2 threads for a sun move, a material change and a
-//! luminaire dimming, with both relight strategies and both sweeps (docs/benchmarks.md).
+//! once (wall and CPU time), then relight latency on 2 threads for a sun move, a material change and a
+//! luminaire dimming, with both relight strategies and every sweep (criterion medians, then a
+//! summary of wall and CPU time per relight and the load average; docs/benchmarks.md).
 #![allow(clippy::unwrap_used)]
 
 use std::sync::atomic::AtomicBool;
@@ -155,35 +156,111 @@ fn build(p: &TransferParams) -> Transfer {
     .unwrap()
 }
 
+/// A relight's change, alternating between two states.
+type Change = fn(bool) -> LightingChange;
+
+/// CPU time of this process (all its threads, from each thread's `/proc/self/task/*/schedstat`,
+/// nanosecond resolution), seconds; `None` where there is no such file.
+fn cpu_s() -> Option<f64> {
+    let mut ns = 0u64;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        ns += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(ns as f64 * 1e-9)
+}
+
+/// The 1-minute load average (`/proc/loadavg`), `None` where there is none.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+fn fmt_opt(v: Option<f64>, scale: f64, unit: &str) -> String {
+    v.map_or_else(|| "n/a".to_owned(), |v| format!("{:.2} {unit}", v * scale))
+}
+
+/// Wall and CPU time of `f`, seconds.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    let (c0, t0) = (cpu_s(), Instant::now());
+    let out = f();
+    let wall = t0.elapsed().as_secs_f64();
+    let cpu = cpu_s().zip(c0).map(|(a, b)| a - b);
+    (out, wall, cpu)
+}
+
+/// `runs` alternating relights: median wall and median CPU time per relight, milliseconds.
+fn wall_and_cpu(
+    pool: &rayon::ThreadPool,
+    t: &mut Transfer,
+    runs: usize,
+    change: impl Fn(bool) -> LightingChange,
+) -> (f64, Option<f64>) {
+    let mut walls = Vec::with_capacity(runs);
+    let mut cpus = Vec::with_capacity(runs);
+    for i in 0..runs {
+        let c = change(i % 2 == 0);
+        let (_, wall, cpu) = timed(|| pool.install(|| t.relight(&c).unwrap()));
+        walls.push(wall * 1e3);
+        cpus.extend(cpu.map(|c| c * 1e3));
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let cpu = (cpus.len() == runs).then(|| median(&mut cpus));
+    (median(&mut walls), cpu)
+}
+
+fn sun_change(flip: bool) -> LightingChange {
+    LightingChange {
+        sun: Some(Some(if flip { sun(0.75, 2.7) } else { sun(0.7, 2.6) })),
+        ..LightingChange::default()
+    }
+}
+
+fn material_change(flip: bool) -> LightingChange {
+    let rho = if flip { [0.7, 0.5, 0.4] } else { [0.6; 3] };
+    LightingChange {
+        material_reflectance: vec![("render".into(), rho)],
+        ..LightingChange::default()
+    }
+}
+
+fn dimming_change(flip: bool) -> LightingChange {
+    LightingChange {
+        luminaire_dimming: vec![("luminaire:street".into(), if flip { 0.5 } else { 1.0 })],
+        ..LightingChange::default()
+    }
+}
+
 fn bench_transfer(c: &mut Criterion) {
     let pool = pool();
-    // Precompute: three timed builds (criterion's minimum of 10 samples would take minutes).
-    let p = params(RelightStrategy::LinearResponses, Sweep::GaussSeidel);
-    let mut times = Vec::new();
-    let mut transfer = None;
-    for _ in 0..3 {
-        let t0 = Instant::now();
-        let t = pool.install(|| build(&p));
-        times.push(t0.elapsed().as_secs_f64());
-        transfer = Some(t);
-    }
-    times.sort_by(f64::total_cmp);
-    let base = transfer.unwrap();
+    println!(
+        "transfer bench: {THREADS} threads, load average at start {}",
+        fmt_opt(load_average(), 1.0, "")
+    );
+    // Precompute: timed once (criterion's minimum of 10 samples would take minutes).
+    let p = params(RelightStrategy::LinearResponses, Sweep::Shooting);
+    let (base, wall, cpu) = timed(|| pool.install(|| build(&p)));
     let s = base.solution();
     println!(
-        "transfer precompute: {} elements, {} patches, {} links; builds {:.2} / {:.2} / {:.2} s (median {:.2} s)",
+        "transfer precompute: {} elements, {} patches, {} links; wall {wall:.2} s, CPU {} \
+         (load average now {})",
         s.mesh.elements.len(),
         s.mesh.patches.len(),
         s.interactions,
-        times[0],
-        times[1],
-        times[2],
-        times[1]
+        fmt_opt(cpu, 1.0, "s"),
+        fmt_opt(load_average(), 1.0, "")
     );
     let mut group = c.benchmark_group("relight_50k");
-    group.sample_size(20);
-    group.warm_up_time(std::time::Duration::from_secs(1));
-    group.measurement_time(std::time::Duration::from_secs(3));
+    group.sample_size(10);
+    group.warm_up_time(std::time::Duration::from_millis(500));
+    group.measurement_time(std::time::Duration::from_secs(2));
     // The sun's direct term alone: one shadow ray per element sample (2 × 2) towards the sun.
     let engine = FormFactorEngine::new(&s.mesh, base.tracer(), p.solve.form_factors).unwrap();
     let moved = [photomontage::radiosity::DistantSource {
@@ -193,7 +270,13 @@ fn bench_transfer(c: &mut Criterion) {
     group.bench_function("sun_retrace_only", |b| {
         b.iter(|| pool.install(|| direct_irradiance(&engine, &moved, 0)));
     });
+    let mut summary = Vec::new();
     for (label, strategy, sweep) in [
+        (
+            "linear_shooting",
+            RelightStrategy::LinearResponses,
+            Sweep::Shooting,
+        ),
         (
             "linear_gauss_seidel",
             RelightStrategy::LinearResponses,
@@ -211,54 +294,29 @@ fn bench_transfer(c: &mut Criterion) {
         ),
     ] {
         let mut t = base.clone().with_strategy(strategy, sweep);
-        let mut flip = false;
-        group.bench_function(format!("{label}/sun_move"), |b| {
-            b.iter(|| {
-                flip = !flip;
-                let s = if flip { sun(0.75, 2.7) } else { sun(0.7, 2.6) };
-                pool.install(|| {
-                    t.relight(&LightingChange {
-                        sun: Some(Some(s)),
-                        ..LightingChange::default()
-                    })
-                    .unwrap()
-                })
+        let changes: [(&str, Change); 3] = [
+            ("sun_move", sun_change),
+            ("material", material_change),
+            ("dimming", dimming_change),
+        ];
+        for (what, change) in changes {
+            let mut flip = false;
+            group.bench_function(format!("{label}/{what}"), |b| {
+                b.iter(|| {
+                    flip = !flip;
+                    let c = change(flip);
+                    pool.install(|| t.relight(&c).unwrap())
+                });
             });
-        });
-        group.bench_function(format!("{label}/material"), |b| {
-            b.iter(|| {
-                flip = !flip;
-                let rho = if flip { [0.7, 0.5, 0.4] } else { [0.6; 3] };
-                pool.install(|| {
-                    t.relight(&LightingChange {
-                        material_reflectance: vec![("render".into(), rho)],
-                        ..LightingChange::default()
-                    })
-                    .unwrap()
-                })
-            });
-        });
-        group.bench_function(format!("{label}/dimming"), |b| {
-            b.iter(|| {
-                flip = !flip;
-                let d = if flip { 0.5 } else { 1.0 };
-                pool.install(|| {
-                    t.relight(&LightingChange {
-                        luminaire_dimming: vec![("luminaire:street".into(), d)],
-                        ..LightingChange::default()
-                    })
-                    .unwrap()
-                })
-            });
-        });
+            let (wall_ms, cpu_ms) = wall_and_cpu(&pool, &mut t, 6, change);
+            summary.push(format!(
+                "{label}/{what}: wall {wall_ms:.2} ms, CPU {} (median of 6, load {})",
+                fmt_opt(cpu_ms, 1.0, "ms"),
+                fmt_opt(load_average(), 1.0, "")
+            ));
+        }
         // Passes of one sun move and one material change (printed for the docs).
-        let s = pool.install(|| {
-            t.relight(&LightingChange {
-                sun: Some(Some(sun(0.8, 2.8))),
-                ..LightingChange::default()
-            })
-            .unwrap()
-        });
+        let s = pool.install(|| t.relight(&sun_change(true)).unwrap());
         let m = pool.install(|| {
             t.relight(&LightingChange {
                 material_reflectance: vec![("brick".into(), [0.5, 0.4, 0.3])],
@@ -266,16 +324,42 @@ fn bench_transfer(c: &mut Criterion) {
             })
             .unwrap()
         });
-        println!(
-            "{label}: sun move {} passes, material change {:?} passes per group",
+        let links = |rows: &[photomontage::radiosity::ConvergenceRow]| -> u64 {
+            rows.iter().map(|r| r.interactions).sum()
+        };
+        summary.push(format!(
+            "{label}: sun move {} passes ({} link reads), material change {:?} passes per group \
+             ({} link reads in all)",
             s.groups[0].convergence.len(),
+            links(&s.groups[0].convergence),
             m.groups
                 .iter()
                 .map(|g| g.convergence.len())
-                .collect::<Vec<_>>()
-        );
+                .collect::<Vec<_>>(),
+            if sweep == Sweep::Shooting {
+                m.groups
+                    .iter()
+                    .map(|g| links(&g.convergence))
+                    .max()
+                    .unwrap_or(0)
+            } else {
+                m.groups.iter().map(|g| links(&g.convergence)).sum()
+            }
+        ));
     }
     group.finish();
+    println!("\n== transfer summary ({THREADS} threads; wall and CPU per relight) ==");
+    println!(
+        "precompute: wall {wall:.2} s, CPU {}",
+        fmt_opt(cpu, 1.0, "s")
+    );
+    for line in summary {
+        println!("{line}");
+    }
+    println!(
+        "load average at the end {}",
+        fmt_opt(load_average(), 1.0, "")
+    );
 }
 
 criterion_group!(benches, bench_transfer);

@@ -173,3 +173,29 @@ fn luminaires_are_light_groups() {
         "{report}"
     );
 }
+
+/// The light groups come from the one site builder (`site_light_groups`): a sun below the
+/// horizon is named as a warning and gives no group, so with the sky weight 0 and no luminaire
+/// nothing lights the site and the command says so.
+#[test]
+fn a_sun_below_the_horizon_is_named_and_lights_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = common::make_site(dir.path());
+    let text = std::fs::read_to_string(&site).unwrap();
+    let start = text.find("sun_manual = {").unwrap();
+    let end = start + text[start..].find('}').unwrap() + 1;
+    let text = format!(
+        "{}sun_manual = {{ azimuth_deg = 180.0, elevation_deg = -5.0 }}{}",
+        &text[..start],
+        &text[end..]
+    );
+    std::fs::write(&site, text).unwrap();
+    let out = photomontage(&["radiosity".as_ref(), site.as_os_str(), "--json".as_ref()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("the sun is below the horizon (elevation -5.00°)"),
+        "{err}"
+    );
+    assert!(err.contains("nothing lights"), "{err}");
+}

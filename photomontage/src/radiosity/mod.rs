@@ -43,6 +43,7 @@ pub mod hierarchical;
 pub mod mesh;
 pub mod progressive;
 pub mod query;
+mod shooting;
 mod solve;
 pub mod sources;
 pub mod transfer;

@@ -21,11 +21,12 @@
 //!
 //! Iterations start warm: B_start = B₀′ + (ρ′/ρ)·(B − B₀) per element, i.e. the previous
 //! interreflected part carried over (scaled by the ratio of the group's sources under
-//! `LinearResponses`), and run Gauss–Seidel sweeps (patch by patch, sequential) or Jacobi sweeps
-//! (parallel) on the stored links ([`Sweep`]) until the stop rule holds, its mean-change test
-//! measured from the warm start. [`RelightStrategy::WarmGaussSeidel`] is the first way:
-//! every change, scalings included, re-iterates the groups it touches from their previous
-//! solution. Both are measured in docs/benchmarks.md.
+//! `LinearResponses`), and run Gauss–Seidel sweeps (patch by patch, sequential), Jacobi sweeps
+//! (parallel) or ΔB shooting (only the difference from the old solution is passed on, through
+//! the links by source; the default) on the stored links ([`Sweep`]) until the stop rule holds,
+//! its mean-change test measured from the warm start. [`RelightStrategy::WarmGaussSeidel`] is
+//! the first way: every change, scalings included, re-iterates the groups it touches from
+//! their previous solution. All are measured in docs/benchmarks.md.
 //!
 //! Links are stored as compressed rows per receiver node with `f32` factors (the factors'
 //! Monte Carlo error is ~1e-2, their rounding 6e-8); sweeps visit receivers in a fixed order,
@@ -48,6 +49,7 @@ use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_cha
 use super::form_factor::FormFactorEngine;
 use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
+use super::shooting::{ShotGroup, SourceRows, shoot};
 use super::solve::{GroundTerm, group_direct, initial_exitance};
 use super::sources::{self, LightWarning, PointSource};
 use super::{
@@ -129,6 +131,10 @@ pub enum Sweep {
     GaussSeidel,
     /// All receivers from the previous sweep's values (parallel).
     Jacobi,
+    /// Only the change is passed on: the difference from the old solution is shot through the
+    /// links by source, from the elements where it is not zero, all groups at once
+    /// (progressive refinement on ΔB; module `radiosity::shooting`).
+    Shooting,
 }
 
 /// Transfer tunables.
@@ -145,14 +151,14 @@ pub struct TransferParams {
 }
 
 impl Default for TransferParams {
-    /// Default solve parameters (hierarchical), sky tolerance 0.1, linear responses with
-    /// Gauss–Seidel sweeps (the faster pair measured in docs/benchmarks.md).
+    /// Default solve parameters (hierarchical), sky tolerance 0.1, linear responses with ΔB
+    /// shooting (the fastest pair measured in docs/benchmarks.md).
     fn default() -> Self {
         Self {
             solve: SolveParams::default(),
             sky_tolerance: 0.1,
             strategy: RelightStrategy::LinearResponses,
-            sweep: Sweep::GaussSeidel,
+            sweep: Sweep::Shooting,
         }
     }
 }
@@ -221,15 +227,15 @@ impl LinkRows {
 
 /// Node topology for iterative push–pull (nodes are in pre-order per scene triangle).
 #[derive(Debug, Clone)]
-struct Topology {
+pub(super) struct Topology {
     /// Parent node, `u32::MAX` for a scene triangle's root.
-    parent: Vec<u32>,
+    pub(super) parent: Vec<u32>,
     /// Area of a node over its parent's.
-    weight: Vec<f64>,
+    pub(super) weight: Vec<f64>,
     /// Per patch, its subtree's node range.
-    patch_ranges: Vec<(usize, usize)>,
+    pub(super) patch_ranges: Vec<(usize, usize)>,
     /// Element areas, m².
-    areas: Vec<f64>,
+    pub(super) areas: Vec<f64>,
 }
 
 impl Topology {
@@ -277,6 +283,8 @@ pub struct Transfer {
     tracer: SceneTracer,
     params: TransferParams,
     rows: LinkRows,
+    /// The same links by source, for [`Sweep::Shooting`].
+    source_rows: SourceRows,
     topology: Topology,
     ground: Option<GroundTerm>,
     dome: IcosahedralDome,
@@ -494,11 +502,13 @@ impl Transfer {
             .map(|s| scene.triangles()[s.scene_triangle].material.0 as usize)
             .collect();
         let rows = LinkRows::new(mesh.nodes.len(), &hierarchy);
+        let source_rows = SourceRows::new(mesh.nodes.len(), &hierarchy.links);
         let topology = Topology::new(&mesh);
         Ok(Self {
             tracer,
             params: params.clone(),
             rows,
+            source_rows,
             topology,
             ground,
             dome,
@@ -708,6 +718,8 @@ impl Transfer {
             .collect();
         solution_warnings.extend(warnings);
         let linear = self.params.strategy == RelightStrategy::LinearResponses;
+        // Groups to iterate: index, new initial exitance, warm start.
+        let mut pending: Vec<(usize, Vec<Rgb>, Vec<Rgb>)> = Vec::new();
         for (g, action) in actions.into_iter().enumerate() {
             let emission = self.groups[g].emission;
             let group = &mut self.solution.groups[g];
@@ -767,26 +779,66 @@ impl Transfer {
                     })
                 })
                 .collect();
-            let (radiosity, rows) = iterate(
+            pending.push((g, b0_new, start));
+        }
+        if self.params.sweep == Sweep::Shooting && !pending.is_empty() {
+            let mesh = &self.solution.mesh;
+            let shot: Vec<ShotGroup<'_>> = pending
+                .iter_mut()
+                .map(|(g, _, start)| ShotGroup {
+                    name: &self.solution.groups[*g].name,
+                    old: &self.solution.groups[*g].radiosity_rgb,
+                    start: std::mem::take(start),
+                })
+                .collect();
+            let results = shoot(
                 mesh,
-                &self.rows,
                 &self.topology,
+                &self.source_rows,
                 &new_rho,
-                &b0_new,
-                &start,
-                &group.name,
+                shot,
                 &self.params.solve.stop,
-                self.params.sweep,
             );
-            group.radiosity_rgb = radiosity;
-            group.convergence = rows;
-            self.b0s[g] = b0_new;
+            for ((g, b0_new, _), (radiosity, rows)) in pending.into_iter().zip(results) {
+                let group = &mut self.solution.groups[g];
+                group.radiosity_rgb = radiosity;
+                group.convergence = rows;
+                self.b0s[g] = b0_new;
+            }
+        } else {
+            for (g, b0_new, start) in pending {
+                let group = &mut self.solution.groups[g];
+                let (radiosity, rows) = iterate(
+                    &self.solution.mesh,
+                    &self.rows,
+                    &self.topology,
+                    &new_rho,
+                    &b0_new,
+                    &start,
+                    &group.name,
+                    &self.params.solve.stop,
+                    self.params.sweep,
+                );
+                group.radiosity_rgb = radiosity;
+                group.convergence = rows;
+                self.b0s[g] = b0_new;
+            }
         }
         self.groups = new_groups;
         self.lighting = lighting;
         self.solution.warnings = solution_warnings;
         self.solution.locator = std::sync::OnceLock::new();
         Ok(self.solution.clone())
+    }
+
+    /// Links whose source node lies on scene object `object` (tests of the shooting relight).
+    #[cfg(test)]
+    pub(super) fn links_from_object(&self, object: &str) -> u64 {
+        let mesh = &self.solution.mesh;
+        (0..mesh.nodes.len())
+            .filter(|&n| mesh.object_name(n) == object)
+            .map(|n| self.source_rows.row_len(n))
+            .sum()
     }
 
     fn element_reflectance(&self) -> Vec<Rgb> {
@@ -826,7 +878,8 @@ fn iterate(
     let leaves = |b: &[Rgb]| -> Vec<Rgb> { mesh.elements.iter().map(|&n| b[n as usize]).collect() };
     for pass in 1..=stop.max_passes {
         let update = match sweep {
-            Sweep::GaussSeidel => {
+            // (Shooting relights do not come here; a full sweep is its fallback.)
+            Sweep::GaussSeidel | Sweep::Shooting => {
                 let mut update = 0.0;
                 for &(lo, hi) in &topology.patch_ranges {
                     for (n, a) in acc.iter_mut().enumerate().take(hi).skip(lo) {

@@ -178,7 +178,8 @@ fn assert_matches_resolve(label: &str, relit: &Solution, full: &Solution) {
     }
 }
 
-const STRATEGIES: [(RelightStrategy, Sweep); 3] = [
+const STRATEGIES: [(RelightStrategy, Sweep); 4] = [
+    (RelightStrategy::LinearResponses, Sweep::Shooting),
     (RelightStrategy::LinearResponses, Sweep::GaussSeidel),
     (RelightStrategy::LinearResponses, Sweep::Jacobi),
     (RelightStrategy::WarmGaussSeidel, Sweep::GaussSeidel),
@@ -245,9 +246,15 @@ fn sun_move_sky_change_and_material_change_match_a_full_resolve() {
 
 #[test]
 fn relight_on_the_same_links_is_the_cold_solve() {
+    for sweep in [Sweep::GaussSeidel, Sweep::Shooting] {
+        relight_on_the_same_links_is_the_cold_solve_with(sweep);
+    }
+}
+
+fn relight_on_the_same_links_is_the_cold_solve_with(sweep: Sweep) {
     // A relight and a cold solve on the stored links (same hierarchy) reach the same fixed point.
     let scene = yard([0.6; 3]);
-    let p = params(RelightStrategy::LinearResponses, Sweep::GaussSeidel);
+    let p = params(RelightStrategy::LinearResponses, sweep);
     let mut t = build(&scene, &lighting(), &p);
     let change = LightingChange {
         sun: Some(Some(sun_at(0.4, 1.2))),
@@ -277,7 +284,38 @@ fn relight_on_the_same_links_is_the_cold_solve() {
         &relit.total_radiosity_rgb(),
         &w,
     );
-    assert!(rel < SAME_LINKS_L1_REL_TOL, "{rel}");
+    assert!(rel < SAME_LINKS_L1_REL_TOL, "{sweep:?}: {rel}");
+}
+
+#[test]
+fn shooting_a_material_change_reads_only_that_materials_links_first() {
+    // Only the block is `render`: the first shooting round reads exactly the links whose source
+    // node lies on the block, far fewer than a sweep over all links.
+    let scene = yard([0.6; 3]);
+    let mut t = build(
+        &scene,
+        &lighting(),
+        &params(RelightStrategy::LinearResponses, Sweep::Shooting),
+    );
+    let links = t.solution().interactions;
+    let relit = t
+        .relight(&LightingChange {
+            material_reflectance: vec![("render".into(), [0.8, 0.3, 0.2])],
+            ..LightingChange::default()
+        })
+        .unwrap();
+    // The links whose source node is on the block: the receivers of its radiosity.
+    let block_links = t.links_from_object("block");
+    for g in &relit.groups {
+        let first = &g.convergence[0];
+        assert_eq!(first.interactions, block_links, "{}", g.name);
+        assert!(
+            first.interactions < links / 2,
+            "{} of {links}",
+            first.interactions
+        );
+    }
+    assert!(relit.converged(&STOP));
 }
 
 #[test]
@@ -316,7 +354,7 @@ fn dimming_and_weights_are_exact_scalings() {
 #[test]
 fn relights_are_bit_identical_on_one_and_two_threads() {
     let scene = yard([0.6; 3]);
-    for sweep in [Sweep::GaussSeidel, Sweep::Jacobi] {
+    for sweep in [Sweep::Shooting, Sweep::GaussSeidel, Sweep::Jacobi] {
         let p = params(RelightStrategy::LinearResponses, sweep);
         let on = |threads: usize| {
             rayon::ThreadPoolBuilder::new()

@@ -13,11 +13,13 @@ use super::luminaires::site_luminaire_lights;
 use super::render::{site_sky_model, site_sun_dir};
 use super::render_error::SiteRenderError;
 use crate::radiosity::{
-    GroundBelowHorizon, NamedLuminaire, PointSource, Sky, Sun, TransferLighting,
+    GroundBelowHorizon, LightGroup, LightWarning, NamedLuminaire, PointSource, Sky, Sun,
+    TransferLighting,
 };
 use crate::render::luminaire_light::ArtificialLight;
 use crate::scene::{ObjectKind, Scene};
 use crate::sky::SkyModel;
+use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
 /// A natural polygon whose normal is within 30° of the zenith is ground (cos 30°).
 pub const GROUND_NORMAL_MIN_Z: f64 = 0.866;
@@ -137,4 +139,61 @@ pub fn site_transfer_lighting(
         },
         notes,
     ))
+}
+
+/// A site's radiosity light groups, as [`site_light_groups`] builds them.
+#[derive(Debug, Clone)]
+pub struct SiteLightGroups {
+    /// The lighting (sun, sky, luminaires, emitters) a transfer is built for.
+    pub lighting: TransferLighting,
+    /// The groups that carry light, in transfer order (sun, sky, each luminaire, emitters).
+    pub groups: Vec<LightGroup>,
+    /// Notes for the user (terms the radiosity ignores).
+    pub notes: Vec<String>,
+    /// Warnings about the sources (the sun below the horizon).
+    pub warnings: Vec<LightWarning>,
+}
+
+/// The one builder of a site's radiosity light groups: [`site_transfer_lighting`]'s lighting
+/// (sun placed for photo `view`) listed as [`TransferLighting::light_groups`] lists it on the
+/// Tonn & Donath dome clustered to `sky_tolerance`, without the groups that carry no light (a
+/// zero `sun_weight` or `sky_weight`, a sun at or below the horizon).
+///
+/// # Errors
+/// Sky model, sun position and luminaire errors; invalid sources or a sky that cannot be
+/// clustered ([`SiteRenderError::Sky`]).
+pub fn site_light_groups(
+    doc: &SiteDocument,
+    scene: &Scene,
+    view: &str,
+    sky_tolerance: f64,
+) -> Result<SiteLightGroups, SiteRenderError> {
+    let (lighting, notes) = site_transfer_lighting(doc, scene, view)?;
+    let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
+    let (groups, warnings) =
+        lighting
+            .light_groups(&dome, sky_tolerance)
+            .map_err(|e| SiteRenderError::Sky {
+                reason: e.to_string(),
+            })?;
+    let groups = groups.into_iter().filter(carries_light).collect();
+    Ok(SiteLightGroups {
+        lighting,
+        groups,
+        notes,
+        warnings,
+    })
+}
+
+/// Whether a group has a source with light or takes the materials' emission.
+fn carries_light(group: &LightGroup) -> bool {
+    group.emission
+        || group
+            .sources
+            .iter()
+            .any(|s| s.normal_irradiance_rgb.iter().any(|&v| v != 0.0))
+        || group
+            .points
+            .iter()
+            .any(|p| p.intensity_rgb.iter().any(|&v| v != 0.0))
 }

@@ -12,9 +12,7 @@ use std::time::Duration;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use photomontage::radiosity::hierarchical::HierarchicalParams;
-use photomontage::radiosity::{
-    QueryParams, RelightStrategy, Solver, Sweep, Transfer, TransferParams, parse_query_points,
-};
+use photomontage::radiosity::{QueryParams, Solver, Transfer, TransferParams, parse_query_points};
 use photomontage::site::SiteDocument;
 use photomontage::site::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
 use photomontage::site::render::site_scene;
@@ -71,8 +69,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             ground,
         )?,
         sky_tolerance: args.solve.sky_tolerance,
-        strategy: RelightStrategy::LinearResponses,
-        sweep: Sweep::GaussSeidel,
+        ..TransferParams::default()
     };
     let query = QueryParams {
         max_interpolation_edge_m: args.max_interpolation_edge_m,

@@ -13,18 +13,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use photomontage::atomic_file::{probe_writable, write_atomically};
 use photomontage::radiosity::convergence::csv;
 use photomontage::radiosity::hierarchical::HierarchicalParams;
-use photomontage::radiosity::sources::sky_sources;
 use photomontage::radiosity::{
-    FormFactorParams, LightGroup, MeshParams, PointSource, SolveParams, Solver, StopRule,
-    luminance, solve,
+    FormFactorParams, MeshParams, SolveParams, Solver, StopRule, luminance, solve,
 };
-use photomontage::render::luminaire_light::ArtificialLight;
 use photomontage::site::SiteDocument;
-use photomontage::site::luminaires::site_luminaire_lights;
-use photomontage::site::radiosity_lighting::site_ground_below_horizon;
-use photomontage::site::render::{site_scene, site_sky_model, site_sun_dir};
-use photomontage::sky::SkyModel;
-use photomontage::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
+use photomontage::site::radiosity_lighting::{site_ground_below_horizon, site_light_groups};
+use photomontage::site::render::site_scene;
 
 use crate::render::{install_cancel, with_threads};
 
@@ -160,65 +154,6 @@ pub fn object_sizes(specs: &[String]) -> anyhow::Result<BTreeMap<String, f64>> {
         .collect()
 }
 
-fn light_groups(doc: &SiteDocument, args: &Args) -> anyhow::Result<Vec<LightGroup>> {
-    let l = &doc.site.lighting;
-    let model = site_sky_model(l.sky_model)?;
-    let sun_weighted = l.sun_weight.iter().any(|&k| k != 0.0);
-    let sky_weighted = l.sky_weight.iter().any(|&k| k != 0.0);
-    let needs_sun = sun_weighted || (sky_weighted && matches!(model, SkyModel::CieGeneral(_)));
-    let view = args.solve.view_id(doc);
-    let sun_dir = if needs_sun {
-        Some(site_sun_dir(doc, &view)?)
-    } else {
-        None
-    };
-    let mut groups = Vec::new();
-    if sun_weighted {
-        match sun_dir.filter(|d| d.z > 0.0) {
-            Some(d) => groups.push(LightGroup::sun(d, l.sun_weight)),
-            None => eprintln!("warning: the sun is below the horizon; no sun group"),
-        }
-    }
-    if sky_weighted {
-        let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
-        let sky_sun = sun_dir.unwrap_or_else(nalgebra::Vector3::z);
-        groups.push(LightGroup::sky(sky_sources(
-            &model,
-            &sky_sun,
-            l.sky_weight,
-            &dome,
-            args.solve.sky_tolerance,
-        )?));
-    }
-    // One group per enabled [[luminaires]] entry, in the site's order (as the renderer lists them).
-    let lights = site_luminaire_lights(doc)?;
-    let names = doc
-        .site
-        .luminaires
-        .iter()
-        .filter(|l| l.enabled)
-        .map(|l| l.id.clone());
-    for (name, light) in names.zip(lights) {
-        let source = match light {
-            ArtificialLight::Point(p) => PointSource {
-                position_in_world_m: p.position_in_world_m,
-                luminaire: None,
-                intensity_rgb: p.intensity_rgb,
-            },
-            ArtificialLight::Luminaire(l) => PointSource {
-                position_in_world_m: l.luminaire.position_in_world,
-                luminaire: Some(l.luminaire.clone()),
-                intensity_rgb: l.rgb_per_cd,
-            },
-        };
-        groups.push(LightGroup::luminaire(&format!("luminaire:{name}"), source));
-    }
-    if l.ambient_weight.iter().any(|&k| k != 0.0) {
-        eprintln!("note: ambient_weight is the renderer's term; the radiosity solve ignores it");
-    }
-    Ok(groups)
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     for path in args
         .mesh_out
@@ -233,13 +168,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for w in &site.warnings {
         eprintln!("warning: {w}");
     }
-    let mut groups = light_groups(&doc, args)?;
-    if site.scene.materials().iter().any(|m| {
-        m.emission_rgb_w_m2_sr
-            .is_some_and(|e| e.iter().any(|&v| v > 0.0))
-    }) {
-        groups.push(LightGroup::emitters());
+    // The one builder of a site's light groups (shared with `irradiance` and the transfer).
+    let lights = site_light_groups(
+        &doc,
+        &site.scene,
+        &args.solve.view_id(&doc),
+        args.solve.sky_tolerance,
+    )?;
+    for w in &lights.warnings {
+        eprintln!("warning: {w}");
     }
+    for n in &lights.notes {
+        eprintln!("note: {n}");
+    }
+    let groups = &lights.groups;
     if groups.is_empty() {
         bail!(
             "nothing lights {}: sun_weight and sky_weight are zero (or the sun is down), no \
@@ -280,7 +222,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     );
     let start = Instant::now();
     let result = with_threads(args.solve.threads, || {
-        Ok(solve(&site.scene, &groups, &params, cancel, &|row| {
+        Ok(solve(&site.scene, groups, &params, cancel, &|row| {
             bar.set_message(format!(
                 "{} pass {}: residual {:.2e}, mean change {:.2e}, {} interactions",
                 row.group, row.pass, row.residual, row.mean_change, row.interactions
@@ -342,6 +284,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .iter()
             .map(ToString::to_string)
             .chain(solution.warnings.iter().map(ToString::to_string))
+            .chain(lights.warnings.iter().map(ToString::to_string))
             .collect::<Vec<_>>(),
     });
     if args.json {

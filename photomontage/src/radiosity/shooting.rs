@@ -1,0 +1,257 @@
+//! ΔB shooting on the stored links: the relight of [`super::transfer::Sweep::Shooting`].
+//!
+//! A relight starts warm at S = B₀′ + (ρ′/ρ)·(B − B₀) (transfer.rs). With the old solution B
+//! at its fixed point (B − B₀ = ρ·F·B), the residual of S is ρ′·F·(S − B): only the difference
+//! D = S − B has not been passed on. D is zero wherever neither ρ nor the direct light changed,
+//! so for a material change it lives on that material's elements only. The exact answer is
+//! B′ = S + Σ_{k≥1} (ρ′F)^k·D, which progressive refinement (Cohen et al. 1988) computes by
+//! *shooting*: D is the unshot radiosity; a round sends the unshot radiosity of the chosen
+//! patches through the links **by source** (a node's unshot value is the area-weighted mean of
+//! its leaves', as a hierarchical link reads it), pushes what each receiver got down to its
+//! leaves (ΔB = ρ′·gathered), adds it to B and makes it the new unshot radiosity. Only links
+//! whose source carries unshot radiosity are read, and all light groups travel together on one
+//! read of each link.
+//!
+//! Each round shoots the patches with the most unshot power (A·|ΔB| in luminance, relative to
+//! each group's total) until what is left is at most half the stop rule's residual; a group
+//! stops when its unshot power over its total power is below the residual (a bound on what one
+//! more round would add) and its mean brightness changed by less than the stop rule's mean
+//! change. Rounds are sequential in a fixed order: the result does not depend on the thread
+//! count. A round's convergence row counts the links it read (`interactions`), the same in every
+//! group's row; its residual is the group's unshot power over its total.
+
+use super::convergence::{ConvergenceRow, StopRule, relative_change};
+use super::hierarchical::Link;
+use super::mesh::Mesh;
+use super::transfer::Topology;
+use super::{Rgb, luminance};
+
+/// The links as compressed rows per **source** node (receiver and factor).
+#[derive(Debug, Clone)]
+pub(super) struct SourceRows {
+    /// Row of node n: `start[n]..start[n + 1]`.
+    start: Vec<u32>,
+    receiver: Vec<u32>,
+    form_factor: Vec<f32>,
+}
+
+impl SourceRows {
+    /// Transposes `links` (any order; rows keep the links' order within a source).
+    #[allow(clippy::cast_possible_truncation)] // at most `max_links` links, node ids are u32
+    pub(super) fn new(nodes: usize, links: &[Link]) -> Self {
+        let mut start = vec![0u32; nodes + 1];
+        for l in links {
+            start[l.source as usize + 1] += 1;
+        }
+        for n in 0..nodes {
+            start[n + 1] += start[n];
+        }
+        let mut next: Vec<u32> = start[..nodes].to_vec();
+        let mut receiver = vec![0u32; links.len()];
+        let mut form_factor = vec![0f32; links.len()];
+        for l in links {
+            let i = next[l.source as usize] as usize;
+            next[l.source as usize] += 1;
+            receiver[i] = l.receiver;
+            form_factor[i] = l.form_factor as f32;
+        }
+        Self {
+            start,
+            receiver,
+            form_factor,
+        }
+    }
+}
+
+#[cfg(test)]
+impl SourceRows {
+    /// Links whose source is node `n`.
+    pub(super) fn row_len(&self, n: usize) -> u64 {
+        u64::from(self.start[n + 1] - self.start[n])
+    }
+}
+
+/// One light group to shoot: its old radiosity and its warm start, per element.
+pub(super) struct ShotGroup<'a> {
+    pub name: &'a str,
+    pub old: &'a [Rgb],
+    pub start: Vec<Rgb>,
+}
+
+/// Shoots D = start − old of every group (module doc) with reflectance `rho` (per element).
+/// Returns each group's radiosity per element and its convergence rows.
+#[allow(clippy::too_many_lines)]
+pub(super) fn shoot(
+    mesh: &Mesh,
+    topology: &Topology,
+    rows: &SourceRows,
+    rho: &[Rgb],
+    groups: Vec<ShotGroup<'_>>,
+    stop: &StopRule,
+) -> Vec<(Vec<Rgb>, Vec<ConvergenceRow>)> {
+    let k = groups.len();
+    let stride = 3 * k;
+    let n_el = mesh.elements.len();
+    let n_nodes = mesh.nodes.len();
+    let node_element = |n: usize| mesh.nodes[n].element;
+    let areas = &topology.areas;
+    let area_sum: f64 = areas.iter().sum();
+    // Leaves: B and the unshot part, `stride` values per element (group-major within).
+    let mut b = vec![0.0; n_el * stride];
+    let mut u = vec![0.0; n_el * stride];
+    for (g, group) in groups.iter().enumerate() {
+        for e in 0..n_el {
+            let (s, o) = (group.start[e], group.old[e]);
+            for c in 0..3 {
+                b[e * stride + 3 * g + c] = s[c];
+                // Bit-equal values have nothing to pass on (D = 0 exactly, not a rounding).
+                if s[c].to_bits() != o[c].to_bits() {
+                    u[e * stride + 3 * g + c] = s[c] - o[c];
+                }
+            }
+        }
+    }
+    let power = |v: &[f64], e: usize, g: usize| -> f64 {
+        let i = e * stride + 3 * g;
+        luminance(&[v[i].abs(), v[i + 1].abs(), v[i + 2].abs()]) * areas[e]
+    };
+    let totals = |b: &[f64]| -> Vec<f64> {
+        (0..k)
+            .map(|g| (0..n_el).map(|e| power(b, e, g)).sum())
+            .collect()
+    };
+    let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
+    let mut previous_mean: Vec<f64> = totals(&b).iter().map(|t| t / area_sum).collect();
+    let mut un = vec![0.0; n_nodes * stride];
+    let mut acc = vec![0.0; n_nodes * stride];
+    let patches = &topology.patch_ranges;
+    for pass in 1..=stop.max_passes {
+        let total = totals(&b);
+        // Unshot power per patch, relative to each group's total.
+        let scale: Vec<f64> = total
+            .iter()
+            .map(|&t| if t > 0.0 { 1.0 / t } else { 0.0 })
+            .collect();
+        let score: Vec<f64> = patches
+            .iter()
+            .map(|&(lo, hi)| {
+                (lo..hi)
+                    .filter_map(node_element)
+                    .map(|e| {
+                        (0..k)
+                            .map(|g| power(&u, e as usize, g) * scale[g])
+                            .sum::<f64>()
+                    })
+                    .sum()
+            })
+            .collect();
+        let unshot: f64 = score.iter().sum();
+        if unshot <= 0.0 {
+            break;
+        }
+        let mut order: Vec<usize> = (0..patches.len()).filter(|&p| score[p] > 0.0).collect();
+        order.sort_by(|&a, &c| score[c].total_cmp(&score[a]).then(a.cmp(&c)));
+        let mut left = unshot;
+        let mut interactions = 0u64;
+        for &p in &order {
+            if left <= 0.5 * stop.residual {
+                break;
+            }
+            left -= score[p];
+            let (lo, hi) = patches[p];
+            // Node values of the unshot part (leaves up), then clear the leaves.
+            for n in (lo..hi).rev() {
+                let (head, tail) = un.split_at_mut((n + 1) * stride);
+                let own = &mut head[n * stride..];
+                if let Some(e) = node_element(n) {
+                    let e = e as usize;
+                    own.copy_from_slice(&u[e * stride..(e + 1) * stride]);
+                    u[e * stride..(e + 1) * stride].fill(0.0);
+                } else {
+                    own.fill(0.0);
+                    for kid in mesh.nodes[n].children.into_iter().flatten() {
+                        let kid = kid as usize;
+                        let w = topology.weight[kid];
+                        let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
+                        for (o, v) in own.iter_mut().zip(kid_vals) {
+                            *o += w * v;
+                        }
+                    }
+                }
+            }
+            for n in lo..hi {
+                let src = &un[n * stride..(n + 1) * stride];
+                if src.iter().all(|&v| v == 0.0) {
+                    continue;
+                }
+                let (a, z) = (rows.start[n] as usize, rows.start[n + 1] as usize);
+                interactions += (z - a) as u64;
+                for (r, f) in rows.receiver[a..z].iter().zip(&rows.form_factor[a..z]) {
+                    let f = f64::from(*f);
+                    let dst = &mut acc[*r as usize * stride..(*r as usize + 1) * stride];
+                    for (d, s) in dst.iter_mut().zip(src) {
+                        *d += f * s;
+                    }
+                }
+            }
+        }
+        // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot.
+        for &(lo, hi) in patches {
+            for n in lo..hi {
+                if n > lo {
+                    let parent = topology.parent[n] as usize;
+                    let (head, tail) = acc.split_at_mut(n * stride);
+                    for (d, s) in tail[..stride]
+                        .iter_mut()
+                        .zip(&head[parent * stride..(parent + 1) * stride])
+                    {
+                        *d += s;
+                    }
+                }
+                if let Some(e) = node_element(n) {
+                    let e = e as usize;
+                    for j in 0..stride {
+                        let db = rho[e][j % 3] * acc[n * stride + j];
+                        b[e * stride + j] += db;
+                        u[e * stride + j] += db;
+                    }
+                }
+            }
+        }
+        acc.fill(0.0);
+        let total = totals(&b);
+        let mut all_met = true;
+        for g in 0..k {
+            let unshot_g: f64 = (0..n_el).map(|e| power(&u, e, g)).sum();
+            let mean = total[g] / area_sum;
+            let row = ConvergenceRow {
+                group: groups[g].name.to_owned(),
+                pass,
+                residual: if total[g] > 0.0 {
+                    unshot_g / total[g]
+                } else {
+                    0.0
+                },
+                mean_change: relative_change(Some(previous_mean[g]), mean),
+                mean_brightness: mean,
+                interactions,
+            };
+            previous_mean[g] = mean;
+            all_met &= stop.met(&row) || mean <= 0.0;
+            out_rows[g].push(row);
+        }
+        if all_met {
+            break;
+        }
+    }
+    out_rows
+        .into_iter()
+        .enumerate()
+        .map(|(g, rows)| {
+            let values = (0..n_el)
+                .map(|e| std::array::from_fn(|c| b[e * stride + 3 * g + c]))
+                .collect();
+            (values, rows)
+        })
+        .collect()
+}
