@@ -433,6 +433,8 @@ pub fn linear_photo(photo: &crate::photo::PhotoImage) -> Rgb32FImage {
 #[cfg(test)]
 mod physics_tests;
 #[cfg(test)]
+mod radiosity_tests;
+#[cfg(test)]
 mod sampling_tests;
 #[cfg(test)]
 mod tests;

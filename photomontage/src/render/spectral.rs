@@ -150,6 +150,8 @@ fn pass_lighting(
 ) -> Result<Lighting, SpectralError> {
     let light = |rgb: Rgb| pick(&conv.light(rgb), bands);
     let mut out = lighting.clone();
+    // The radiosity solutions are RGB: the spectral passes use the facets.
+    out.radiosity = None;
     if let Some(sun) = &mut out.daylight.sun {
         sun.normal_irradiance_rgb = light(sun.normal_irradiance_rgb);
     }
