@@ -390,6 +390,39 @@ mod tests {
     }
 
     #[test]
+    fn radiosity_mode_is_in_the_identity_and_refused_with_spectral_mode() {
+        let mut doc = street();
+        let solution = crate::site::solve_site(&doc);
+        crate::site::apply_solution(&mut doc.site, &solution);
+        let plain = RenderPlan::new(&doc, &RenderRequest::view("V1")).unwrap();
+        assert!(!plain.radiosity && !plain.identity.contains_key("lighting"));
+        let request = RenderRequest {
+            radiosity: true,
+            ..RenderRequest::view("V1")
+        };
+        let plan = RenderPlan::new(&doc, &request).unwrap();
+        assert!(plan.radiosity);
+        assert_eq!(plan.identity["lighting"], "radiosity");
+        // The site's setting turns it on as the request does.
+        let mut on = doc.clone();
+        on.site.render.radiosity = true;
+        assert!(
+            RenderPlan::new(&on, &RenderRequest::view("V1"))
+                .unwrap()
+                .radiosity
+        );
+        let err = RenderPlan::new(
+            &doc,
+            &RenderRequest {
+                spectral: true,
+                ..request
+            },
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("radiosity"), "{err}");
+    }
+
+    #[test]
     fn the_content_hash_follows_the_content_not_the_path() {
         let doc = street();
         let mut moved = doc.clone();
