@@ -208,6 +208,7 @@ impl JobRender {
             spp_max: self.spp_max,
             seed: self.seed,
             spectral: self.spectral,
+            radiosity: false,
             layers: LayerSet::parse(&self.layers)
                 .map_err(|e| FarmError::Argument(e.to_string()))?,
             exposure: self.exposure,

@@ -31,7 +31,8 @@
 //! water materials are treated by their diffuse reflectance only. Elements are a uniform
 //! subdivision (midpoint 1→4 splits to the element size); there is no discontinuity meshing, the
 //! adaptivity is the hierarchical solver's (links at coarser levels where the transfer is small).
-//! The renderer does not use the solution yet. No spectral mode (RGB only). Luminaires are point
+//! The renderer uses the solution only in its opt-in radiosity lighting mode
+//! (`render::differential::radiosity_light`). No spectral mode (RGB only). Luminaires are point
 //! sources. [`transfer`] relights on the links refined for the lighting it was built with.
 
 pub mod convergence;

@@ -191,6 +191,48 @@ impl Solution {
         total
     }
 
+    /// The same solution without the direct irradiance of the groups `exact` names: their
+    /// direct term is taken out of both the direct irradiance and the radiosity
+    /// (B − ρ·E_direct), so [`Solution::irradiance_at`] then gives every other group's light plus
+    /// all interreflected light, theirs included. The differential renderer adds the named
+    /// groups' direct light itself with exact shadow rays (the sun, the luminaires).
+    #[must_use]
+    pub fn without_direct_of(&self, exact: &dyn Fn(&str) -> bool) -> Self {
+        let mesh = &self.mesh;
+        let groups = self
+            .groups
+            .iter()
+            .map(|g| {
+                if !exact(&g.name) {
+                    return g.clone();
+                }
+                let radiosity_rgb = (0..mesh.elements.len())
+                    .map(|e| {
+                        let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+                        std::array::from_fn(|c| {
+                            g.radiosity_rgb[e][c]
+                                - surface.reflectance_rgb[c] * g.direct_irradiance_rgb[e][c]
+                        })
+                    })
+                    .collect();
+                GroupSolution {
+                    name: g.name.clone(),
+                    direct_irradiance_rgb: vec![[0.0; 3]; mesh.elements.len()],
+                    radiosity_rgb,
+                    convergence: g.convergence.clone(),
+                }
+            })
+            .collect();
+        Self {
+            mesh: Arc::clone(&self.mesh),
+            groups,
+            interactions: self.interactions,
+            refinement: self.refinement.clone(),
+            warnings: self.warnings.clone(),
+            locator: std::sync::OnceLock::new(),
+        }
+    }
+
     /// Every convergence row: the refinement's, then each group's.
     #[must_use]
     pub fn convergence(&self) -> Vec<ConvergenceRow> {

@@ -136,6 +136,39 @@ impl Default for RenderSettings {
     }
 }
 
+impl RenderSettings {
+    /// The adaptive sampling rule, after `n` rays of a pixel (a multiple of 4) whose samples
+    /// sum to `sum` and `sum_sq` per channel, `changed` when any of them differed from the
+    /// photo: never beyond `max_rays_per_pixel`; always up to `min_rays_per_pixel`, even when
+    /// no ray so far saw a change (a thin shadow or pole can fall between the first rays, and
+    /// a pixel stops early only once `min_rays_per_pixel` of them missed it); between the two
+    /// only while the pixel changed and the standard error of its mean exceeds
+    /// `max_standard_error`.
+    #[must_use]
+    pub fn wants_more_rays(
+        &self,
+        n: u32,
+        changed: bool,
+        sum: &[f64; 3],
+        sum_sq: &[f64; 3],
+    ) -> bool {
+        if n >= self.max_rays_per_pixel {
+            return false;
+        }
+        if n < self.min_rays_per_pixel {
+            return true;
+        }
+        if !changed {
+            return false;
+        }
+        let nf = f64::from(n);
+        let worst_var = (0..3)
+            .map(|k| ((sum_sq[k] - sum[k] * sum[k] / nf) / (nf - 1.0)).max(0.0))
+            .fold(0.0, f64::max);
+        (worst_var / nf).sqrt() > self.max_standard_error
+    }
+}
+
 /// A finished tile, reported to the progress callback with its pixels (so that a viewer can
 /// show the render progressively).
 #[derive(Debug, Clone, PartialEq)]
@@ -353,17 +386,8 @@ fn render_tile(
                     }
                 }
                 n += 4;
-                if !changed || n >= settings.max_rays_per_pixel {
+                if !settings.wants_more_rays(n, changed, &sum, &sum_sq) {
                     break;
-                }
-                if n >= settings.min_rays_per_pixel {
-                    let nf = f64::from(n);
-                    let worst_var = (0..3)
-                        .map(|k| ((sum_sq[k] - sum[k] * sum[k] / nf) / (nf - 1.0)).max(0.0))
-                        .fold(0.0, f64::max);
-                    if (worst_var / nf).sqrt() <= settings.max_standard_error {
-                        break;
-                    }
                 }
             }
             out.rays += u64::from(n);
@@ -408,5 +432,9 @@ pub fn linear_photo(photo: &crate::photo::PhotoImage) -> Rgb32FImage {
 
 #[cfg(test)]
 mod physics_tests;
+#[cfg(test)]
+mod radiosity_tests;
+#[cfg(test)]
+mod sampling_tests;
 #[cfg(test)]
 mod tests;

@@ -150,6 +150,8 @@ fn pass_lighting(
 ) -> Result<Lighting, SpectralError> {
     let light = |rgb: Rgb| pick(&conv.light(rgb), bands);
     let mut out = lighting.clone();
+    // The radiosity solutions are RGB: the spectral passes use the facets.
+    out.radiosity = None;
     if let Some(sun) = &mut out.daylight.sun {
         sun.normal_irradiance_rgb = light(sun.normal_irradiance_rgb);
     }
@@ -363,17 +365,8 @@ impl Job<'_, '_> {
                         }
                     }
                     n += 4;
-                    if !changed || n >= settings.max_rays_per_pixel {
+                    if !settings.wants_more_rays(n, changed, &sum, &sum_sq) {
                         break;
-                    }
-                    if n >= settings.min_rays_per_pixel {
-                        let nf = f64::from(n);
-                        let worst_var = (0..3)
-                            .map(|k| ((sum_sq[k] - sum[k] * sum[k] / nf) / (nf - 1.0)).max(0.0))
-                            .fold(0.0, f64::max);
-                        if (worst_var / nf).sqrt() <= settings.max_standard_error {
-                            break;
-                        }
                     }
                 }
                 out.rays += u64::from(n);

@@ -23,6 +23,7 @@ pub mod radiosity_lighting;
 pub mod render;
 pub mod render_error;
 pub mod render_photo;
+pub mod render_radiosity;
 mod schema;
 pub mod site_scene;
 pub mod site_time;

@@ -297,6 +297,7 @@ pub fn site_lighting(
             .map(durisch_dome)
             .transpose()?,
         horizon_rgb: l.atmosphere.horizon_colour,
+        radiosity: None,
     };
     Ok((lighting, sun_up))
 }

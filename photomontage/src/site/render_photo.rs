@@ -45,6 +45,8 @@ pub struct RenderRequest {
     pub seed: Option<u64>,
     /// Spectral mode (Durisch's 9 samples); `false` takes the site's `render.spectral`.
     pub spectral: bool,
+    /// Radiosity lighting mode; `false` takes the site's `render.radiosity`.
+    pub radiosity: bool,
     /// Auxiliary EXR layers (RGB mode only).
     pub layers: LayerSet,
     /// Exposure multiplier for 8-bit output.
@@ -63,6 +65,7 @@ impl RenderRequest {
             spp_max: None,
             seed: None,
             spectral: false,
+            radiosity: false,
             layers: LayerSet::default(),
             exposure: None,
             band: Band::WHOLE,
@@ -77,6 +80,8 @@ pub struct RenderPlan {
     pub request: RenderRequest,
     /// Spectral mode on (by the request or the site).
     pub spectral: bool,
+    /// Radiosity lighting mode on (by the request or the site).
+    pub radiosity: bool,
     /// Exposure multiplier for 8-bit output.
     pub exposure: f64,
     /// Whole image size, pixels.
@@ -164,6 +169,13 @@ impl RenderPlan {
                 ),
             ));
         }
+        let radiosity = request.radiosity || doc.site.render.radiosity;
+        if radiosity && spectral {
+            return Err(request_error(
+                "radiosity",
+                "the radiosity lighting mode is RGB only; render without spectral mode".to_owned(),
+            ));
+        }
         let exposure = request.exposure.unwrap_or(doc.site.render.exposure);
         if !(exposure.is_finite() && exposure > 0.0) {
             return Err(request_error(
@@ -177,7 +189,7 @@ impl RenderPlan {
             .pixel_rows(full_size_px[1], settings.tile_size_px)
             .map_err(|e| request_error("tile", format!("view {}: {e}", request.view)))?;
         let mode = if spectral { "spectral Durisch9" } else { "rgb" };
-        let identity: BTreeMap<String, String> = [
+        let mut identity: BTreeMap<String, String> = [
             ("site_sha256", site_content_sha256(doc)?),
             ("view", request.view.clone()),
             ("mode", mode.to_owned()),
@@ -202,9 +214,13 @@ impl RenderPlan {
         .into_iter()
         .map(|(k, v)| (k.to_owned(), v))
         .collect();
+        if radiosity {
+            identity.insert("lighting".to_owned(), "radiosity".to_owned());
+        }
         Ok(Self {
             request: request.clone(),
             spectral,
+            radiosity,
             exposure,
             full_size_px,
             rows_px: [rows.start, rows.end],
@@ -256,6 +272,18 @@ impl RenderPlan {
     ) -> Result<RenderedPhoto, SiteRenderError> {
         let mut job = prepare_view(doc, &self.request.view)?;
         edit(&mut job.scene.scene)?;
+        let radiosity = if self.radiosity {
+            let (light, report) = super::render_radiosity::site_radiosity_arc(
+                doc,
+                &job.scene.scene,
+                &self.request.view,
+                cancel,
+            )?;
+            job.lighting.radiosity = Some(light);
+            Some(report)
+        } else {
+            None
+        };
         let tracer = DifferentialTracer::new(
             &job.scene.scene,
             &job.lighting,
@@ -298,6 +326,7 @@ impl RenderPlan {
                 .collect(),
             sun_dir_in_world: job.sun_dir_in_world,
             warnings,
+            radiosity,
         })
     }
 
@@ -336,6 +365,8 @@ pub struct RenderedPhoto {
     pub sun_dir_in_world: Option<Vector3<f64>>,
     /// Scene warnings and setting adjustments.
     pub warnings: Vec<SiteWarning>,
+    /// The radiosity precompute, in the radiosity lighting mode.
+    pub radiosity: Option<super::render_radiosity::RadiosityReport>,
 }
 
 #[cfg(test)]
@@ -356,6 +387,39 @@ mod tests {
         assert!(matches!(err, SiteRenderError::NotSolved { .. }), "{err}");
         let err = RenderPlan::new(&doc, &RenderRequest::view("nope")).unwrap_err();
         assert!(err.to_string().contains("nope"), "{err}");
+    }
+
+    #[test]
+    fn radiosity_mode_is_in_the_identity_and_refused_with_spectral_mode() {
+        let mut doc = street();
+        let solution = crate::site::solve_site(&doc);
+        crate::site::apply_solution(&mut doc.site, &solution);
+        let plain = RenderPlan::new(&doc, &RenderRequest::view("V1")).unwrap();
+        assert!(!plain.radiosity && !plain.identity.contains_key("lighting"));
+        let request = RenderRequest {
+            radiosity: true,
+            ..RenderRequest::view("V1")
+        };
+        let plan = RenderPlan::new(&doc, &request).unwrap();
+        assert!(plan.radiosity);
+        assert_eq!(plan.identity["lighting"], "radiosity");
+        // The site's setting turns it on as the request does.
+        let mut on = doc.clone();
+        on.site.render.radiosity = true;
+        assert!(
+            RenderPlan::new(&on, &RenderRequest::view("V1"))
+                .unwrap()
+                .radiosity
+        );
+        let err = RenderPlan::new(
+            &doc,
+            &RenderRequest {
+                spectral: true,
+                ..request
+            },
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("radiosity"), "{err}");
     }
 
     #[test]

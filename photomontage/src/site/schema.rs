@@ -472,6 +472,10 @@ pub struct RenderSettings {
     pub spectral: bool,
     /// Reflection/refraction recursion limit.
     pub max_depth: u32,
+    /// Radiosity lighting mode: sky and interreflected light from radiosity solutions of the
+    /// site with and without the planned objects (docs/methodology.md).
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub radiosity: bool,
     /// Exposure multiplier applied before 8-bit output.
     pub exposure: f64,
 }
@@ -484,6 +488,7 @@ impl Default for RenderSettings {
             seed: 0,
             spectral: false,
             max_depth: 4,
+            radiosity: false,
             exposure: 1.0,
         }
     }

@@ -46,6 +46,10 @@ pub struct Args {
     /// is true); about 3× the time. Not combinable with --layers.
     #[arg(long)]
     spectral: bool,
+    /// Radiosity lighting mode: sky and interreflected light from radiosity solutions of the
+    /// site with and without the planned objects (also when the site's render.radiosity is true).
+    #[arg(long)]
+    radiosity: bool,
     /// Extra EXR layers, comma-separated: depth, object_id, shadow_change.
     #[arg(long, value_name = "LIST", default_value = "")]
     layers: String,
@@ -182,6 +186,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         spp_max: args.spp_max,
         seed: args.seed,
         spectral: args.spectral,
+        radiosity: args.radiosity,
         layers,
         exposure: args.exposure,
         band: band.unwrap_or(Band::WHOLE),
@@ -284,6 +289,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "  changed pixels {} ({changed_pct:.1} %), {rays_per_pixel:.2} rays/pixel, {elapsed_s:.2} s",
         image.changed_pixels
     );
+    if let Some(r) = &rendered.radiosity {
+        println!(
+            "  radiosity precompute {:.2} s (included above): {} / {} elements with / without the \
+             planned objects, {:.2} m element edge",
+            r.seconds, r.elements[0], r.elements[1], r.element_edge_m
+        );
+        for note in &r.notes {
+            println!("  radiosity note: {note}");
+        }
+    }
     match rendered.sun_dir_in_world {
         Some(d) => println!(
             "  sun elevation {:.2}°, grid azimuth {:.2}°",

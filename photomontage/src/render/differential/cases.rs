@@ -10,6 +10,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::glass::PhotoBehind;
+use super::radiosity_light::RadiosityLight;
 use super::specular::{SurfaceFrame, reflect_above};
 use super::{DifferentialTracer, PrimaryHit, RaySample, SURFACE_OFFSET_M};
 use crate::render::illumination::{
@@ -19,6 +20,13 @@ use crate::render::illumination::{
 use crate::render::irradiance_cache::GatherKind;
 use crate::render::water::shading_normal;
 use crate::scene::{ObjectKind, SceneHit};
+
+/// A natural point's photographed apparent colour and the distance it was photographed from.
+#[derive(Debug, Clone, Copy)]
+struct PhotoSeen {
+    rgb: Rgb,
+    distance_m: f64,
+}
 
 impl DifferentialTracer<'_> {
     /// Traces a primary ray through a sample of the pixel whose photo value is `photo_pixel_rgb`
@@ -130,16 +138,29 @@ impl DifferentialTracer<'_> {
         let rho = material.map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
         let daylight = &self.lighting.daylight;
         let sun_passed = self.sun_transmittance(&origin, &normal);
-        let e_natural =
-            natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |i| {
+        // Radiosity mode: sky and every bounce from the solution with the artificial objects.
+        let e_radiosity = self
+            .lighting
+            .radiosity
+            .as_ref()
+            .and_then(|r| r.with_at(point, &normal));
+        let e_natural = match e_radiosity {
+            Some(e_rad) => add(
+                natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |_| {
+                    [0.0; 3]
+                }),
+                e_rad,
+            ),
+            None => natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |i| {
                 self.light_transmittance(&origin, &daylight.sky[i].dir_in_world, f64::INFINITY)
-            });
+            }),
+        };
         let lights = self.visible_artificial_lights(point, &origin, &normal);
         let mut e = add(
             e_natural,
             Self::artificial_light_irradiance(&lights, &shading_normal).0,
         );
-        if depth < self.max_depth {
+        if depth < self.max_depth && e_radiosity.is_none() {
             e = add(
                 e,
                 self.cached_photo_bounce(GatherKind::ArtificialPoint, &origin, &shading_normal),
@@ -217,6 +238,26 @@ impl DifferentialTracer<'_> {
         distance_m: f64,
     ) -> (Rgb, bool) {
         let normal = self.normal_facing(hit, dir_in_world);
+        if let Some(radiosity) = &self.lighting.radiosity
+            && let (Some(e_with), Some(e_without)) = (
+                radiosity.with_at(point, &normal),
+                radiosity.without_at(point, &normal),
+            )
+        {
+            let photo = PhotoSeen {
+                rgb: photo_rgb,
+                distance_m: photo_distance_m,
+            };
+            return self.case_d_radiosity(
+                hit,
+                point,
+                &normal,
+                photo,
+                distance_m,
+                [e_with, e_without],
+                radiosity.as_ref(),
+            );
+        }
         let origin = point + normal * SURFACE_OFFSET_M;
         let daylight = &self.lighting.daylight;
         let inf = f64::INFINITY;
@@ -293,6 +334,65 @@ impl DifferentialTracer<'_> {
             ),
         );
         self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m)
+    }
+
+    /// Case D in the radiosity mode ([`super::radiosity_light`]): `e_rad` holds the sky and
+    /// interreflected irradiance at the point with and without the artificial objects.
+    #[allow(clippy::too_many_arguments)]
+    fn case_d_radiosity(
+        &self,
+        hit: &SceneHit,
+        point: &Point3<f64>,
+        normal: &Vector3<f64>,
+        photo: PhotoSeen,
+        distance_m: f64,
+        e_rad: [Rgb; 2],
+        radiosity: &RadiosityLight,
+    ) -> (Rgb, bool) {
+        let [e_with, e_without] = e_rad;
+        let origin = point + normal * SURFACE_OFFSET_M;
+        let daylight = &self.lighting.daylight;
+        let inf = f64::INFINITY;
+        // D3 for the sun, exact: blocked by an artificial object and by no natural one.
+        let sun_d3 = daylight.sun.as_ref().and_then(|s| {
+            if s.dir_in_world.dot(normal) <= 0.0 {
+                return None;
+            }
+            let passed = self.artificial_transmittance(&origin, &s.dir_in_world, inf);
+            (passed.iter().any(|&x| x < 1.0) && !self.natural_blocks(&origin, &s.dir_in_world, inf))
+                .then(|| passed.map(|x| 1.0 - x))
+        });
+        let (e_d1, lit_d1) = Self::artificial_light_irradiance(
+            &self.visible_artificial_lights(point, &origin, normal),
+            normal,
+        );
+        let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
+            s.dir_in_world.dot(normal) > 0.0 && !self.natural_blocks(&origin, &s.dir_in_world, inf)
+        });
+        let e_natural = add(
+            natural_irradiance_rgb(daylight, normal, sun_natural, |_| false),
+            e_without,
+        );
+        let e_change = add(e_with, scale(e_without, -1.0));
+        let unchanged = sun_d3.is_none() && !lit_d1 && !radiosity.is_change(&e_change, &e_natural);
+        if unchanged {
+            if photo.distance_m.to_bits() == distance_m.to_bits() {
+                return (photo.rgb, false);
+            }
+            let l0 = self.true_colour(photo.rgb, photo.distance_m);
+            return (self.apparent(l0, distance_m), false);
+        }
+        let l0 = self.true_colour(photo.rgb, photo.distance_m);
+        let rho = diffuse_reflectance_from_true_colour(l0, e_natural).unwrap_or_else(|| {
+            self.material_of(hit)
+                .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb)
+        });
+        let mut e_d3 = [0.0; 3];
+        if let (Some(blocked), Some(s)) = (sun_d3, &daylight.sun) {
+            e_d3 = mul(s.irradiance_rgb(normal), blocked);
+        }
+        let delta = diffuse_radiance_rgb(rho, add(add(e_d1, e_change), scale(e_d3, -1.0)));
+        self.changed_apparent(photo.rgb, l0, delta, photo.distance_m, distance_m)
     }
 
     /// The apparent colour after adding `delta` to the true colour `l0`: along the photo's own

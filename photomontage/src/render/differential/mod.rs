@@ -60,6 +60,7 @@ use nalgebra::{Point2, Point3};
 mod cases;
 pub mod glass;
 mod interreflection;
+pub mod radiosity_light;
 mod shading;
 pub mod specular;
 mod visibility;
@@ -111,6 +112,10 @@ pub struct Lighting {
     /// Horizon colour L∞ returned by case B (when there is no atmosphere, the sky colour seen in
     /// mirrors).
     pub horizon_rgb: Rgb,
+    /// The radiosity lighting mode ([`radiosity_light`]): sky and interreflected light from
+    /// solutions with and without the artificial objects instead of the sky facets and the
+    /// photo bounce. `None`: the facet mode.
+    pub radiosity: Option<std::sync::Arc<radiosity_light::RadiosityLight>>,
 }
 
 /// What one ray returned.

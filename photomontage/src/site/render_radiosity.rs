@@ -1,0 +1,153 @@
+//! The site's radiosity solutions for the renderer's radiosity mode (`[render] radiosity = true`,
+//! `render --radiosity`; [`crate::render::differential::radiosity_light`]): the site scene is
+//! solved twice with the site's light groups ([`super::radiosity_lighting`]), once with natural
+//! objects only (the photographed state, without the project's luminaires) and once with
+//! everything.
+//!
+//! Elements are [`ELEMENT_EDGE_M`] long, or longer where the scene's area would need more than
+//! [`ELEMENT_BUDGET`] of them (the size is then √(area / budget), stated in the report); patches
+//! are [`PATCH_PER_ELEMENT`] elements long. The hierarchical solver and the seed's stop rule of
+//! [`SolveParams::default`] are used.
+//!
+//! # Known limitations
+//! Both solves run before every render (no cache between renders of the same site); a large
+//! ground plane takes the element size up for every object, blurring the sky a building blocks
+//! over that size (docs/methodology.md).
+
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use super::SiteDocument;
+use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
+use super::render_error::SiteRenderError;
+use crate::radiosity::{MeshParams, SolveParams, solve};
+use crate::render::differential::radiosity_light::RadiosityLight;
+use crate::scene::{ObjectKind, Scene, SceneError};
+use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
+
+/// Longest element edge where the budget allows, metres.
+pub const ELEMENT_EDGE_M: f64 = 1.0;
+/// At most about this many elements per solve (the scene's area over the element area).
+pub const ELEMENT_BUDGET: f64 = 20_000.0;
+/// Patch edge in element edges (the hierarchy's roots).
+pub const PATCH_PER_ELEMENT: f64 = 4.0;
+/// Sky clustering tolerance of the icosahedral dome (as the `radiosity` CLI's default).
+pub const SKY_TOLERANCE: f64 = 0.1;
+
+/// What the precompute did, for reports and benches.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadiosityReport {
+    /// Element edge used, metres.
+    pub element_edge_m: f64,
+    /// Elements of the solve with / without the artificial objects.
+    pub elements: [usize; 2],
+    /// Wall time of both solves, seconds.
+    pub seconds: f64,
+    /// Notes for the user (terms the solve ignores).
+    pub notes: Vec<String>,
+}
+
+/// The natural objects of `scene` alone (materials, names and triangle order kept).
+///
+/// # Errors
+/// Scene id overflow (not reachable from a valid scene).
+pub fn natural_part(scene: &Scene) -> Result<Scene, SceneError> {
+    let mut out = Scene::new();
+    for m in scene.materials() {
+        out.add_material(m.clone())?;
+    }
+    let mut ids = Vec::with_capacity(scene.objects().len());
+    for o in scene.objects() {
+        ids.push(if o.kind == ObjectKind::Natural {
+            Some(out.add_object(o.clone())?)
+        } else {
+            None
+        });
+    }
+    for t in scene.triangles() {
+        if let Some(Some(id)) = ids.get(t.object.0 as usize) {
+            out.add_polygon(&t.vertices_in_world_m, t.material, *id)?;
+        }
+    }
+    Ok(out)
+}
+
+fn area_m2(scene: &Scene) -> f64 {
+    scene
+        .triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.vertices_in_world_m;
+            (b - a).cross(&(c - a)).norm() / 2.0
+        })
+        .sum()
+}
+
+fn radiosity_error(e: &crate::radiosity::RadiosityError) -> SiteRenderError {
+    SiteRenderError::Request {
+        field: "render.radiosity",
+        reason: e.to_string(),
+    }
+}
+
+/// Solves the site scene `scene` (natural and artificial objects, as rendered) with and without
+/// its artificial objects under the lighting of photo `view` (module doc).
+///
+/// # Errors
+/// The lighting's errors; a solve error (a scene too large, a bad source) as
+/// [`SiteRenderError::Request`] naming `render.radiosity`.
+pub fn site_radiosity_light(
+    doc: &SiteDocument,
+    scene: &Scene,
+    view: &str,
+    cancel: &AtomicBool,
+) -> Result<(RadiosityLight, RadiosityReport), SiteRenderError> {
+    let start = Instant::now();
+    let (lighting, notes) = site_transfer_lighting(doc, scene, view)?;
+    let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
+    let (groups, _warnings) = lighting
+        .light_groups(&dome, SKY_TOLERANCE)
+        .map_err(|e| radiosity_error(&e))?;
+    let natural = natural_part(scene)?;
+    let element_edge_m = ELEMENT_EDGE_M.max((area_m2(scene) / ELEMENT_BUDGET).sqrt());
+    let params = SolveParams {
+        mesh: MeshParams {
+            max_patch_edge_m: PATCH_PER_ELEMENT * element_edge_m,
+            max_element_edge_m: element_edge_m,
+            ..MeshParams::default()
+        },
+        ground: site_ground_below_horizon(doc, scene)?,
+        ..SolveParams::default()
+    };
+    let with = solve(scene, &groups, &params, cancel, &|_| {}).map_err(|e| radiosity_error(&e))?;
+    // The photographed state has none of the project's luminaires.
+    let natural_groups: Vec<_> = groups
+        .iter()
+        .filter(|g| !g.name.starts_with("luminaire"))
+        .cloned()
+        .collect();
+    let without = solve(&natural, &natural_groups, &params, cancel, &|_| {})
+        .map_err(|e| radiosity_error(&e))?;
+    let report = RadiosityReport {
+        element_edge_m,
+        elements: [with.mesh.elements.len(), without.mesh.elements.len()],
+        seconds: start.elapsed().as_secs_f64(),
+        notes,
+    };
+    let light = RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly);
+    Ok((light, report))
+}
+
+/// [`site_radiosity_light`] shared behind an [`Arc`] for [`crate::render::Lighting::radiosity`].
+///
+/// # Errors
+/// As [`site_radiosity_light`].
+pub fn site_radiosity_arc(
+    doc: &SiteDocument,
+    scene: &Scene,
+    view: &str,
+    cancel: &AtomicBool,
+) -> Result<(Arc<RadiosityLight>, RadiosityReport), SiteRenderError> {
+    site_radiosity_light(doc, scene, view, cancel).map(|(l, r)| (Arc::new(l), r))
+}

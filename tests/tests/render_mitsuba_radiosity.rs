@@ -1,0 +1,225 @@
+//! The differential renderer in its radiosity lighting mode against Mitsuba 3 (issue 13
+//! acceptance, "montage accuracy with the radiosity path on"): as `render_mitsuba.rs`, with the
+//! sky and every bounce taken from radiosity solutions of the pair scene with and without the
+//! box instead of the sky facets and the photo-bounce gathers.
+//!
+//! The radiosity mesh is the render scene's with the 1000 m ground cut into a fine square
+//! around the box ([`NEAR_HALF_M`], elements of [`NEAR_ELEMENT_M`]) and a coarse ring
+//! ([`FAR_ELEMENT_M`]), the same plane, so that the element budget goes where the box changes
+//! the light. The images are box-filtered 4 × 4 as in `render_mitsuba.rs`.
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::Point3;
+use photomontage::peer_scene::{MAX_DEPTH, mitsuba_pair_scene};
+use photomontage::radiosity::{DistantSource, LightGroup, MeshParams, SolveParams, solve};
+use photomontage::render::differential::radiosity_light::RadiosityLight;
+use photomontage::render::{DifferentialTracer, RenderSettings, render_view};
+use photomontage::scene::{ObjectKind, Scene, SceneObject};
+use photomontage_tests::shared_file;
+use photomontage_tests::street::downscale;
+use serde_json::Value;
+
+const SCALE: u32 = 4;
+/// Half-size of the finely meshed ground square around the box, metres (the box's shadow at
+/// 35° sun elevation reaches 17 m beyond its 9 m half-diagonal).
+const NEAR_HALF_M: f64 = 40.0;
+/// Element edge near the box and on it, metres.
+const NEAR_ELEMENT_M: f64 = 1.0;
+/// Element edge of the ground ring out to 500 m, metres.
+const FAR_ELEMENT_M: f64 = 25.0;
+/// Box pixels, mean relative error: a regression bound above the measurement, NOT yet the
+/// issue's goal (at or below the facet mode's 2.0 %, `render_mitsuba.rs`). Measured 2026-11-24:
+/// 4.9 % with a signed mean of −0.06 %, i.e. unbiased but noisier than the facet mode, which
+/// points at element-to-element noise of the 4 × 4-sample form factors on 1 m elements.
+const BOX_MEAN_REL_TOL: f64 = 0.055;
+/// Shadow pixels: a regression bound, NOT yet the goal (facet mode 2.0 %). Measured 3.1 %
+/// (signed −2.0 %: the shadow comes out slightly dark).
+const SHADOW_MEAN_REL_TOL: f64 = 0.035;
+
+/// The render scene with the ground (object 0, the pair's only natural object) cut into the
+/// near square and the far ring.
+fn radiosity_scene(scene: &Scene, with_box: bool) -> Scene {
+    let mut out = Scene::new();
+    for m in scene.materials() {
+        out.add_material(m.clone()).unwrap();
+    }
+    let ground_material = scene.triangles()[0].material;
+    let g = 500.0;
+    let n = NEAR_HALF_M;
+    let near = out
+        .add_object(SceneObject {
+            name: "ground_near".into(),
+            kind: ObjectKind::Natural,
+            image_attribute: None,
+        })
+        .unwrap();
+    let far = out
+        .add_object(SceneObject {
+            name: "ground_far".into(),
+            kind: ObjectKind::Natural,
+            image_attribute: None,
+        })
+        .unwrap();
+    let quad = |x0: f64, y0: f64, x1: f64, y1: f64| {
+        [[x0, y0], [x1, y0], [x1, y1], [x0, y1]].map(|[x, y]| Point3::new(x, y, 0.0))
+    };
+    out.add_polygon(&quad(-n, -n, n, n), ground_material, near)
+        .unwrap();
+    for q in [
+        quad(-g, -g, g, -n),
+        quad(-g, n, g, g),
+        quad(-g, -n, -n, n),
+        quad(n, -n, g, n),
+    ] {
+        out.add_polygon(&q, ground_material, far).unwrap();
+    }
+    if with_box {
+        let o = out.add_object(scene.objects()[1].clone()).unwrap();
+        for t in scene
+            .triangles()
+            .iter()
+            .filter(|t| scene.objects()[t.object.0 as usize].kind == ObjectKind::Artificial)
+        {
+            out.add_polygon(&t.vertices_in_world_m, t.material, o)
+                .unwrap();
+        }
+    }
+    out
+}
+
+#[test]
+fn box_and_shadow_match_mitsuba_1024spp_in_radiosity_mode() {
+    let (Some(json), Some(photo_path), Some(truth_path)) = (
+        shared_file("bench/data/mitsuba/scene.json"),
+        shared_file("bench/data/mitsuba/llvm_ad_rgb_1024spp_without_box.exr"),
+        shared_file("bench/data/mitsuba/llvm_ad_rgb_1024spp_with_box.exr"),
+    ) else {
+        return;
+    };
+    let spec: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let load = |p: &Path| photomontage::photo::load(p).unwrap().pixels;
+    let photo = downscale(&load(&photo_path), SCALE);
+    let truth = downscale(&load(&truth_path), SCALE);
+    let (w, h) = (photo.width(), photo.height());
+    let peer = mitsuba_pair_scene(&spec, [w, h]).unwrap();
+    let (scene, camera, mut lighting) = (peer.scene, peer.camera, peer.lighting);
+
+    let sun = lighting.daylight.sun.unwrap();
+    let groups = vec![
+        LightGroup::sun(sun.dir_in_world, sun.normal_irradiance_rgb),
+        LightGroup::sky(
+            lighting
+                .daylight
+                .sky
+                .iter()
+                .map(|f| DistantSource {
+                    dir_in_world: f.dir_in_world,
+                    normal_irradiance_rgb: f.normal_irradiance_rgb,
+                })
+                .collect(),
+        ),
+    ];
+    let start = std::time::Instant::now();
+    let solve_scene = |with_box: bool| {
+        let mut sizes: std::collections::BTreeMap<String, f64> = [
+            ("ground_near".to_owned(), NEAR_ELEMENT_M),
+            ("ground_far".to_owned(), FAR_ELEMENT_M),
+        ]
+        .into_iter()
+        .collect();
+        if with_box {
+            sizes.insert(scene.objects()[1].name.clone(), NEAR_ELEMENT_M);
+        }
+        let params = SolveParams {
+            mesh: MeshParams {
+                max_patch_edge_m: FAR_ELEMENT_M,
+                max_element_edge_m: FAR_ELEMENT_M,
+                object_element_edge_m: sizes,
+                ..MeshParams::default()
+            },
+            ..SolveParams::default()
+        };
+        solve(
+            &radiosity_scene(&scene, with_box),
+            &groups,
+            &params,
+            &AtomicBool::new(false),
+            &|_| {},
+        )
+        .unwrap()
+    };
+    let (with, without) = (solve_scene(true), solve_scene(false));
+    let precompute_s = start.elapsed().as_secs_f64();
+    lighting.radiosity = Some(Arc::new(RadiosityLight::new(
+        &with,
+        &without,
+        &RadiosityLight::traced_exactly,
+    )));
+    let tracer = DifferentialTracer::new(&scene, &lighting, &camera, &photo, MAX_DEPTH).unwrap();
+    let start = std::time::Instant::now();
+    let out = render_view(
+        &tracer,
+        &RenderSettings::default(),
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let render_s = start.elapsed().as_secs_f64();
+
+    let (mut box_err, mut box_n, mut shadow_err, mut shadow_n, mut sq) = (0.0, 0, 0.0, 0, 0.0);
+    let (mut box_bias, mut shadow_bias) = (0.0, 0.0);
+    for y in 0..h {
+        for x in 0..w {
+            let ours = out.rgba[(y * w + x) as usize];
+            let t = truth.get_pixel(x, y).0;
+            let p = photo.get_pixel(x, y).0;
+            let err = |k: usize| (f64::from(ours[k]) - f64::from(t[k])) / f64::from(t[k]).max(1e-3);
+            let rel = (0..3).map(|k| err(k).abs()).sum::<f64>() / 3.0;
+            let signed = (0..3).map(err).sum::<f64>() / 3.0;
+            sq += (0..3)
+                .map(|k| (f64::from(ours[k]) - f64::from(t[k])).powi(2))
+                .sum::<f64>();
+            let lum = |v: [f32; 3]| v.iter().map(|&c| f64::from(c)).sum::<f64>();
+            if ours[3] >= 1.0 {
+                box_err += rel;
+                box_bias += signed;
+                box_n += 1;
+            } else if ours[3] <= 0.0 && lum(t) < 0.8 * lum(p) {
+                shadow_err += rel;
+                shadow_bias += signed;
+                shadow_n += 1;
+            }
+        }
+    }
+    let box_mre = box_err / f64::from(box_n);
+    let shadow_mre = shadow_err / f64::from(shadow_n);
+    let rmse = (sq / f64::from(3 * w * h)).sqrt();
+    println!(
+        "mitsuba radiosity {w}x{h}: elements {} / {}, precompute {precompute_s:.2} s, render \
+         {render_s:.2} s; box pixels {box_n} mean rel err {box_mre:.4}; shadow pixels {shadow_n} \
+         mean rel err {shadow_mre:.4}; signed: box {:+.4}, shadow {:+.4}; RMSE {rmse:.5}; \
+         changed pixels {}; rays/pixel {:.2}",
+        with.mesh.elements.len(),
+        without.mesh.elements.len(),
+        box_bias / f64::from(box_n),
+        shadow_bias / f64::from(shadow_n),
+        out.changed_pixels,
+        out.primary_rays as f64 / f64::from(w * h)
+    );
+    assert!(
+        box_n > 1000 && shadow_n > 300,
+        "masks: {box_n} box, {shadow_n} shadow"
+    );
+    assert!(
+        box_mre <= BOX_MEAN_REL_TOL,
+        "box mean relative error {box_mre}"
+    );
+    assert!(
+        shadow_mre <= SHADOW_MEAN_REL_TOL,
+        "shadow mean relative error {shadow_mre}"
+    );
+}
