@@ -229,7 +229,7 @@ impl LightPanel {
                 let r = ui.add(
                     egui::TextEdit::singleline(text)
                         .hint_text(hint)
-                        .desired_width(200.0),
+                        .min_size(egui::vec2(200.0, 0.0)),
                 );
                 name_widget(ui, &r, label);
                 ui.end_row();
@@ -284,7 +284,7 @@ impl LightPanel {
             let r = ui.add(
                 egui::TextEdit::singleline(&mut self.lighting_time)
                     .hint_text("empty: the photo's time")
-                    .desired_width(200.0),
+                    .min_size(egui::vec2(200.0, 0.0)),
             );
             name_widget(ui, &r, "lighting time");
             if ui.button("Set lighting time").clicked() {
@@ -306,7 +306,7 @@ impl LightPanel {
                 let r = ui.add(
                     egui::TextEdit::singleline(&mut self.taken_at)
                         .hint_text("empty: EXIF time")
-                        .desired_width(200.0),
+                        .min_size(egui::vec2(200.0, 0.0)),
                 );
                 name_widget(ui, &r, "capture time");
                 if ui.button("Set capture time").clicked() {
