@@ -42,6 +42,7 @@ pub mod fit_tables;
 pub mod fit_worker;
 mod jobs;
 pub mod light_commands;
+pub mod light_inputs;
 pub mod light_luminaires;
 pub mod light_panel;
 pub mod light_sky_map;

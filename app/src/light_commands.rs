@@ -150,6 +150,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::float_cmp)] // values are moved, never computed: exact
     fn every_light_edit_undoes_to_the_exact_site() {
         let original = site();
         let mut s = original.clone();
