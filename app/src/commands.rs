@@ -17,6 +17,7 @@ use photomontage::site::{
 };
 
 use crate::fit_commands::{self, FitCommand, FitCommandError};
+use crate::light_commands::{self, LightCommand, LightCommandError};
 
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -37,6 +38,17 @@ pub enum CommandError {
     NothingToRedo,
     #[error("no sample `{id}`")]
     NoSuchSample { id: String },
+    #[error("no luminaire `{id}`")]
+    NoSuchLuminaire { id: String },
+}
+
+impl From<LightCommandError> for CommandError {
+    fn from(e: LightCommandError) -> Self {
+        match e {
+            LightCommandError::NoSuchPhoto { id } => Self::NoSuchPhoto { id },
+            LightCommandError::NoSuchLuminaire { id } => Self::NoSuchLuminaire { id },
+        }
+    }
 }
 
 impl From<FitCommandError> for CommandError {
@@ -94,6 +106,8 @@ pub enum Command {
     Batch(Vec<Command>),
     /// An edit of the lighting fit's data ([`fit_commands`]).
     Fit(FitCommand),
+    /// An edit of the location, light or luminaires ([`light_commands`]).
+    Light(LightCommand),
 }
 
 impl Command {
@@ -118,6 +132,7 @@ impl Command {
             Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
             Self::Fit(c) => c.describe(),
+            Self::Light(c) => c.describe(),
         }
     }
 }
@@ -314,6 +329,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
             Command::Batch(inverses)
         }
         Command::Fit(c) => Command::Fit(fit_commands::apply(site, c)?),
+        Command::Light(c) => Command::Light(light_commands::apply(site, c)?),
     })
 }
 

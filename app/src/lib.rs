@@ -41,6 +41,11 @@ pub mod fit_pick;
 pub mod fit_tables;
 pub mod fit_worker;
 mod jobs;
+pub mod light_commands;
+pub mod light_inputs;
+pub mod light_luminaires;
+pub mod light_panel;
+pub mod light_sky_map;
 pub mod models_panel;
 pub mod new_site;
 pub mod panel;
@@ -150,6 +155,7 @@ enum SideTab {
     Scene,
     Fit,
     Ties,
+    Light,
 }
 
 /// The studio app.
@@ -195,6 +201,7 @@ pub struct Studio {
     host_clears_to_panel_fill: bool,
     fit: fit_panel::FitPanel,
     ties: tie_panel::TiePointsPanel,
+    light: light_panel::LightPanel,
 }
 
 impl Studio {
@@ -242,6 +249,7 @@ impl Studio {
             host_clears_to_panel_fill: false,
             fit: fit_panel::FitPanel::default(),
             ties: tie_panel::TiePointsPanel,
+            light: light_panel::LightPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -284,6 +292,7 @@ impl Studio {
                 self.viewport = Viewport::default();
                 self.fit.worker.cancel();
                 self.fit = fit_panel::FitPanel::default();
+                self.light = light_panel::LightPanel::default();
                 self.doc = Some(doc);
                 self.ui_state.remember(path);
                 self.persist_ui_state();
@@ -584,6 +593,8 @@ impl Studio {
             widgets::name_widget(ui, &r, "Fit tab");
             let r = ui.selectable_value(&mut self.tab, SideTab::Ties, "Tie points");
             widgets::name_widget(ui, &r, "Tie points tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Light, "Site & light");
+            widgets::name_widget(ui, &r, "Site & light tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -595,6 +606,7 @@ impl Studio {
             SideTab::Scene => &mut self.scene,
             SideTab::Fit => &mut self.fit,
             SideTab::Ties => &mut self.ties,
+            SideTab::Light => &mut self.light,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);

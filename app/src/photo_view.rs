@@ -88,8 +88,12 @@ impl Studio {
             crate::SideTab::Fit if !space => {
                 self.fit_pick_interaction(&response, &t, &id, size_px);
             }
+            crate::SideTab::Light if !space => self.light_pick_interaction(&response, &t, &id),
             // The Tie points tab selects from its list; the photo only shows the tracks.
-            crate::SideTab::Scene | crate::SideTab::Fit | crate::SideTab::Ties => {}
+            crate::SideTab::Scene
+            | crate::SideTab::Fit
+            | crate::SideTab::Ties
+            | crate::SideTab::Light => {}
             _ => self.observation_interaction(&response, &t, &id, space),
         }
 

@@ -86,6 +86,12 @@ impl SiteTimeZone {
             }),
         }
     }
+
+    /// `instant` as this zone's clock shows it (with the offset in force then).
+    #[must_use]
+    pub fn to_local(&self, instant: &DateTime<FixedOffset>) -> DateTime<FixedOffset> {
+        instant.with_timezone(&self.0).fixed_offset()
+    }
 }
 
 /// The known zone name closest to `name` (case-insensitive edit distance), when one is near.

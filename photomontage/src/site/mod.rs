@@ -28,6 +28,7 @@ mod schema;
 pub mod site_scene;
 pub mod site_time;
 pub mod solve;
+pub mod sun_path;
 #[cfg(feature = "opencv")]
 pub mod tie_matching;
 pub mod tie_points;

@@ -149,18 +149,10 @@ pub fn site_sun_dir(doc: &SiteDocument, photo_id: &str) -> Result<Vector3<f64>, 
         .location
         .as_ref()
         .map_or(0.0, |l| l.grid_convergence_deg);
-    if let Some(m) = &site.lighting.sun_manual {
-        return Ok(survey_dir_from_true_azimuth(
-            m.azimuth_deg,
-            m.elevation_deg,
-            convergence,
-        ));
-    }
-    let time = super::site_time::site_sun_time(doc, photo_id)?;
-    let pos = super::site_time::site_solar_position(site, &time, photo_id)?;
+    let sun = super::sun_path::site_sun_angles(doc, photo_id)?;
     Ok(survey_dir_from_true_azimuth(
-        pos.azimuth_deg,
-        pos.elevation_deg,
+        sun.azimuth_deg,
+        sun.elevation_deg,
         convergence,
     ))
 }

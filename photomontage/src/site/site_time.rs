@@ -8,7 +8,7 @@
 use chrono::{DateTime, FixedOffset, NaiveDateTime};
 
 use super::{Site, SiteDocument};
-use crate::sun::{SolarPosition, SpaParams, solar_position};
+use crate::sun::{SolarPosition, solar_position};
 use crate::time_zone::SiteTimeZone;
 
 pub use super::render_error::SiteRenderError;
@@ -127,11 +127,10 @@ pub fn site_solar_position(
             photo: photo_id.to_owned(),
             reason: "the site has no [location]".to_owned(),
         })?;
-    let params = SpaParams {
-        elevation_m: loc.elevation_m,
-        ..SpaParams::at(loc.latitude_deg, loc.longitude_deg)
-    };
-    Ok(solar_position(time, &params)?)
+    Ok(solar_position(
+        time,
+        &super::sun_path::location_spa_params(loc),
+    )?)
 }
 
 #[cfg(test)]
