@@ -21,6 +21,10 @@ use rayon::prelude::*;
 use crate::radiosity::SolveArgs;
 use crate::render::{install_cancel, with_threads};
 
+/// Gather rays per point by default: 16 × the library's default, since a CLI query is a few
+/// points, not a render.
+const POINT_GATHER_RAYS: u32 = 4096;
+
 #[derive(clap::Args)]
 pub struct Args {
     /// The site file (TOML).
@@ -32,11 +36,13 @@ pub struct Args {
     #[command(flatten)]
     solve: SolveArgs,
     /// Interpolate on elements no longer than this, metres; coarser elements (and points on
-    /// no element) are final-gathered.
-    #[arg(long, default_value_t = QueryParams::default().max_interpolation_edge_m)]
+    /// no element) are final-gathered. Default 0: every point is gathered, which gives the
+    /// solution's value at the point (within 2.2 % of Radiance's `rtrace -I` on the courtyard,
+    /// where element values were up to 5.7 % off at the feet of walls; docs/benchmarks.md).
+    #[arg(long, default_value_t = 0.0)]
     max_interpolation_edge_m: f64,
-    /// Rays of a final gather.
-    #[arg(long, default_value_t = QueryParams::default().gather_rays)]
+    /// Rays of a final gather (the interreflected part's standard error falls as 1/√rays).
+    #[arg(long, default_value_t = POINT_GATHER_RAYS)]
     gather_rays: u32,
     /// Print JSON (else one CSV row per point: id, irradiance, direct and indirect RGB).
     #[arg(long)]
