@@ -57,6 +57,7 @@ pub mod scene_panel;
 pub mod scene_pick;
 pub mod solve;
 pub mod state;
+pub mod study_panel;
 pub mod table_sort;
 pub mod tie_panel;
 pub mod viewport;
@@ -150,6 +151,7 @@ enum SideTab {
     Scene,
     Fit,
     Ties,
+    Study,
 }
 
 /// The studio app.
@@ -195,6 +197,7 @@ pub struct Studio {
     host_clears_to_panel_fill: bool,
     fit: fit_panel::FitPanel,
     ties: tie_panel::TiePointsPanel,
+    study: study_panel::StudyPanel,
 }
 
 impl Studio {
@@ -242,6 +245,7 @@ impl Studio {
             host_clears_to_panel_fill: false,
             fit: fit_panel::FitPanel::default(),
             ties: tie_panel::TiePointsPanel,
+            study: study_panel::StudyPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -584,6 +588,8 @@ impl Studio {
             widgets::name_widget(ui, &r, "Fit tab");
             let r = ui.selectable_value(&mut self.tab, SideTab::Ties, "Tie points");
             widgets::name_widget(ui, &r, "Tie points tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Study, "Study");
+            widgets::name_widget(ui, &r, "Study tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -595,6 +601,7 @@ impl Studio {
             SideTab::Scene => &mut self.scene,
             SideTab::Fit => &mut self.fit,
             SideTab::Ties => &mut self.ties,
+            SideTab::Study => &mut self.study,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);
@@ -635,6 +642,9 @@ impl Studio {
             Action::StartFit => self.start_fit(ctx),
             Action::CancelFit => self.fit.worker.cancel(),
             Action::ApplyFit => self.apply_fit_report(),
+            Action::StartStudy => self.start_study(ctx),
+            Action::CancelStudy => self.study.cancel(),
+            Action::ExportStudy => self.export_study(),
         }
     }
 
