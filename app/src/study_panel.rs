@@ -496,8 +496,7 @@ impl StudyPanel {
         let index = self.frame;
         let f = &mut self.frames[index];
         let caption = f.caption();
-        let r = ui.strong(format!("{}/{n}  {caption}", index + 1));
-        name_widget(ui, &r, "study frame caption");
+        ui.strong(format!("{}/{n}  {caption}", index + 1));
         let (slot, image) = match show {
             PreviewKind::Montage => (0, f.montage.as_ref()),
             PreviewKind::ShadowMap => (1, f.shadow_map.as_ref()),
@@ -590,6 +589,38 @@ impl crate::Studio {
         }
         if self.study.busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(50));
+        }
+    }
+}
+
+impl crate::Studio {
+    /// Shows the side tab labelled `label` (as on its button: "Points", "Results", "Render",
+    /// "Models", "Scene", "Fit", "Tie points", "Study"); the window's `--tab` uses it. A new
+    /// side tab adds its line here.
+    ///
+    /// # Errors
+    /// An unknown label, naming the known ones.
+    pub fn select_tab(&mut self, label: &str) -> Result<(), String> {
+        use crate::SideTab;
+        let known = [
+            ("Points", SideTab::Points),
+            ("Results", SideTab::Solve),
+            ("Render", SideTab::Render),
+            ("Models", SideTab::Models),
+            ("Scene", SideTab::Scene),
+            ("Fit", SideTab::Fit),
+            ("Tie points", SideTab::Ties),
+            ("Study", SideTab::Study),
+        ];
+        match known.iter().find(|(name, _)| *name == label) {
+            Some((_, tab)) => {
+                self.tab = *tab;
+                Ok(())
+            }
+            None => Err(format!(
+                "--tab {label}: no such side tab (known: {})",
+                known.map(|(n, _)| n).join(", ")
+            )),
         }
     }
 }
