@@ -28,8 +28,10 @@ if [[ ${1:-} == --release ]]; then
 fi
 tabs=("$@")
 
-cargo build --locked "${build_flag[@]}" -p photomontage --bin photomontage
-cargo build --locked "${build_flag[@]}" -p photomontage-studio --bin photomontage-studio
+if [[ -z ${SCREENSHOTS_NO_BUILD:-} ]]; then  # set it to use the binaries already built
+    cargo build --locked "${build_flag[@]}" -p photomontage --bin photomontage
+    cargo build --locked "${build_flag[@]}" -p photomontage-studio --bin photomontage-studio
+fi
 bin="$root/target/$profile"
 
 work=$(mktemp -d)
@@ -58,8 +60,8 @@ shot() {
 if [[ ${#tabs[@]} -eq 0 ]]; then
     shot docs/images/studio-study.png --tab Study \
         --study-dates 2026-06-21 --study-times 09:00,12:00,15:00 --study-frame 1
-    shot docs/images/studio-study-shadow.png --tab Study \
-        --study-dates 2026-06-21 --study-times 09:00,17:00 --study-shadow-maps --study-frame 1
+    shot docs/images/studio-study-shadow.png --tab Study --study-dates 2026-03-20,2026-06-21 \
+        --study-times 09:00,12:00,17:00 --study-shadow-maps --study-no-montages --study-frame 4
     tabs=("Site & light" "Materials" "Variants")
 fi
 for tab in "${tabs[@]}"; do

@@ -8,8 +8,8 @@
 //! `enable|disable PHOTO POINT`) through the studio's command path at start. `--headless`: run
 //! the studio's frames without a window (no display needed; autosave and workers run as usual)
 //! until killed — the crash-safety test uses it. `--solve`: start a solve on the first frame.
-//! `--tab LABEL` shows that side tab; `--study-dates D --study-times T [--study-shadow-maps]
-//! [--study-frame N]` runs the Study tab's sun study on the first frame (the screenshot waits
+//! `--tab LABEL` shows that side tab; `--study-dates D --study-times T [--study-shadow-maps
+//! [--study-no-montages]] [--study-frame N]` runs the Study tab's sun study on the first frame (the screenshot waits
 //! for it; `docs/screenshots.sh` uses these).
 
 use anyhow::{Context as _, bail};
@@ -61,6 +61,9 @@ struct Args {
     /// With --study-dates: also map the shadows in plan view (and show the maps).
     #[arg(long, requires = "study_dates")]
     study_shadow_maps: bool,
+    /// With --study-shadow-maps: no montages, only the maps (quick).
+    #[arg(long, requires = "study_shadow_maps")]
+    study_no_montages: bool,
     /// With --study-dates: the preview frame shown (0 = first).
     #[arg(long, value_name = "N", requires = "study_dates")]
     study_frame: Option<usize>,
@@ -209,6 +212,7 @@ fn main() -> anyhow::Result<()> {
         panel.dates.clone_from(dates);
         panel.times.clone_from(times);
         panel.shadow_maps = args.study_shadow_maps;
+        panel.montages = !args.study_no_montages;
         if args.study_shadow_maps {
             panel.show = photomontage_studio::study_panel::PreviewKind::ShadowMap;
         }

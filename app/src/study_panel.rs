@@ -41,8 +41,8 @@ pub enum StudyUpdate {
     Frame(Box<PreviewFrame>),
 }
 
-/// The study's worker.
-pub type StudyWorker = Worker<Result<StudyResult, StudyError>, StudyUpdate>;
+/// The study's worker: the study, or the library's message why not.
+pub type StudyWorker = Worker<Result<StudyResult, String>, StudyUpdate>;
 
 /// One frame of the animated preview.
 pub struct PreviewFrame {
@@ -162,7 +162,7 @@ fn study_job(
     request: &StudyRequest,
     options: StudyOptions,
     progress: &Progress<StudyUpdate>,
-) -> Result<StudyResult, StudyError> {
+) -> Result<StudyResult, String> {
     let on_event = |event: StudyEvent<'_>| match event {
         StudyEvent::Planned {
             daylight,
@@ -190,7 +190,7 @@ fn study_job(
             })));
         }
     };
-    run_study(doc, request, options, &on_event, progress.cancel_flag())
+    run_study(doc, request, options, &on_event, progress.cancel_flag()).map_err(|e| e.to_string())
 }
 
 impl StudyPanel {
@@ -221,12 +221,12 @@ impl StudyPanel {
     /// The request typed in the tab for `view`.
     ///
     /// # Errors
-    /// The library's parse errors, naming the entry.
-    pub fn request(&self, view: &str) -> Result<StudyRequest, StudyError> {
+    /// The library's parse errors as text, naming the entry.
+    pub fn request(&self, view: &str) -> Result<StudyRequest, String> {
         Ok(StudyRequest {
             view: view.to_owned(),
-            dates: parse_dates(&self.dates)?,
-            times: parse_times(&self.times)?,
+            dates: parse_dates(&self.dates).map_err(|e| e.to_string())?,
+            times: parse_times(&self.times).map_err(|e| e.to_string())?,
             spp_min: None,
             spp_max: None,
             seed: None,
@@ -257,7 +257,7 @@ impl StudyPanel {
         if self.worker.busy() {
             return Err("a study is already running".into());
         }
-        let request = self.request(view).map_err(|e| e.to_string())?;
+        let request = self.request(view)?;
         let options = self.options();
         if !options.montages && !options.shadow_maps {
             return Err(StudyError::NothingToMake.to_string());
@@ -306,7 +306,7 @@ impl StudyPanel {
         let outcome = match state {
             Poll::Idle | Poll::Running(_) => return None,
             Poll::Done(Ok(result)) => Ok(result),
-            Poll::Done(Err(e)) => Err(e.to_string()),
+            Poll::Done(Err(e)) => Err(e),
             Poll::Cancelled => Err(StudyError::Cancelled.to_string()),
             Poll::Failed(message) => Err(format!("study of {view} failed: {message}")),
         };
