@@ -5,8 +5,9 @@
 #
 #   bash docs/screenshots.sh [--release] [TAB ...]
 #
-# Without TAB arguments it takes the Study tab shots (docs/images/studio-study.png,
-# studio-study-shadow.png) and one shot of each further side tab it knows by label
+# Without TAB arguments it takes the Study tab shots (docs/images/studio-study-shadow.png, which
+# the user guide shows, and studio-study.png with montages, which takes long in a debug build and
+# is not in the guide yet) and one shot of each further side tab it knows by label
 # ("Site & light", "Materials", "Variants": docs/images/studio-<tab>.png); a tab the studio does
 # not know yet (`--tab` refuses it) is skipped with a note. With TAB arguments only those tabs.
 # A new tab needs its label in `Studio::select_tab` (app/src/study_panel.rs).
