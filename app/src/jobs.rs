@@ -26,6 +26,7 @@ impl Studio {
             && !self.render.busy()
             && !self.dialogs.busy()
             && !self.fit.worker.busy()
+            && !self.study.busy()
     }
 
     /// Starts a solve of the site as it is now on the worker thread.
@@ -98,6 +99,7 @@ impl Studio {
         self.poll_render(ctx);
         self.poll_dialogs(ctx);
         self.poll_fit(ctx);
+        self.poll_study(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)

@@ -62,6 +62,7 @@ pub mod scene_panel;
 pub mod scene_pick;
 pub mod solve;
 pub mod state;
+pub mod study_panel;
 pub mod table_sort;
 pub mod tie_panel;
 pub mod viewport;
@@ -156,6 +157,7 @@ enum SideTab {
     Fit,
     Ties,
     Light,
+    Study,
 }
 
 /// The studio app.
@@ -202,6 +204,7 @@ pub struct Studio {
     fit: fit_panel::FitPanel,
     ties: tie_panel::TiePointsPanel,
     light: light_panel::LightPanel,
+    study: study_panel::StudyPanel,
 }
 
 impl Studio {
@@ -250,6 +253,7 @@ impl Studio {
             fit: fit_panel::FitPanel::default(),
             ties: tie_panel::TiePointsPanel,
             light: light_panel::LightPanel::default(),
+            study: study_panel::StudyPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -595,6 +599,8 @@ impl Studio {
             widgets::name_widget(ui, &r, "Tie points tab");
             let r = ui.selectable_value(&mut self.tab, SideTab::Light, "Site & light");
             widgets::name_widget(ui, &r, "Site & light tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Study, "Study");
+            widgets::name_widget(ui, &r, "Study tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -607,6 +613,7 @@ impl Studio {
             SideTab::Fit => &mut self.fit,
             SideTab::Ties => &mut self.ties,
             SideTab::Light => &mut self.light,
+            SideTab::Study => &mut self.study,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);
@@ -647,6 +654,9 @@ impl Studio {
             Action::StartFit => self.start_fit(ctx),
             Action::CancelFit => self.fit.worker.cancel(),
             Action::ApplyFit => self.apply_fit_report(),
+            Action::StartStudy => self.start_study(ctx),
+            Action::CancelStudy => self.study.cancel(),
+            Action::ExportStudy => self.export_study(),
         }
     }
 

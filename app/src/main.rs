@@ -8,6 +8,9 @@
 //! `enable|disable PHOTO POINT`) through the studio's command path at start. `--headless`: run
 //! the studio's frames without a window (no display needed; autosave and workers run as usual)
 //! until killed — the crash-safety test uses it. `--solve`: start a solve on the first frame.
+//! `--tab LABEL` shows that side tab; `--study-dates D --study-times T [--study-shadow-maps
+//! [--study-no-montages]] [--study-frame N]` runs the Study tab's sun study on the first frame (the screenshot waits
+//! for it; `docs/screenshots.sh` uses these).
 
 use anyhow::{Context as _, bail};
 use clap::Parser as _;
@@ -45,6 +48,25 @@ struct Args {
     /// Start a solve on the first frame.
     #[arg(long)]
     solve: bool,
+    /// Show the side tab with this label at start ("Study", "Render", …).
+    #[arg(long, value_name = "LABEL")]
+    tab: Option<String>,
+    /// Run a sun study of the first photo on the first frame, at these dates (as the Study
+    /// tab's and `photomontage study`'s --dates).
+    #[arg(long, value_name = "LIST", requires = "study_times")]
+    study_dates: Option<String>,
+    /// The study's local clock times (as --times of `photomontage study`).
+    #[arg(long, value_name = "LIST", requires = "study_dates")]
+    study_times: Option<String>,
+    /// With --study-dates: also map the shadows in plan view (and show the maps).
+    #[arg(long, requires = "study_dates")]
+    study_shadow_maps: bool,
+    /// With --study-shadow-maps: no montages, only the maps (quick).
+    #[arg(long, requires = "study_shadow_maps")]
+    study_no_montages: bool,
+    /// With --study-dates: the preview frame shown (0 = first).
+    #[arg(long, value_name = "N", requires = "study_dates")]
+    study_frame: Option<usize>,
     /// Largest photo the studio decodes, in megapixels (as the CLI's option).
     #[arg(long, value_name = "MP", default_value_t = 250.0)]
     max_photo_megapixels: f64,
@@ -77,6 +99,8 @@ struct Shell {
     shot: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
     requested: bool,
     solve_on_start: bool,
+    study_on_start: bool,
+    study_frame: Option<usize>,
 }
 
 impl eframe::App for Shell {
@@ -84,6 +108,17 @@ impl eframe::App for Shell {
         if std::mem::take(&mut self.solve_on_start) {
             let ctx = ui.ctx().clone();
             self.studio.start_solve(&ctx);
+        }
+        if std::mem::take(&mut self.study_on_start) {
+            let ctx = ui.ctx().clone();
+            self.studio.start_study(&ctx);
+        }
+        if let Some(n) = self.study_frame
+            && !self.studio.study_panel().busy()
+            && self.studio.study_panel().frames().len() > n
+        {
+            self.studio.study_panel_mut().frame = n;
+            self.study_frame = None;
         }
         self.studio.ui(ui);
         let Some(path) = self.screenshot.clone() else {
@@ -169,6 +204,19 @@ fn main() -> anyhow::Result<()> {
     if let Some(script) = &args.script {
         apply_script(&mut studio, script)?;
     }
+    if let Some(tab) = &args.tab {
+        studio.select_tab(tab).map_err(anyhow::Error::msg)?;
+    }
+    if let (Some(dates), Some(times)) = (&args.study_dates, &args.study_times) {
+        let panel = studio.study_panel_mut();
+        panel.dates.clone_from(dates);
+        panel.times.clone_from(times);
+        panel.shadow_maps = args.study_shadow_maps;
+        panel.montages = !args.study_no_montages;
+        if args.study_shadow_maps {
+            panel.show = photomontage_studio::study_panel::PreviewKind::ShadowMap;
+        }
+    }
     if args.headless {
         return run_headless(studio);
     }
@@ -180,6 +228,8 @@ fn main() -> anyhow::Result<()> {
         shot: Arc::new(Mutex::new(None)),
         requested: false,
         solve_on_start: args.solve,
+        study_on_start: args.study_dates.is_some(),
+        study_frame: args.study_frame,
     };
     eframe::run_native(
         "photomontage studio",

@@ -127,6 +127,12 @@ pub enum Action {
     CancelFit,
     /// Write the last fit's report into the site (one undoable edit).
     ApplyFit,
+    /// Run the Study tab's sun study of the current photo.
+    StartStudy,
+    /// Stop the running study at its next tile.
+    CancelStudy,
+    /// Write the last study to the Study tab's folder.
+    ExportStudy,
 }
 
 /// A side-tab panel.

@@ -15,10 +15,14 @@
 //! With the frames come plan-view shadow maps ([`shadow_map`]): the site from above, each cell
 //! lit, in existing shadow, in shadow added by the proposal, or under the proposal.
 //!
+//! [`series::run_study`] makes a whole study (with an observer for progress and previews) and
+//! [`series::StudyResult::write`] writes it; the CLI and the studio both use them.
+//!
 //! Known limitations: the frames of a study are rendered one after the other, each loading the
 //! view again (the scene is small next to the tracing).
 
 pub mod contact_sheet;
+pub mod series;
 pub mod shadow_map;
 
 use std::sync::atomic::AtomicBool;
@@ -71,6 +75,14 @@ pub enum StudyError {
     NoGround,
     #[error("shadow map: {0}")]
     Scene(crate::scene::SceneError),
+    #[error("study cancelled: nothing written")]
+    Cancelled,
+    #[error("nothing to make: ask for montages, shadow maps or both")]
+    NothingToMake,
+    #[error("shadow map cell {cell_m} m: must be a positive number of metres")]
+    BadCell { cell_m: f64 },
+    #[error("cannot write {path}: {message}")]
+    Write { path: String, message: String },
 }
 
 /// A clock time of the study, with its own UTC offset when one was given.

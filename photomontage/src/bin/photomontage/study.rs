@@ -1,22 +1,19 @@
 //! `photomontage study SITE --view V --dates D1,D2 --times 09:00,12:00 --out DIR`: a sun and
-//! shadow study (see [`photomontage::study`]). Every daylight frame is rendered first, then all
-//! files are written (each atomically): Ctrl-C or an error leaves nothing in DIR.
+//! shadow study (see [`photomontage::study`], run and written by
+//! [`photomontage::study::series`]). Every daylight frame is rendered first, then all files are
+//! written (a new DIR as a whole, else each file atomically): Ctrl-C or an error leaves nothing
+//! in DIR.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
+use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use photomontage::colour::encode_srgb8;
-use photomontage::render::output::OutputLayers;
 use photomontage::site::SiteDocument;
-use photomontage::study::contact_sheet::{SheetCell, contact_sheet};
-use photomontage::study::shadow_map::shadow_map_image;
+use photomontage::study::series::{StudyEvent, StudyOptions, run_study};
 use photomontage::study::{
-    StudyRequest, frame_shadow_map, parse_dates, parse_times, plan_frames, render_frame,
+    StudyError, StudyRequest, frame_plan, parse_dates, parse_times, plan_frames,
 };
-use photomontage::verified::image_metadata::write_render;
 
-use crate::render::{install_cancel, tile_bar, view_of, with_threads};
+use crate::render::{install_cancel, tile_bar, with_threads};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -63,24 +60,6 @@ pub struct Args {
     threads: Option<usize>,
 }
 
-fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default()
-}
-
-/// Writes `img` as PNG through a temporary file and a rename.
-fn write_png(path: &Path, img: &image::RgbImage) -> anyhow::Result<()> {
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .with_context(|| format!("encoding {}", path.display()))?;
-    photomontage::site::write_atomically(path, &bytes)
-        .with_context(|| format!("cannot write {}", path.display()))
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let request = StudyRequest {
         view: args.view.clone(),
@@ -97,6 +76,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     let doc = SiteDocument::load(&args.site)?;
+    // Planned here too (cheap: the SPA per frame) so that bad input is refused before the
+    // Ctrl-C handler and the progress bar.
     let frames = plan_frames(&doc, &request)?;
     if args.out.exists() && !args.out.is_dir() {
         bail!("--out {} exists and is not a folder", args.out.display());
@@ -109,126 +90,68 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             -f.sun_elevation_deg
         );
     }
-    let daylight: Vec<_> = frames.iter().filter(|f| f.is_daylight()).collect();
 
     // Render every frame before writing anything.
     let cancel = install_cancel()?;
-    let first = photomontage::study::frame_plan(&daylight[0].document(&doc), &request)?;
-    let [w, h] = first.full_size_px;
-    let bar = tile_bar(first.tile_count() * daylight.len() as u64);
-    eprintln!(
-        "rendering {} frames of {w}×{h} px (Ctrl-C cancels)",
-        daylight.len()
-    );
-    let mut rendered = Vec::with_capacity(daylight.len());
-    for frame in &daylight {
-        let result = with_threads(args.threads, || {
-            Ok(render_frame(
-                &doc,
-                frame,
-                &request,
-                &|_| bar.inc(1),
-                cancel,
-            )?)
-        });
-        if cancel.load(Ordering::SeqCst) {
-            bar.finish_and_clear();
-            bail!(
-                "cancelled (Ctrl-C): nothing written to {}",
-                args.out.display()
-            );
+    let bar = tile_bar(0);
+    let options = StudyOptions {
+        montages: true,
+        shadow_maps: args.shadow_maps,
+        cell_m: args.cell_m,
+    };
+    let on_event = |event: StudyEvent<'_>| match event {
+        StudyEvent::Planned {
+            frames,
+            daylight,
+            tiles_total,
+        } => {
+            bar.set_length(tiles_total);
+            let size = frames
+                .iter()
+                .find(|f| f.is_daylight())
+                .and_then(|f| frame_plan(&f.document(&doc), &request).ok())
+                .map_or_else(String::new, |p| {
+                    format!(" of {}×{} px", p.full_size_px[0], p.full_size_px[1])
+                });
+            bar.suspend(|| eprintln!("rendering {daylight} frames{size} (Ctrl-C cancels)"));
         }
-        let (plan, photo) = result?;
-        for warning in &photo.warnings {
-            eprintln!("warning: {} {warning}", frame.stem(&args.view));
-        }
-        let map = if args.shadow_maps {
-            let map = frame_shadow_map(&doc, frame, &args.view, args.cell_m)?;
-            Some(shadow_map_image(&map, &frame.label()))
-        } else {
-            None
-        };
-        rendered.push((frame, plan, photo, map));
-    }
+        StudyEvent::Tile(_) => bar.inc(1),
+        StudyEvent::FrameStarted { .. } | StudyEvent::FrameDone { .. } => {}
+    };
+    let result = with_threads(args.threads, || {
+        Ok(run_study(&doc, &request, options, &on_event, cancel))
+    })?;
     bar.finish_and_clear();
-
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create --out {}", args.out.display()))?;
-    let mut json_frames = Vec::new();
-    let mut thumbs = Vec::new();
-    for (frame, plan, photo, map) in &rendered {
-        let stem = frame.stem(&args.view);
-        let png = args.out.join(format!("{stem}.png"));
-        let tone_map = plan.tone_map();
-        // The frame's own view geometry: its sun angles are those of the frame's time.
-        let view = view_of(&frame.document(&doc), &args.view);
-        write_render(
-            &png,
-            &photo.image,
-            &OutputLayers::default(),
-            &tone_map,
-            view.as_ref(),
-        )?;
-        if args.exr {
-            let exr = args.out.join(format!("{stem}.exr"));
-            write_render(&exr, &photo.image, &photo.layers, &tone_map, view.as_ref())?;
-        }
-        let [fw, fh] = photo.image.size_px;
-        thumbs.push(image::RgbImage::from_fn(fw, fh, |x, y| {
-            let p = photo.image.rgba[(y * fw + x) as usize];
-            image::Rgb(encode_srgb8([p[0], p[1], p[2]], &tone_map))
-        }));
-        let mut entry = serde_json::json!({
-            "time": frame.time_rfc3339(),
-            "sun_azimuth_deg": frame.sun_azimuth_deg,
-            "sun_elevation_deg": frame.sun_elevation_deg,
-            "file": file_name(&png),
-        });
-        if let Some(map) = map {
-            let path = args.out.join(format!("{stem}_shadow.png"));
-            write_png(&path, map)?;
-            entry["shadow_map"] = file_name(&path).into();
-        }
-        json_frames.push(entry);
-        if !args.json {
-            println!(
-                "{}  sun azimuth {:.2}°, elevation {:.2}°  {}",
-                frame.time_rfc3339(),
-                frame.sun_azimuth_deg,
-                frame.sun_elevation_deg,
-                png.display()
-            );
+    let result = match result {
+        Err(StudyError::Cancelled) => bail!(
+            "cancelled (Ctrl-C): nothing written to {}",
+            args.out.display()
+        ),
+        other => other?,
+    };
+    for out in &result.outputs {
+        for warning in &out.warnings {
+            eprintln!("warning: {} {warning}", out.frame.stem(&args.view));
         }
     }
-    let mut thumb_iter = thumbs.iter();
-    let cells: Vec<SheetCell<'_>> = frames
-        .iter()
-        .map(|f| SheetCell {
-            image: if f.is_daylight() {
-                thumb_iter.next()
-            } else {
-                None
-            },
-            label: if f.is_daylight() {
-                f.label()
-            } else {
-                format!("{} {} night", f.date, f.clock.format("%H:%M"))
-            },
-        })
-        .collect();
-    let sheet = contact_sheet(&cells, request.times.len());
-    let sheet_path = args.out.join(format!("{}_contact_sheet.png", args.view));
-    write_png(&sheet_path, &sheet)?;
+    let written = result
+        .write(&args.out, args.exr)
+        .with_context(|| format!("writing the study to {}", args.out.display()))?;
     if args.json {
-        println!(
-            "{}",
-            serde_json::json!({
-                "frames": json_frames,
-                "contact_sheet": file_name(&sheet_path),
-            })
-        );
+        println!("{}", written.to_json());
     } else {
-        println!("contact sheet {}", sheet_path.display());
+        for w in &written.frames {
+            if let Some(png) = &w.file {
+                println!(
+                    "{}  sun azimuth {:.2}°, elevation {:.2}°  {}",
+                    w.frame.time_rfc3339(),
+                    w.frame.sun_azimuth_deg,
+                    w.frame.sun_elevation_deg,
+                    png.display()
+                );
+            }
+        }
+        println!("contact sheet {}", written.contact_sheet.display());
     }
     Ok(())
 }
