@@ -24,6 +24,7 @@ pub mod render;
 pub mod render_error;
 pub mod render_photo;
 mod schema;
+pub mod site_materials;
 pub mod site_scene;
 pub mod site_time;
 pub mod solve;
