@@ -14,6 +14,7 @@
 //! the line of the enclosing table.
 
 pub mod control_location;
+pub mod elevation;
 mod locate;
 pub mod luminaires;
 pub mod models;
