@@ -41,6 +41,8 @@ pub mod fit_pick;
 pub mod fit_tables;
 pub mod fit_worker;
 mod jobs;
+pub mod material_commands;
+pub mod materials_panel;
 pub mod models_panel;
 pub mod new_site;
 pub mod panel;
@@ -150,6 +152,7 @@ enum SideTab {
     Scene,
     Fit,
     Ties,
+    Materials,
 }
 
 /// The studio app.
@@ -195,6 +198,7 @@ pub struct Studio {
     host_clears_to_panel_fill: bool,
     fit: fit_panel::FitPanel,
     ties: tie_panel::TiePointsPanel,
+    materials: materials_panel::MaterialsPanel,
 }
 
 impl Studio {
@@ -242,6 +246,7 @@ impl Studio {
             host_clears_to_panel_fill: false,
             fit: fit_panel::FitPanel::default(),
             ties: tie_panel::TiePointsPanel,
+            materials: materials_panel::MaterialsPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -584,6 +589,8 @@ impl Studio {
             widgets::name_widget(ui, &r, "Fit tab");
             let r = ui.selectable_value(&mut self.tab, SideTab::Ties, "Tie points");
             widgets::name_widget(ui, &r, "Tie points tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Materials, "Materials");
+            widgets::name_widget(ui, &r, "Materials tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -595,6 +602,7 @@ impl Studio {
             SideTab::Scene => &mut self.scene,
             SideTab::Fit => &mut self.fit,
             SideTab::Ties => &mut self.ties,
+            SideTab::Materials => &mut self.materials,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);

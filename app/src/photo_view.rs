@@ -90,6 +90,8 @@ impl Studio {
             }
             // The Tie points tab selects from its list; the photo only shows the tracks.
             crate::SideTab::Scene | crate::SideTab::Fit | crate::SideTab::Ties => {}
+            // The Materials tab selects from its list (picking on the photo is not built yet).
+            crate::SideTab::Materials => {}
             _ => self.observation_interaction(&response, &t, &id, space),
         }
 

@@ -1,3 +1,6 @@
+// Exact comparisons: the values are copied, not computed.
+#![allow(clippy::float_cmp)]
+
 use super::*;
 use crate::scene::{Material, ObjectKind, SceneObject};
 

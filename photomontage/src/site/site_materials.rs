@@ -58,7 +58,11 @@ pub fn resolve_site_material(
         colour = Some(spec);
     } else {
         let resolved = resolve_linear(material.diffuse_rgb);
-        if resolved.linear_rgb != material.diffuse_rgb {
+        if material
+            .diffuse_rgb
+            .iter()
+            .any(|c| !(0.0..=1.0).contains(c))
+        {
             warnings.push(SiteWarning::SiteMaterial {
                 material: name.clone(),
                 message: format!(
