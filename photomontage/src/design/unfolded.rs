@@ -342,6 +342,9 @@ pub struct UnfoldedImage {
     pub max_irradiance_y: Option<f64>,
 }
 
+/// A drawn pixel: position, a fixed colour, or a value for the ramp.
+type Cell = (u32, u32, Option<[u8; 3]>, Option<f64>);
+
 /// Draws the layout.
 #[must_use]
 pub fn draw(scene: &Scene, layout: &UnfoldedLayout, shading: Shading<'_>) -> UnfoldedImage {
@@ -349,7 +352,7 @@ pub fn draw(scene: &Scene, layout: &UnfoldedLayout, shading: Shading<'_>) -> Unf
     let mut img = RgbImage::from_pixel(w, h, Rgb(BACKGROUND));
     let space = RgbColourSpace::srgb();
     // First pass: values per pixel (Y for irradiance), so the ramp can be scaled to the maximum.
-    let mut cells: Vec<(u32, u32, Option<[u8; 3]>, Option<f64>)> = Vec::new();
+    let mut cells: Vec<Cell> = Vec::new();
     let mut max_y: f64 = 0.0;
     for panel in &layout.panels {
         for y in layout.y0_px..layout.y0_px + layout.height_px {
