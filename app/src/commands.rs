@@ -18,6 +18,7 @@ use photomontage::site::{
 
 use crate::fit_commands::{self, FitCommand, FitCommandError};
 use crate::light_commands::{self, LightCommand, LightCommandError};
+use crate::material_commands::{self, MaterialCommand, MaterialCommandError};
 
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -40,6 +41,8 @@ pub enum CommandError {
     NoSuchSample { id: String },
     #[error("no luminaire `{id}`")]
     NoSuchLuminaire { id: String },
+    #[error(transparent)]
+    Material(#[from] MaterialCommandError),
 }
 
 impl From<LightCommandError> for CommandError {
@@ -108,6 +111,8 @@ pub enum Command {
     Fit(FitCommand),
     /// An edit of the location, light or luminaires ([`light_commands`]).
     Light(LightCommand),
+    /// An edit of the site's materials or palette ([`material_commands`]).
+    Material(MaterialCommand),
 }
 
 impl Command {
@@ -133,6 +138,7 @@ impl Command {
             Self::Batch(c) => format!("{} edits", c.len()),
             Self::Fit(c) => c.describe(),
             Self::Light(c) => c.describe(),
+            Self::Material(c) => c.describe(),
         }
     }
 }
@@ -330,6 +336,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
         }
         Command::Fit(c) => Command::Fit(fit_commands::apply(site, c)?),
         Command::Light(c) => Command::Light(light_commands::apply(site, c)?),
+        Command::Material(c) => Command::Material(material_commands::apply(site, c)?),
     })
 }
 

@@ -46,6 +46,8 @@ pub mod light_inputs;
 pub mod light_luminaires;
 pub mod light_panel;
 pub mod light_sky_map;
+pub mod material_commands;
+pub mod materials_panel;
 pub mod models_panel;
 pub mod new_site;
 pub mod panel;
@@ -158,6 +160,7 @@ enum SideTab {
     Ties,
     Light,
     Study,
+    Materials,
 }
 
 /// The studio app.
@@ -205,6 +208,7 @@ pub struct Studio {
     ties: tie_panel::TiePointsPanel,
     light: light_panel::LightPanel,
     study: study_panel::StudyPanel,
+    materials: materials_panel::MaterialsPanel,
 }
 
 impl Studio {
@@ -254,6 +258,7 @@ impl Studio {
             ties: tie_panel::TiePointsPanel,
             light: light_panel::LightPanel::default(),
             study: study_panel::StudyPanel::default(),
+            materials: materials_panel::MaterialsPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -601,6 +606,8 @@ impl Studio {
             widgets::name_widget(ui, &r, "Site & light tab");
             let r = ui.selectable_value(&mut self.tab, SideTab::Study, "Study");
             widgets::name_widget(ui, &r, "Study tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Materials, "Materials");
+            widgets::name_widget(ui, &r, "Materials tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -614,6 +621,7 @@ impl Studio {
             SideTab::Ties => &mut self.ties,
             SideTab::Light => &mut self.light,
             SideTab::Study => &mut self.study,
+            SideTab::Materials => &mut self.materials,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);

@@ -611,6 +611,7 @@ impl crate::Studio {
             ("Fit", SideTab::Fit),
             ("Tie points", SideTab::Ties),
             ("Site & light", SideTab::Light),
+            ("Materials", SideTab::Materials),
             ("Study", SideTab::Study),
         ];
         match known.iter().find(|(name, _)| *name == label) {

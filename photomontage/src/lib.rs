@@ -15,6 +15,7 @@ pub mod bvh;
 pub mod calibration;
 pub mod camera;
 pub mod colour;
+pub mod design;
 pub mod exchange;
 pub mod farm;
 pub mod features;

@@ -14,6 +14,7 @@
 //! the line of the enclosing table.
 
 pub mod control_location;
+pub mod elevation;
 mod locate;
 pub mod luminaires;
 pub mod models;
@@ -25,6 +26,7 @@ pub mod render_error;
 pub mod render_photo;
 pub mod render_radiosity;
 mod schema;
+pub mod site_materials;
 pub mod site_scene;
 pub mod site_time;
 pub mod solve;

@@ -25,6 +25,8 @@ pub enum SiteRenderError {
     UnknownPoint { polygon: String, point: String },
     #[error("polygon `{polygon}`: {source}")]
     Polygon { polygon: String, source: SceneError },
+    #[error("[[materials]] `{material}`: {reason}; nothing written")]
+    SiteMaterial { material: String, reason: String },
     #[error("material library {path}: {source}")]
     MaterialLibrary {
         path: String,
@@ -109,6 +111,8 @@ pub enum SiteWarning {
     Setting { message: String },
     /// A luminaire that will not light as the user probably meant (e.g. zero scale).
     Luminaire { luminaire: String, message: String },
+    /// A site material (`[[materials]]`) was clamped or matches nothing in the scene.
+    SiteMaterial { material: String, message: String },
 }
 
 impl fmt::Display for SiteWarning {
@@ -128,6 +132,9 @@ impl fmt::Display for SiteWarning {
             Self::Setting { message } => f.write_str(message),
             Self::Luminaire { luminaire, message } => {
                 write!(f, "luminaire `{luminaire}`: {message}")
+            }
+            Self::SiteMaterial { material, message } => {
+                write!(f, "[[materials]] `{material}`: {message}")
             }
         }
     }

@@ -4,11 +4,13 @@
 use serde::{Deserialize, Serialize};
 
 mod lighting_fit;
+mod materials;
 mod names;
 
 pub use lighting_fit::{
     FitRecord, FitSettings, HorizonSample, Sample, SamplePurpose, SunShadowPair,
 };
+pub use materials::{PaletteColour, SiteMaterial};
 pub use names::{ModelUnits, ModelUpAxis, SkyModelName};
 
 fn default_true() -> bool {
@@ -84,6 +86,13 @@ pub struct Site {
     /// Settings of the lighting fit (`[fit_settings]`).
     #[serde(default, skip_serializing_if = "FitSettings::is_default")]
     pub fit_settings: FitSettings,
+    /// Site materials (`[[materials]]`): override the library's and the CAD files' material of
+    /// the same name; a designer's colour may set the diffuse reflectance.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<SiteMaterial>,
+    /// The site's named colours (`[[palette]]`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub palette: Vec<PaletteColour>,
 }
 
 impl Default for Site {
@@ -107,6 +116,8 @@ impl Default for Site {
             sun_shadow_pairs: Vec::new(),
             fit: None,
             fit_settings: FitSettings::default(),
+            materials: Vec::new(),
+            palette: Vec::new(),
         }
     }
 }

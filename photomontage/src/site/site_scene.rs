@@ -76,19 +76,36 @@ fn import_options(model: &CadModel) -> ImportOptions {
 ///
 /// # Errors
 /// [`SiteRenderError::MaterialLibrary`] when it cannot be read or is invalid.
+/// The site's `[[materials]]` overlay the file's entries (see
+/// [`super::site_materials::overlay_site_materials`]); clamping warnings are dropped here, and
+/// kept by [`site_material_library_with_warnings`].
 pub fn site_material_library(
     doc: &SiteDocument,
 ) -> Result<Option<MaterialLibrary>, SiteRenderError> {
-    let Some(rel) = &doc.site.lighting.material_library else {
-        return Ok(None);
+    site_material_library_with_warnings(doc).map(|(lib, _)| lib)
+}
+
+/// [`site_material_library`] with the warnings of the site materials (clamped colours and
+/// reflectances).
+///
+/// # Errors
+/// An unreadable or invalid library file; an unparsable colour or invalid site material.
+pub fn site_material_library_with_warnings(
+    doc: &SiteDocument,
+) -> Result<(Option<MaterialLibrary>, Vec<SiteWarning>), SiteRenderError> {
+    let file_library = match &doc.site.lighting.material_library {
+        None => None,
+        Some(rel) => {
+            let path = doc.resolve(rel);
+            Some(MaterialLibrary::load(&path).map_err(|source| {
+                SiteRenderError::MaterialLibrary {
+                    path: path.display().to_string(),
+                    source,
+                }
+            })?)
+        }
     };
-    let path = doc.resolve(rel);
-    MaterialLibrary::load(&path)
-        .map(Some)
-        .map_err(|source| SiteRenderError::MaterialLibrary {
-            path: path.display().to_string(),
-            source,
-        })
+    super::site_materials::overlay_site_materials(file_library, &doc.site.materials)
 }
 
 /// Builds the scene of a site: one natural object per polygon (triangulated, material from the
@@ -98,7 +115,7 @@ pub fn site_material_library(
 /// An unknown vertex id, a polygon that cannot be triangulated, an unreadable material library
 /// or CAD file (no faces, non-finite vertices, a size above 100 km), a bad unit or up axis.
 pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
-    let library = site_material_library(doc)?;
+    let (library, material_warnings) = site_material_library_with_warnings(doc)?;
     let natural = natural_scene(&doc.site, library.as_ref()).map_err(|e| match e {
         NaturalSceneError::Polygon { polygon, source } => {
             SiteRenderError::Polygon { polygon, source }
@@ -124,6 +141,7 @@ pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
         .into_iter()
         .map(|(material, polygons)| SiteWarning::MissingMaterial { material, polygons })
         .collect();
+    warnings.extend(material_warnings);
     for model in doc.site.models.iter().filter(|m| m.visible) {
         let options = import_options(model);
         let path = doc.resolve(&model.file);
@@ -159,6 +177,10 @@ pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
     if let Some(lib) = &library {
         scene.apply_material_library(lib);
     }
+    warnings.extend(super::site_materials::unmatched_site_materials(
+        &doc.site.materials,
+        scene.materials(),
+    ));
     Ok(SiteScene {
         scene,
         object_sources,

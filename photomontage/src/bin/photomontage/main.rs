@@ -2,6 +2,7 @@
 
 mod calibrate;
 mod calibrate_opencv;
+mod elevation;
 mod exchange;
 mod farm;
 mod fit;
@@ -108,6 +109,9 @@ enum Command {
     /// sun, sky, luminaires and interreflection, split into direct and indirect (JSON with
     /// `--json`).
     Irradiance(irradiance::Args),
+    /// The unfolded elevation of one CAD model: its façades side by side with their colours,
+    /// or (`--irradiance`) the irradiance of the site's radiosity solution, as a PNG.
+    Elevation(elevation::Args),
     /// Tie points by feature matching (SIFT, ratio test, fundamental-matrix RANSAC, tracks),
     /// written into the site atomically; `solve` then uses them. Needs a build with the
     /// `opencv` feature.
@@ -150,6 +154,7 @@ fn main() -> anyhow::Result<()> {
         Command::ImportCameras(args) => exchange::import(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Irradiance(args) => irradiance::run(&args),
+        Command::Elevation(args) => elevation::run(&args),
         Command::Match(args) => tie_match::run(&args),
         Command::CalibrateOpencv(args) => calibrate_opencv::run(&args),
     }
