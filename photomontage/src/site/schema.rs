@@ -5,11 +5,13 @@ use serde::{Deserialize, Serialize};
 
 mod lighting_fit;
 mod names;
+mod variants;
 
 pub use lighting_fit::{
     FitRecord, FitSettings, HorizonSample, Sample, SamplePurpose, SunShadowPair,
 };
 pub use names::{ModelUnits, ModelUpAxis, SkyModelName};
+pub use variants::{Variant, VariantPlacement};
 
 fn default_true() -> bool {
     true
@@ -84,6 +86,9 @@ pub struct Site {
     /// Settings of the lighting fit (`[fit_settings]`).
     #[serde(default, skip_serializing_if = "FitSettings::is_default")]
     pub fit_settings: FitSettings,
+    /// Design variants (`[[variants]]`): visible models, placements and materials per variant.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub variants: Vec<Variant>,
 }
 
 impl Default for Site {
@@ -107,6 +112,7 @@ impl Default for Site {
             sun_shadow_pairs: Vec::new(),
             fit: None,
             fit_settings: FitSettings::default(),
+            variants: Vec::new(),
         }
     }
 }

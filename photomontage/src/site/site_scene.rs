@@ -159,6 +159,10 @@ pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
     if let Some(lib) = &library {
         scene.apply_material_library(lib);
     }
+    // A design variant's materials come last (`site::variants`).
+    if let Some(overrides) = super::variants::applied_variant_materials(doc) {
+        scene.apply_material_library(&overrides);
+    }
     Ok(SiteScene {
         scene,
         object_sources,
