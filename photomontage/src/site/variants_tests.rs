@@ -1,3 +1,5 @@
+#![allow(clippy::float_cmp)] // placements and reflectances are copied, not computed: exact
+
 use std::path::Path;
 
 use super::*;
@@ -43,9 +45,11 @@ fn doc_in(dir: &Path) -> SiteDocument {
         .push(crate::scene::Material::diffuse("black", RED));
     let mut hidden = Variant::named("hidden");
     hidden.visible_models = Some(Vec::new());
-    let mut site = Site::default();
-    site.models = vec![model("a"), b];
-    site.variants = vec![only_b, hidden];
+    let site = Site {
+        models: vec![model("a"), b],
+        variants: vec![only_b, hidden],
+        ..Site::default()
+    };
     SiteDocument {
         path: dir.join("site.toml"),
         site,
