@@ -17,6 +17,7 @@ use photomontage::site::{
 };
 
 use crate::fit_commands::{self, FitCommand, FitCommandError};
+use crate::variant_commands::{self, VariantCommand, VariantCommandError};
 
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -37,6 +38,8 @@ pub enum CommandError {
     NothingToRedo,
     #[error("no sample `{id}`")]
     NoSuchSample { id: String },
+    #[error(transparent)]
+    Variant(#[from] VariantCommandError),
 }
 
 impl From<FitCommandError> for CommandError {
@@ -94,6 +97,8 @@ pub enum Command {
     Batch(Vec<Command>),
     /// An edit of the lighting fit's data ([`fit_commands`]).
     Fit(FitCommand),
+    /// An edit of the design variants ([`variant_commands`]).
+    Variant(VariantCommand),
 }
 
 impl Command {
@@ -118,6 +123,7 @@ impl Command {
             Self::RemovePolygon { id } => format!("remove polygon {id}"),
             Self::Batch(c) => format!("{} edits", c.len()),
             Self::Fit(c) => c.describe(),
+            Self::Variant(c) => c.describe(),
         }
     }
 }
@@ -314,6 +320,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
             Command::Batch(inverses)
         }
         Command::Fit(c) => Command::Fit(fit_commands::apply(site, c)?),
+        Command::Variant(c) => Command::Variant(variant_commands::apply(site, c)?),
     })
 }
 

@@ -59,6 +59,7 @@ pub mod solve;
 pub mod state;
 pub mod table_sort;
 pub mod tie_panel;
+pub mod variant_commands;
 pub mod viewport;
 pub mod widgets;
 pub mod window;
