@@ -19,6 +19,7 @@ use photomontage::site::{
 use crate::fit_commands::{self, FitCommand, FitCommandError};
 use crate::light_commands::{self, LightCommand, LightCommandError};
 use crate::material_commands::{self, MaterialCommand, MaterialCommandError};
+use crate::variant_commands::{self, VariantCommand, VariantCommandError};
 
 /// What can go wrong applying a command.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -43,6 +44,8 @@ pub enum CommandError {
     NoSuchLuminaire { id: String },
     #[error(transparent)]
     Material(#[from] MaterialCommandError),
+    #[error(transparent)]
+    Variant(#[from] VariantCommandError),
 }
 
 impl From<LightCommandError> for CommandError {
@@ -113,6 +116,8 @@ pub enum Command {
     Light(LightCommand),
     /// An edit of the site's materials or palette ([`material_commands`]).
     Material(MaterialCommand),
+    /// An edit of the design variants ([`variant_commands`]).
+    Variant(VariantCommand),
 }
 
 impl Command {
@@ -139,6 +144,7 @@ impl Command {
             Self::Fit(c) => c.describe(),
             Self::Light(c) => c.describe(),
             Self::Material(c) => c.describe(),
+            Self::Variant(c) => c.describe(),
         }
     }
 }
@@ -337,6 +343,7 @@ pub fn apply(site: &mut Site, command: Command) -> Result<Command, CommandError>
         Command::Fit(c) => Command::Fit(fit_commands::apply(site, c)?),
         Command::Light(c) => Command::Light(light_commands::apply(site, c)?),
         Command::Material(c) => Command::Material(material_commands::apply(site, c)?),
+        Command::Variant(c) => Command::Variant(variant_commands::apply(site, c)?),
     })
 }
 

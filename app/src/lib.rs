@@ -67,6 +67,7 @@ pub mod state;
 pub mod study_panel;
 pub mod table_sort;
 pub mod tie_panel;
+pub mod variant_commands;
 pub mod viewport;
 pub mod widgets;
 pub mod window;

@@ -36,6 +36,7 @@ pub mod tie_matching;
 pub mod tie_points;
 pub mod toml_merge;
 mod validate;
+pub mod variants;
 
 pub use schema::*;
 pub use solve::{SiteSolution, apply_solution, solve_site, stored_camera};

@@ -373,7 +373,9 @@ pub fn prepare_view_with(
     options: &SiteLightingOptions,
 ) -> Result<ViewJob, SiteRenderError> {
     let camera = site_camera(doc, photo_id)?;
-    if !doc.site.models.iter().any(|m| m.visible) {
+    // A design variant may show no model (the existing situation, for comparison).
+    let variant_applied = doc.site.variants.iter().any(|v| v.applied);
+    if !variant_applied && !doc.site.models.iter().any(|m| m.visible) {
         return Err(SiteRenderError::NoVisibleModel);
     }
     let scene = site_scene(doc)?;

@@ -258,6 +258,33 @@ impl RenderPlan {
         self.render_edited(doc, &|_| Ok(()), on_tile, cancel)
     }
 
+    /// The band of the photo itself, unchanged (alpha 0: no artificial coverage).
+    fn photo_band(&self, job: &super::render::ViewJob) -> RenderedPhoto {
+        let [w, _] = self.full_size_px;
+        let [y0, y1] = self.rows_px;
+        let rgba = (y0..y1)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let p = job.photo_linear.get_pixel(x, y).0;
+                [p[0], p[1], p[2], 0.0]
+            })
+            .collect();
+        RenderedPhoto {
+            image: RenderedImage {
+                size_px: [w, y1 - y0],
+                rgba,
+                changed_pixels: 0,
+                primary_rays: 0,
+            },
+            layers: OutputLayers::default(),
+            object_names: Vec::new(),
+            sun_dir_in_world: job.sun_dir_in_world,
+            warnings: job.warnings.clone(),
+            // Nothing is added, so nothing is solved.
+            radiosity: None,
+        }
+    }
+
     /// [`RenderPlan::render`] with `edit` applied to the scene before tracing (e.g. the AVR2
     /// massing material). Record the edit in [`RenderPlan::identity`] when parts are written.
     ///
@@ -272,6 +299,17 @@ impl RenderPlan {
     ) -> Result<RenderedPhoto, SiteRenderError> {
         let mut job = prepare_view(doc, &self.request.view)?;
         edit(&mut job.scene.scene)?;
+        if job
+            .scene
+            .object_sources
+            .iter()
+            .all(|s| !matches!(s, ObjectSource::Model(_)))
+            && self.request.layers.is_empty()
+        {
+            // Only a design variant gets here without a model (prepare_view refuses the
+            // site itself): nothing is added, the band is the photo.
+            return Ok(self.photo_band(&job));
+        }
         let radiosity = if self.radiosity {
             let (light, report) = super::render_radiosity::site_radiosity_arc(
                 doc,

@@ -6,12 +6,14 @@ use serde::{Deserialize, Serialize};
 mod lighting_fit;
 mod materials;
 mod names;
+mod variants;
 
 pub use lighting_fit::{
     FitRecord, FitSettings, HorizonSample, Sample, SamplePurpose, SunShadowPair,
 };
 pub use materials::{PaletteColour, SiteMaterial};
 pub use names::{ModelUnits, ModelUpAxis, SkyModelName};
+pub use variants::{Variant, VariantPlacement};
 
 fn default_true() -> bool {
     true
@@ -93,6 +95,9 @@ pub struct Site {
     /// The site's named colours (`[[palette]]`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub palette: Vec<PaletteColour>,
+    /// Design variants (`[[variants]]`): visible models, placements and materials per variant.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub variants: Vec<Variant>,
 }
 
 impl Default for Site {
@@ -118,6 +123,7 @@ impl Default for Site {
             fit_settings: FitSettings::default(),
             materials: Vec::new(),
             palette: Vec::new(),
+            variants: Vec::new(),
         }
     }
 }

@@ -181,6 +181,10 @@ pub fn site_scene(doc: &SiteDocument) -> Result<SiteScene, SiteRenderError> {
         &doc.site.materials,
         scene.materials(),
     ));
+    // A design variant's materials come last (`site::variants`).
+    if let Some(overrides) = super::variants::applied_variant_materials(doc) {
+        scene.apply_material_library(&overrides);
+    }
     Ok(SiteScene {
         scene,
         object_sources,

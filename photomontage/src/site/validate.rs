@@ -344,6 +344,7 @@ impl Site {
                 issues.push(issue("location.time_zone".into(), e.to_string()));
             }
         }
+        issues.extend(super::variants::variant_issues(self));
         issues
     }
 }

@@ -25,6 +25,7 @@
 //! See each module.
 
 pub mod avr;
+pub mod comparison_sheet;
 pub mod cylindrical_view;
 pub mod geometry;
 pub mod image_metadata;

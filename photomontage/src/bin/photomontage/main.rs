@@ -2,6 +2,7 @@
 
 mod calibrate;
 mod calibrate_opencv;
+mod compare;
 mod elevation;
 mod exchange;
 mod farm;
@@ -57,6 +58,9 @@ enum Command {
     /// Sun and shadow study: render a view at every date × local time (SPA sun at [location],
     /// times in location.time_zone) into a folder, with a contact sheet.
     Study(study::Args),
+    /// Design variants side by side: render every `[[variants]]` entry of a view under the same
+    /// light and write a labelled comparison sheet (PDF, one page per variant; PNG grid).
+    Compare(compare::Args),
     /// Solve one photo from a control-point file (CSV or OpenDroneMap gcp_list.txt).
     Resect(resect::Args),
     /// Solar position (NREL SPA), sunrise and sunset.
@@ -135,6 +139,7 @@ fn main() -> anyhow::Result<()> {
         Command::Solve(args) => solve::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Study(args) => study::run(&args),
+        Command::Compare(args) => compare::run(&args),
         Command::Resect(args) => resect::run(&args),
         Command::Sun(args) => sun::run(&args),
         Command::Sky(args) => sky::run(&args),

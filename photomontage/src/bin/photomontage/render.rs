@@ -1,6 +1,7 @@
 //! `photomontage render SITE --view PHOTO --out FILE`: render the site's visible models into one
 //! solved photo with the differential ray tracer and write EXR or 8-bit sRGB. Ctrl-C cancels
 //! the render between tiles; nothing is written then and the exit status is non-zero.
+//! `--variant NAME` renders a design variant (`photomontage::site::variants`).
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -10,6 +11,7 @@ use photomontage::render::output::{self, LayerSet, OutputFormat};
 use photomontage::render::partial::write_part;
 use photomontage::site::SiteDocument;
 use photomontage::site::render_photo::{RenderPlan, RenderRequest};
+use photomontage::site::variants::variant_document;
 use photomontage::verified::ViewMetadata;
 use photomontage::verified::image_metadata::{view_metadata, write_render};
 use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
@@ -65,6 +67,10 @@ pub struct Args {
     /// dashed), 2 massing in a neutral material under the site's light, 3 the full montage.
     #[arg(long, value_name = "LEVEL", default_value_t = 3)]
     avr: u8,
+    /// Render the site as design variant NAME (`[[variants]]`) sees it: its visible models,
+    /// placements and materials, with the site's lighting, seed and settings.
+    #[arg(long, value_name = "NAME")]
+    variant: Option<String>,
 }
 
 /// The view geometry the output carries (EXIF and XMP, EXR attributes); a warning (and none)
@@ -179,7 +185,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let doc = SiteDocument::load(&args.site)?;
+    let doc = variant_document(&SiteDocument::load(&args.site)?, args.variant.as_deref())?;
     let request = RenderRequest {
         view: args.view.clone(),
         spp_min: args.spp_min,
@@ -192,6 +198,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         band: band.unwrap_or(Band::WHOLE),
     };
     let mut plan = RenderPlan::new(&doc, &request)?;
+    if let Some(name) = &args.variant {
+        // Parts of two variants must not merge.
+        plan.identity.insert("variant".into(), name.clone());
+    }
     let avr = AvrLevel::from_number(args.avr)?;
     if matches!(avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
         if plan.spectral || !layers.is_empty() || band.is_some() {
@@ -271,10 +281,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         100.0 * image.changed_pixels as f64 / pixels,
         image.primary_rays as f64 / pixels,
     );
-    let what = match band {
+    let mut what = match band {
         Some(b) => format!("tile {b} of view"),
         None => "view".to_owned(),
     };
+    if let Some(name) = &args.variant {
+        what = format!("variant {name}, {what}");
+    }
     println!(
         "rendered {what} {} ({w}×{h} px, {}) into {}",
         args.view,

@@ -35,9 +35,9 @@ use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 
 /// The embedded font (DejaVu Sans Mono 2.37).
-const FONT_TTF: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
+pub(crate) const FONT_TTF: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
 /// Advance width of every glyph, 1/1000 em (1233/2048).
-const GLYPH_WIDTH: f32 = 602.0;
+pub(crate) const GLYPH_WIDTH: f32 = 602.0;
 /// JPEG quality of the embedded image (visually lossless for photographs).
 pub const JPEG_QUALITY: u8 = 92;
 /// Points per millimetre.
@@ -102,14 +102,21 @@ pub fn winansi(text: &str) -> Vec<u8> {
         .collect()
 }
 
-fn mm(v: f64) -> f32 {
+pub(crate) fn mm(v: f64) -> f32 {
     #[allow(clippy::cast_possible_truncation)]
     let v = v as f32;
     v * PT_PER_MM
 }
 
 /// Writes one line of text at (x, y) mm (baseline), cut to `max_chars`.
-fn text(content: &mut Content, x_mm: f64, y_mm: f64, size_pt: f32, line: &str, max_chars: usize) {
+pub(crate) fn text(
+    content: &mut Content,
+    x_mm: f64,
+    y_mm: f64,
+    size_pt: f32,
+    line: &str,
+    max_chars: usize,
+) {
     let mut bytes = winansi(line);
     bytes.truncate(max_chars);
     content
