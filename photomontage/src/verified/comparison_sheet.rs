@@ -17,10 +17,9 @@
 use std::io::Cursor;
 
 use image::RgbImage;
-use pdf_writer::types::FontFlags;
 use pdf_writer::{Content, Filter, Finish, Name, Pdf, Rect, Ref};
 
-use super::sheet::{FONT_TTF, GLYPH_WIDTH, JPEG_QUALITY, SheetError, mm, text};
+use super::sheet::{JPEG_QUALITY, SheetError, mm, text, write_font};
 use crate::study::contact_sheet::{SheetCell, contact_sheet};
 
 /// A3 landscape, millimetres.
@@ -120,33 +119,7 @@ pub fn comparison_pdf(cells: &[ComparisonCell<'_>], subtitle: &str) -> Result<Ve
     pdf.pages(tree)
         .kids((0..cells.len()).map(|k| per_page(k, 0)))
         .count(n);
-    {
-        let mut f = pdf.indirect(font).dict();
-        f.pair(Name(b"Type"), Name(b"Font"));
-        f.pair(Name(b"Subtype"), Name(b"TrueType"));
-        f.pair(Name(b"BaseFont"), Name(b"DejaVuSansMono"));
-        f.pair(Name(b"FirstChar"), 32);
-        f.pair(Name(b"LastChar"), 255);
-        f.insert(Name(b"Widths"))
-            .array()
-            .items(std::iter::repeat_n(GLYPH_WIDTH, 224));
-        f.pair(Name(b"FontDescriptor"), descriptor);
-        f.pair(Name(b"Encoding"), Name(b"WinAnsiEncoding"));
-    }
-    pdf.font_descriptor(descriptor)
-        .name(Name(b"DejaVuSansMono"))
-        .flags(FontFlags::FIXED_PITCH | FontFlags::NON_SYMBOLIC)
-        .bbox(Rect::new(-559.0, -375.0, 718.0, 1028.0))
-        .italic_angle(0.0)
-        .ascent(928.0)
-        .descent(-236.0)
-        .cap_height(729.0)
-        .stem_v(80.0)
-        .font_file2(font_file);
-    #[allow(clippy::cast_possible_wrap, clippy::cast_possible_truncation)]
-    let font_len = FONT_TTF.len() as i32;
-    pdf.stream(font_file, FONT_TTF)
-        .pair(Name(b"Length1"), font_len);
+    write_font(&mut pdf, font, descriptor, font_file);
 
     let [page_w, page_h] = PAGE_MM;
     let media = Rect::new(0.0, 0.0, mm(page_w), mm(page_h));

@@ -35,9 +35,9 @@ use crate::site::SiteDocument;
 use crate::site::render::SiteRenderError;
 
 /// The embedded font (DejaVu Sans Mono 2.37).
-pub(crate) const FONT_TTF: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
+const FONT_TTF: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
 /// Advance width of every glyph, 1/1000 em (1233/2048).
-pub(crate) const GLYPH_WIDTH: f32 = 602.0;
+const GLYPH_WIDTH: f32 = 602.0;
 /// JPEG quality of the embedded image (visually lossless for photographs).
 pub const JPEG_QUALITY: u8 = 92;
 /// Points per millimetre.
@@ -341,34 +341,7 @@ pub fn sheet_pdf(input: &SheetInput<'_>) -> Result<Vec<u8>, SheetError> {
             res.x_objects().pair(Name(b"Im0"), image_id);
         }
     }
-    // The font: a TrueType simple font, WinAnsi, every width the same.
-    {
-        let mut f = pdf.indirect(font).dict();
-        f.pair(Name(b"Type"), Name(b"Font"));
-        f.pair(Name(b"Subtype"), Name(b"TrueType"));
-        f.pair(Name(b"BaseFont"), Name(b"DejaVuSansMono"));
-        f.pair(Name(b"FirstChar"), 32);
-        f.pair(Name(b"LastChar"), 255);
-        f.insert(Name(b"Widths"))
-            .array()
-            .items(std::iter::repeat_n(GLYPH_WIDTH, 224));
-        f.pair(Name(b"FontDescriptor"), descriptor);
-        f.pair(Name(b"Encoding"), Name(b"WinAnsiEncoding"));
-    }
-    pdf.font_descriptor(descriptor)
-        .name(Name(b"DejaVuSansMono"))
-        .flags(FontFlags::FIXED_PITCH | FontFlags::NON_SYMBOLIC)
-        .bbox(Rect::new(-559.0, -375.0, 718.0, 1028.0))
-        .italic_angle(0.0)
-        .ascent(928.0)
-        .descent(-236.0)
-        .cap_height(729.0)
-        .stem_v(80.0)
-        .font_file2(font_file);
-    #[allow(clippy::cast_possible_wrap, clippy::cast_possible_truncation)]
-    let font_len = FONT_TTF.len() as i32;
-    pdf.stream(font_file, FONT_TTF)
-        .pair(Name(b"Length1"), font_len);
+    write_font(&mut pdf, font, descriptor, font_file);
     {
         let mut img = pdf.image_xobject(image_id, &jpeg);
         img.filter(Filter::DctDecode);
@@ -613,3 +586,35 @@ pub fn write_sheet(path: &Path, bytes: &[u8]) -> Result<(), SheetError> {
 
 #[cfg(test)]
 mod tests;
+
+/// Writes the sheets' font into `pdf`: DejaVu Sans Mono as a TrueType simple font, WinAnsi, every
+/// width [`GLYPH_WIDTH`], embedded (objects `font`, `descriptor`, `font_file`).
+pub(crate) fn write_font(pdf: &mut Pdf, font: Ref, descriptor: Ref, font_file: Ref) {
+    {
+        let mut f = pdf.indirect(font).dict();
+        f.pair(Name(b"Type"), Name(b"Font"));
+        f.pair(Name(b"Subtype"), Name(b"TrueType"));
+        f.pair(Name(b"BaseFont"), Name(b"DejaVuSansMono"));
+        f.pair(Name(b"FirstChar"), 32);
+        f.pair(Name(b"LastChar"), 255);
+        f.insert(Name(b"Widths"))
+            .array()
+            .items(std::iter::repeat_n(GLYPH_WIDTH, 224));
+        f.pair(Name(b"FontDescriptor"), descriptor);
+        f.pair(Name(b"Encoding"), Name(b"WinAnsiEncoding"));
+    }
+    pdf.font_descriptor(descriptor)
+        .name(Name(b"DejaVuSansMono"))
+        .flags(FontFlags::FIXED_PITCH | FontFlags::NON_SYMBOLIC)
+        .bbox(Rect::new(-559.0, -375.0, 718.0, 1028.0))
+        .italic_angle(0.0)
+        .ascent(928.0)
+        .descent(-236.0)
+        .cap_height(729.0)
+        .stem_v(80.0)
+        .font_file2(font_file);
+    #[allow(clippy::cast_possible_wrap, clippy::cast_possible_truncation)]
+    let font_len = FONT_TTF.len() as i32;
+    pdf.stream(font_file, FONT_TTF)
+        .pair(Name(b"Length1"), font_len);
+}
