@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+pub mod mitsuba_pair;
 pub mod street;
 pub mod truth;
 

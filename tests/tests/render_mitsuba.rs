@@ -13,6 +13,7 @@ use std::sync::atomic::AtomicBool;
 use photomontage::colour::SampleSet;
 use photomontage::peer_scene::{MAX_DEPTH, mitsuba_pair_scene};
 use photomontage::render::{DifferentialTracer, RenderSettings, render_view, render_view_spectral};
+use photomontage_tests::mitsuba_pair::pair_errors;
 use photomontage_tests::shared_file;
 use serde_json::Value;
 
@@ -88,46 +89,24 @@ fn box_and_shadow_match_mitsuba_1024spp() {
         )
         .unwrap();
     }
-    let (mut box_err, mut box_n, mut shadow_err, mut shadow_n, mut sq) = (0.0, 0, 0.0, 0, 0.0);
-    let (mut box_bias, mut shadow_bias) = (0.0, 0.0);
-    for y in 0..h {
-        for x in 0..w {
-            let ours = out.rgba[(y * w + x) as usize];
-            let t = truth.get_pixel(x, y).0;
-            let p = photo.get_pixel(x, y).0;
-            let rel = (0..3)
-                .map(|k| (f64::from(ours[k]) - f64::from(t[k])).abs() / f64::from(t[k]).max(1e-3))
-                .sum::<f64>()
-                / 3.0;
-            sq += (0..3)
-                .map(|k| (f64::from(ours[k]) - f64::from(t[k])).powi(2))
-                .sum::<f64>();
-            let signed = (0..3)
-                .map(|k| (f64::from(ours[k]) - f64::from(t[k])) / f64::from(t[k]).max(1e-3))
-                .sum::<f64>()
-                / 3.0;
-            let lum = |v: [f32; 3]| v.iter().map(|&c| f64::from(c)).sum::<f64>();
-            if ours[3] >= 1.0 {
-                box_err += rel;
-                box_bias += signed;
-                box_n += 1;
-            } else if ours[3] <= 0.0 && lum(t) < 0.8 * lum(p) {
-                shadow_err += rel;
-                shadow_bias += signed;
-                shadow_n += 1;
-            }
-        }
-    }
-    let box_mre = box_err / f64::from(box_n);
-    let shadow_mre = shadow_err / f64::from(shadow_n);
-    let rmse = (sq / f64::from(3 * w * h)).sqrt();
+    let e = pair_errors(&out.rgba, &truth, &photo);
     println!(
-        "mitsuba {w}x{h} {spectral:?}: box pixels {box_n} mean rel err {box_mre:.4}; shadow pixels {shadow_n} \
-         mean rel err {shadow_mre:.4}; signed: box {:+.4}, shadow {:+.4}; RMSE {rmse:.5}; changed pixels {}; rays/pixel {:.2}",
-        box_bias / f64::from(box_n),
-        shadow_bias / f64::from(shadow_n),
+        "mitsuba {w}x{h} {spectral:?}: box pixels {} mean rel err {:.4}; shadow pixels {} mean rel err {:.4}; signed: box {:+.4}, shadow {:+.4}; RMSE {:.5}; changed pixels {}; rays/pixel {:.2}",
+        e.box_pixels,
+        e.box_mean_rel,
+        e.shadow_pixels,
+        e.shadow_mean_rel,
+        e.box_bias,
+        e.shadow_bias,
+        e.rmse,
         out.changed_pixels,
         out.primary_rays as f64 / f64::from(w * h)
+    );
+    let (box_n, shadow_n, box_mre, shadow_mre) = (
+        e.box_pixels,
+        e.shadow_pixels,
+        e.box_mean_rel,
+        e.shadow_mean_rel,
     );
     assert!(
         box_n > 1000 && shadow_n > 300,
