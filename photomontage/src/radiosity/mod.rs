@@ -47,6 +47,7 @@ pub mod query;
 mod shooting;
 mod solve;
 pub mod sources;
+mod topology;
 pub mod transfer;
 
 #[cfg(test)]

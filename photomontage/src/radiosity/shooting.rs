@@ -23,7 +23,7 @@
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
 use super::hierarchical::Link;
 use super::mesh::Mesh;
-use super::transfer::Topology;
+use super::topology::Topology;
 use super::{Rgb, luminance};
 
 /// The links as compressed rows per **source** node (receiver and factor).

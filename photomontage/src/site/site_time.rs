@@ -7,8 +7,8 @@
 
 use chrono::{DateTime, FixedOffset, NaiveDateTime};
 
-use super::{Site, SiteDocument};
-use crate::sun::{SolarPosition, solar_position};
+use super::{Location, Site, SiteDocument};
+use crate::sun::{SolarPosition, SpaParams, solar_position};
 use crate::time_zone::SiteTimeZone;
 
 pub use super::render_error::SiteRenderError;
@@ -20,6 +20,15 @@ const LOCAL_FORMATS: [&str; 4] = [
     "%Y-%m-%d %H:%M:%S",
     "%Y-%m-%d %H:%M",
 ];
+
+/// The SPA inputs of a site location: those of `photomontage sun` with its defaults.
+#[must_use]
+pub fn location_spa_params(location: &Location) -> SpaParams {
+    SpaParams {
+        elevation_m: location.elevation_m,
+        ..SpaParams::at(location.latitude_deg, location.longitude_deg)
+    }
+}
 
 /// The site's `location.time_zone`, parsed; `None` when the site names none.
 ///
@@ -127,10 +136,7 @@ pub fn site_solar_position(
             photo: photo_id.to_owned(),
             reason: "the site has no [location]".to_owned(),
         })?;
-    Ok(solar_position(
-        time,
-        &super::sun_path::location_spa_params(loc),
-    )?)
+    Ok(solar_position(time, &location_spa_params(loc))?)
 }
 
 #[cfg(test)]

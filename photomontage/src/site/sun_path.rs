@@ -16,9 +16,10 @@
 use chrono::{DateTime, Duration, FixedOffset, NaiveDate, NaiveTime};
 
 use super::render_error::SiteRenderError;
+pub use super::site_time::location_spa_params;
 use super::site_time::{site_solar_position, site_sun_time, site_time_zone};
-use super::{Location, Site, SiteDocument};
-use crate::sun::{SpaParams, solar_position};
+use super::{Site, SiteDocument};
+use crate::sun::solar_position;
 use crate::time_zone::SiteTimeZone;
 
 /// Where the sun direction of a photo comes from.
@@ -39,15 +40,6 @@ pub struct SunAngles {
     pub elevation_deg: f64,
     /// Manual or computed.
     pub source: SunSource,
-}
-
-/// The SPA inputs of a site location: those of `photomontage sun` with its defaults.
-#[must_use]
-pub fn location_spa_params(location: &Location) -> SpaParams {
-    SpaParams {
-        elevation_m: location.elevation_m,
-        ..SpaParams::at(location.latitude_deg, location.longitude_deg)
-    }
 }
 
 /// The sun of photo `photo_id` as the renderer places it: `sun_manual`, else the SPA at
@@ -173,6 +165,7 @@ pub fn sky_map_xy(azimuth_deg: f64, elevation_deg: f64) -> [f64; 2] {
 mod tests {
     use super::*;
     use crate::site::Location;
+    use crate::sun::SpaParams;
 
     /// Map coordinates are a sine and a cosine of exact inputs: 1e-12 covers their rounding.
     const MAP_TOL: f64 = 1e-12;

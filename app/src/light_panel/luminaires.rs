@@ -243,13 +243,13 @@ pub fn luminaires_ui(
                 );
                 name_widget(ui, &r, &format!("polar plot {}", l.id));
                 ui.horizontal(|ui| {
-                    crate::light_sky_map::legend_swatch(
+                    crate::light_panel::sky_map::legend_swatch(
                         ui,
                         false,
                         egui::Color32::from_rgb(200, 30, 30),
                     );
                     ui.label("C0–C180");
-                    crate::light_sky_map::legend_swatch(
+                    crate::light_panel::sky_map::legend_swatch(
                         ui,
                         false,
                         egui::Color32::from_rgb(30, 60, 200),

@@ -3,7 +3,7 @@
 //! the "did you mean" hint of `photomontage::time_zone`), the current photo's capture time, the
 //! lighting time, the sun (computed or manual), the sky model and the sun/ambient/sky weights,
 //! the exposure, the atmosphere and the ground, a sky map with date and time sliders
-//! ([`crate::light_sky_map`]) and the luminaires ([`crate::light_luminaires`]).
+//! ([`crate::light_panel::sky_map`]) and the luminaires ([`crate::light_panel::luminaires`]).
 //!
 //! Every change is one undoable `Command::Light` ([`crate::light_commands`]) of the same site
 //! fields the CLI reads; nothing studio-only is written to the site file. Typed values are
@@ -18,6 +18,9 @@
 //! reads it; adding one belongs with the renderer wiring). Local times typed without an offset
 //! are stored resolved to RFC 3339 with the offset in force (what `validate` asks of
 //! `lighting.time`). Luminaire files are typed paths (no file dialog).
+
+pub mod luminaires;
+pub mod sky_map;
 
 use eframe::egui::{self, Color32};
 use photomontage::site::sun_path::{SunSource, site_sun_angles};
@@ -70,9 +73,9 @@ pub struct LightPanel {
     /// The last refusal, shown in red until the next successful edit.
     pub error: Option<String>,
     /// Sky map and sliders.
-    pub sky_map: crate::light_sky_map::SkyMapState,
+    pub sky_map: crate::light_panel::sky_map::SkyMapState,
     /// Luminaires.
-    pub luminaires: crate::light_luminaires::LuminairesState,
+    pub luminaires: crate::light_panel::luminaires::LuminairesState,
     /// Counts drags/typing sessions so that each is one undo step.
     gesture: u64,
 }
@@ -447,11 +450,11 @@ impl Panel for LightPanel {
             ui.separator();
             self.sun_ui(ui, doc, ctx.current_photo, &mut out);
             ui.separator();
-            crate::light_sky_map::sky_map_ui(self, ui, doc, ctx.current_photo, &mut out);
+            crate::light_panel::sky_map::sky_map_ui(self, ui, doc, ctx.current_photo, &mut out);
             ui.separator();
             self.sky_ui(ui, doc, &mut out);
             ui.separator();
-            crate::light_luminaires::luminaires_ui(self, ui, doc, &mut out);
+            crate::light_panel::luminaires::luminaires_ui(self, ui, doc, &mut out);
         });
         out
     }
