@@ -188,42 +188,12 @@ impl MaterialsPanel {
                 actions.extend(self.apply_colour(doc, base, &text));
             }
         });
-        ui.horizontal(|ui| {
-            ui.label("L*a*b*");
-            for (k, name) in ["L*", "a*", "b*"].iter().enumerate() {
-                let r = ui.add(
-                    egui::DragValue::new(&mut self.lab[k])
-                        .speed(0.5)
-                        .max_decimals(2),
-                );
-                name_widget(ui, &r, &format!("Lab {name}"));
-            }
-            let b = ui.button("Apply L*a*b*");
-            name_widget(ui, &b, "Apply Lab");
-            if b.clicked() {
-                let l = self.lab;
-                let text = format!("lab({:.2}, {:.2}, {:.2})", l[0], l[1], l[2]);
-                actions.extend(self.apply_colour(doc, base, &text));
-            }
-        });
-        ui.horizontal(|ui| {
-            ui.label("LCh");
-            for (k, name) in ["L*", "C*", "h"].iter().enumerate() {
-                let r = ui.add(
-                    egui::DragValue::new(&mut self.lch[k])
-                        .speed(0.5)
-                        .max_decimals(2),
-                );
-                name_widget(ui, &r, &format!("LCh {name}"));
-            }
-            let b = ui.button("Apply LCh");
-            name_widget(ui, &b, "Apply LCh");
-            if b.clicked() {
-                let l = self.lch;
-                let text = format!("lch({:.2}, {:.2}, {:.2})", l[0], l[1], l[2]);
-                actions.extend(self.apply_colour(doc, base, &text));
-            }
-        });
+        if let Some(text) = triple_row(ui, "L*a*b*", "Lab", ["L*", "a*", "b*"], &mut self.lab) {
+            actions.extend(self.apply_colour(doc, base, &text));
+        }
+        if let Some(text) = triple_row(ui, "LCh", "LCh", ["L*", "C*", "h"], &mut self.lch) {
+            actions.extend(self.apply_colour(doc, base, &text));
+        }
         let preview = lab_from_lch(self.lch);
         ui.small(format!(
             "LCh as L*a*b*: ({:.1}, {:.1}, {:.1})",
@@ -379,4 +349,38 @@ impl Panel for MaterialsPanel {
             }
         }
     }
+}
+
+/// One row of three numbers and an Apply button (`label`; widgets named `"{prefix} {name}"` and
+/// `"Apply {prefix}"`); on a click, the colour text `"{prefix lowercase}(v0, v1, v2)"`.
+fn triple_row(
+    ui: &mut egui::Ui,
+    label: &str,
+    prefix: &str,
+    names: [&str; 3],
+    values: &mut [f64; 3],
+) -> Option<String> {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for (k, name) in names.iter().enumerate() {
+            let r = ui.add(
+                egui::DragValue::new(&mut values[k])
+                    .speed(0.5)
+                    .max_decimals(2),
+            );
+            name_widget(ui, &r, &format!("{prefix} {name}"));
+        }
+        let b = ui.button(format!("Apply {label}"));
+        name_widget(ui, &b, &format!("Apply {prefix}"));
+        b.clicked().then(|| {
+            format!(
+                "{}({:.2}, {:.2}, {:.2})",
+                prefix.to_lowercase(),
+                values[0],
+                values[1],
+                values[2]
+            )
+        })
+    })
+    .inner
 }
