@@ -16,8 +16,12 @@
 //! each group's total) until what is left is at most half the stop rule's residual; a group
 //! stops when its unshot power over its total power is below the residual (a bound on what one
 //! more round would add) and its mean brightness changed by less than the stop rule's mean
-//! change. Rounds are sequential in a fixed order: the result does not depend on the thread
-//! count. A round's convergence row counts the links it read (`interactions`), the same in every
+//! change. Rounds are sequential. Within a round the links are read in parallel, split by a
+//! fixed set of receiver-node ranges ([`RECEIVER_RANGES`], balanced by links received, every
+//! source row cut at the range boundaries once at build): each range is one task writing only
+//! its own receivers, and a receiver's sum runs over the shot nodes in shooting order and each
+//! row in receiver order, exactly as one thread would, so the result is the same bit for bit on
+//! any number of threads. A round's convergence row counts the links it read (`interactions`), the same in every
 //! group's row; its residual is the group's unshot power over its total.
 
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
@@ -25,41 +29,89 @@ use super::hierarchical::Link;
 use super::mesh::Mesh;
 use super::topology::Topology;
 use super::{Rgb, luminance};
+use rayon::prelude::*;
 
-/// The links as compressed rows per **source** node (receiver and factor).
+/// Receiver ranges of a shooting round: the links of every source row are split at the same
+/// receiver-node boundaries, and each range is accumulated by one task. Fixed, so the result
+/// does not depend on the thread count.
+const RECEIVER_RANGES: usize = 16;
+
+/// The links as compressed rows per **source** node (receiver and factor), each row sorted by
+/// receiver and cut at the [`RECEIVER_RANGES`] receiver-range boundaries.
 #[derive(Debug, Clone)]
 pub(super) struct SourceRows {
     /// Row of node n: `start[n]..start[n + 1]`.
     start: Vec<u32>,
     receiver: Vec<u32>,
     form_factor: Vec<f32>,
+    /// Receiver node ranges: range r is `bounds[r]..bounds[r + 1]` (balanced by links).
+    bounds: Vec<u32>,
+    /// Row of node n, links into receiver range r: `cuts[n·(R+1) + r]..cuts[n·(R+1) + r + 1]`.
+    cuts: Vec<u32>,
 }
 
 impl SourceRows {
-    /// Transposes `links` (any order; rows keep the links' order within a source).
+    /// Transposes `links` (any order; rows are sorted by receiver, stably).
     #[allow(clippy::cast_possible_truncation)] // at most `max_links` links, node ids are u32
     pub(super) fn new(nodes: usize, links: &[Link]) -> Self {
         let mut start = vec![0u32; nodes + 1];
+        let mut into = vec![0u64; nodes];
         for l in links {
             start[l.source as usize + 1] += 1;
+            into[l.receiver as usize] += 1;
         }
         for n in 0..nodes {
             start[n + 1] += start[n];
         }
         let mut next: Vec<u32> = start[..nodes].to_vec();
-        let mut receiver = vec![0u32; links.len()];
-        let mut form_factor = vec![0f32; links.len()];
+        let mut pairs = vec![(0u32, 0f32); links.len()];
         for l in links {
             let i = next[l.source as usize] as usize;
             next[l.source as usize] += 1;
-            receiver[i] = l.receiver;
-            form_factor[i] = l.form_factor as f32;
+            pairs[i] = (l.receiver, l.form_factor as f32);
         }
-        Self {
+        for n in 0..nodes {
+            pairs[start[n] as usize..start[n + 1] as usize].sort_by_key(|&(r, _)| r);
+        }
+        let (receiver, form_factor) = pairs.into_iter().unzip();
+        // Range boundaries at equal shares of the links received.
+        let total: u64 = into.iter().sum();
+        let mut bounds = vec![0u32; RECEIVER_RANGES + 1];
+        let mut seen = 0u64;
+        let mut r = 1;
+        for (n, &k) in into.iter().enumerate() {
+            while r < RECEIVER_RANGES && seen * RECEIVER_RANGES as u64 >= r as u64 * total {
+                bounds[r] = n as u32;
+                r += 1;
+            }
+            seen += k;
+        }
+        for b in &mut bounds[r..] {
+            *b = nodes as u32;
+        }
+        let mut rows = Self {
             start,
             receiver,
             form_factor,
-        }
+            bounds,
+            cuts: Vec::new(),
+        };
+        rows.cuts = (0..nodes)
+            .flat_map(|n| {
+                let (a, z) = (rows.start[n] as usize, rows.start[n + 1] as usize);
+                let row = &rows.receiver[a..z];
+                rows.bounds
+                    .iter()
+                    .map(move |&b| (a + row.partition_point(|&r| r < b)) as u32)
+            })
+            .collect();
+        rows
+    }
+
+    /// The links of node `n`'s row into receiver range `r`.
+    fn cut(&self, n: usize, r: usize) -> std::ops::Range<usize> {
+        let i = n * (RECEIVER_RANGES + 1) + r;
+        self.cuts[i] as usize..self.cuts[i + 1] as usize
     }
 }
 
@@ -152,7 +204,8 @@ pub(super) fn shoot(
         let mut order: Vec<usize> = (0..patches.len()).filter(|&p| score[p] > 0.0).collect();
         order.sort_by(|&a, &c| score[c].total_cmp(&score[a]).then(a.cmp(&c)));
         let mut left = unshot;
-        let mut interactions = 0u64;
+        // The shot nodes, in shooting order.
+        let mut active: Vec<usize> = Vec::new();
         for &p in &order {
             if left <= 0.5 * stop.residual {
                 break;
@@ -179,22 +232,31 @@ pub(super) fn shoot(
                     }
                 }
             }
-            for n in lo..hi {
-                let src = &un[n * stride..(n + 1) * stride];
-                if src.iter().all(|&v| v == 0.0) {
-                    continue;
-                }
-                let (a, z) = (rows.start[n] as usize, rows.start[n + 1] as usize);
-                interactions += (z - a) as u64;
-                for (r, f) in rows.receiver[a..z].iter().zip(&rows.form_factor[a..z]) {
-                    let f = f64::from(*f);
-                    let dst = &mut acc[*r as usize * stride..(*r as usize + 1) * stride];
-                    for (d, s) in dst.iter_mut().zip(src) {
-                        *d += f * s;
-                    }
-                }
-            }
+            active.extend(
+                (lo..hi).filter(|&n| un[n * stride..(n + 1) * stride].iter().any(|&v| v != 0.0)),
+            );
         }
+        let interactions: u64 = active
+            .iter()
+            .map(|&n| u64::from(rows.start[n + 1] - rows.start[n]))
+            .sum();
+        // Each receiver range gathers on its own task; a receiver's sum runs over the shot
+        // nodes in shooting order and each row in receiver order, as one thread would.
+        let mut ranges: Vec<(usize, &mut [f64])> = Vec::with_capacity(RECEIVER_RANGES);
+        let mut rest: &mut [f64] = &mut acc;
+        for r in 0..RECEIVER_RANGES {
+            let (lo, hi) = (rows.bounds[r] as usize, rows.bounds[r + 1] as usize);
+            let (chunk, tail) = std::mem::take(&mut rest).split_at_mut((hi - lo) * stride);
+            ranges.push((r, chunk));
+            rest = tail;
+        }
+        ranges.into_par_iter().for_each(|(r, chunk)| match stride {
+            3 => gather_range::<3>(rows, r, &active, &un, chunk),
+            6 => gather_range::<6>(rows, r, &active, &un, chunk),
+            9 => gather_range::<9>(rows, r, &active, &un, chunk),
+            12 => gather_range::<12>(rows, r, &active, &un, chunk),
+            _ => gather_range_dyn(rows, r, &active, &un, chunk, stride),
+        });
         // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot.
         for &(lo, hi) in patches {
             for n in lo..hi {
@@ -254,4 +316,126 @@ pub(super) fn shoot(
             (values, rows)
         })
         .collect()
+}
+
+/// Receiver range `r` gathers the unshot values `un` (`S` per node) of the `active` nodes
+/// through their links into `acc` (the range's nodes, `S` per node): a receiver's sum runs over
+/// `active` in order and each row in receiver order.
+fn gather_range<const S: usize>(
+    rows: &SourceRows,
+    r: usize,
+    active: &[usize],
+    un: &[f64],
+    acc: &mut [f64],
+) {
+    let base = rows.bounds[r] as usize;
+    for &n in active {
+        let src: &[f64; S] = un[n * S..(n + 1) * S]
+            .try_into()
+            .unwrap_or_else(|_| unreachable!("S values per node"));
+        let links = rows.cut(n, r);
+        for (rcv, f) in rows.receiver[links.clone()]
+            .iter()
+            .zip(&rows.form_factor[links])
+        {
+            let f = f64::from(*f);
+            let at = (*rcv as usize - base) * S;
+            let dst: &mut [f64; S] = (&mut acc[at..at + S])
+                .try_into()
+                .unwrap_or_else(|_| unreachable!("S values per node"));
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d += f * s;
+            }
+        }
+    }
+}
+
+/// [`gather_range`] for any number of values per node.
+fn gather_range_dyn(
+    rows: &SourceRows,
+    r: usize,
+    active: &[usize],
+    un: &[f64],
+    acc: &mut [f64],
+    stride: usize,
+) {
+    let base = rows.bounds[r] as usize;
+    for &n in active {
+        let src = &un[n * stride..(n + 1) * stride];
+        let links = rows.cut(n, r);
+        for (rcv, f) in rows.receiver[links.clone()]
+            .iter()
+            .zip(&rows.form_factor[links])
+        {
+            let f = f64::from(*f);
+            let at = (*rcv as usize - base) * stride;
+            for (d, s) in acc[at..at + stride].iter_mut().zip(src) {
+                *d += f * s;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every link lands in exactly one receiver range, the one holding its receiver, rows keep
+    /// each source's links (sorted by receiver), and the ranges tile the nodes.
+    #[test]
+    fn receiver_ranges_partition_every_row() {
+        let nodes = 997;
+        let mut state = 12_345u64;
+        let mut next = |m: u64| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) % m
+        };
+        #[allow(clippy::cast_possible_truncation)]
+        let links: Vec<Link> = (0..20_000)
+            .map(|_| Link {
+                receiver: next(nodes) as u32,
+                source: next(nodes) as u32,
+                form_factor: 0.001,
+            })
+            .collect();
+        let rows = SourceRows::new(nodes as usize, &links);
+        assert_eq!(rows.bounds[0], 0);
+        assert_eq!(rows.bounds[RECEIVER_RANGES] as usize, nodes as usize);
+        assert!(rows.bounds.windows(2).all(|w| w[0] <= w[1]));
+        let mut seen = 0;
+        for n in 0..nodes as usize {
+            let row = rows.start[n] as usize..rows.start[n + 1] as usize;
+            assert!(rows.receiver[row.clone()].windows(2).all(|w| w[0] <= w[1]));
+            let mut expected: Vec<u32> = links
+                .iter()
+                .filter(|l| l.source as usize == n)
+                .map(|l| l.receiver)
+                .collect();
+            expected.sort_unstable();
+            assert_eq!(rows.receiver[row.clone()], expected[..]);
+            let mut at = row.start;
+            for r in 0..RECEIVER_RANGES {
+                let cut = rows.cut(n, r);
+                assert_eq!(cut.start, at, "ranges of row {n} are contiguous");
+                let (lo, hi) = (rows.bounds[r], rows.bounds[r + 1]);
+                assert!(
+                    rows.receiver[cut.clone()]
+                        .iter()
+                        .all(|&x| lo <= x && x < hi)
+                );
+                seen += cut.len();
+                at = cut.end;
+            }
+            assert_eq!(at, row.end);
+        }
+        assert_eq!(seen, links.len());
+        // Balanced: no range holds more than twice its share of the links.
+        let share = links.len() / RECEIVER_RANGES;
+        for r in 0..RECEIVER_RANGES {
+            let k: usize = (0..nodes as usize).map(|n| rows.cut(n, r).len()).sum();
+            assert!(k <= 2 * share, "range {r} holds {k} links, share {share}");
+        }
+    }
 }

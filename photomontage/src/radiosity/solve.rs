@@ -299,7 +299,7 @@ pub fn solve_on_mesh(
             &group.points,
             &mesh.object_names,
         ));
-        let direct = group_direct(&engine, group, g as u64, ground.as_ref())?;
+        let direct = group_direct(&engine, group, g as u64, ground.as_ref(), None)?;
         b0s.push(initial_exitance(&mesh, &direct, group.emission));
         directs.push(direct);
     }
@@ -435,16 +435,21 @@ impl GroundTerm {
 const GROUND_DOME_FREQUENCIES: [u32; 2] = [4, 2];
 
 /// A group's direct irradiance per element: its distant sources (and the ground they light),
-/// its point sources. `group_index` selects the random streams.
+/// its point sources. `group_index` selects the random streams; `samples`, when given, are that
+/// group's direct-light sample points drawn before (a transfer keeps them).
 pub(crate) fn group_direct(
     engine: &FormFactorEngine<'_>,
     group: &LightGroup,
     group_index: u64,
     ground: Option<&GroundTerm>,
+    samples: Option<&sources::DirectSamples>,
 ) -> Result<Vec<Rgb>, RadiosityError> {
     sources::validate(&group.name, &group.sources)?;
     sources::validate_points(&group.name, &group.points)?;
-    let mut direct = sources::direct_irradiance(engine, &group.sources, group_index);
+    let mut direct = match samples {
+        Some(samples) => sources::direct_irradiance_at(engine, samples, &group.sources),
+        None => sources::direct_irradiance(engine, &group.sources, group_index),
+    };
     if let Some(ground) = ground {
         ground.add(&group.sources, &mut direct);
     }

@@ -90,6 +90,55 @@ pub fn validate(group: &str, sources: &[DistantSource]) -> Result<(), RadiosityE
     Ok(())
 }
 
+/// The stratified sample points of every element for one group's direct light (module doc):
+/// element e's points are `points[e·n .. (e+1)·n]`, n = `samples_per_axis`², drawn from the
+/// element's own stream. A transfer keeps them, so a relight re-traces only the rays.
+#[derive(Debug, Clone)]
+pub struct DirectSamples {
+    per_element: usize,
+    points: Vec<Point3<f64>>,
+}
+
+impl DirectSamples {
+    /// The points of group `group_index` on `engine`'s mesh.
+    #[must_use]
+    pub fn new(engine: &FormFactorEngine<'_>, group_index: u64) -> Self {
+        let mesh = engine.mesh();
+        let params = engine.params();
+        let n = params.samples_per_axis as usize;
+        #[allow(clippy::cast_precision_loss)]
+        let inv_n = 1.0 / n as f64;
+        let points = (0..mesh.elements.len())
+            .into_par_iter()
+            .flat_map_iter(|e| {
+                let node = mesh.element_node(e);
+                let mut rng =
+                    ChaCha8Rng::seed_from_u64(params.seed ^ DIRECT_SEED_SALT ^ group_index);
+                rng.set_stream(e as u64);
+                #[allow(clippy::cast_precision_loss)]
+                (0..n * n)
+                    .map(|k| {
+                        let u = ((k / n) as f64 + rng.random::<f64>()) * inv_n;
+                        let v = ((k % n) as f64 + rng.random::<f64>()) * inv_n;
+                        node.point_at(u, v)
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        Self {
+            per_element: n * n,
+            points,
+        }
+    }
+
+    /// Whether these are the points of a mesh of `elements` elements with `per_element` points
+    /// each.
+    #[must_use]
+    pub fn fits(&self, elements: usize, per_element: usize) -> bool {
+        self.per_element == per_element && self.points.len() == elements * per_element
+    }
+}
+
 /// Direct irradiance per element from `sources` (module doc). `group_index` separates the random
 /// streams of different groups.
 #[must_use]
@@ -98,27 +147,37 @@ pub fn direct_irradiance(
     sources: &[DistantSource],
     group_index: u64,
 ) -> Vec<Rgb> {
+    if sources.is_empty() {
+        return vec![[0.0; 3]; engine.mesh().elements.len()];
+    }
+    direct_irradiance_at(engine, &DirectSamples::new(engine, group_index), sources)
+}
+
+/// [`direct_irradiance`] from sample points drawn before (the same points give the same values,
+/// bit for bit).
+///
+/// # Panics
+/// When `samples` were drawn for another mesh or sample count.
+#[must_use]
+pub fn direct_irradiance_at(
+    engine: &FormFactorEngine<'_>,
+    samples: &DirectSamples,
+    sources: &[DistantSource],
+) -> Vec<Rgb> {
     let mesh = engine.mesh();
     let tracer = engine.tracer();
     let params = engine.params();
-    let n = params.samples_per_axis as usize;
-    let points = n * n;
-    #[allow(clippy::cast_precision_loss)]
-    let inv_n = 1.0 / n as f64;
+    let points = samples.per_element;
+    assert!(
+        samples.fits(mesh.elements.len(), points)
+            && points == (params.samples_per_axis as usize).pow(2),
+        "direct-light samples drawn for another mesh"
+    );
     (0..mesh.elements.len())
         .into_par_iter()
         .map(|e| {
             let node = mesh.element_node(e);
-            let mut rng = ChaCha8Rng::seed_from_u64(params.seed ^ DIRECT_SEED_SALT ^ group_index);
-            rng.set_stream(e as u64);
-            #[allow(clippy::cast_precision_loss)]
-            let samples: Vec<_> = (0..points)
-                .map(|k| {
-                    let u = ((k / n) as f64 + rng.random::<f64>()) * inv_n;
-                    let v = ((k % n) as f64 + rng.random::<f64>()) * inv_n;
-                    node.point_at(u, v)
-                })
-                .collect();
+            let samples = &samples.points[e * points..(e + 1) * points];
             let mut e_rgb = [0.0; 3];
             for (s, source) in sources.iter().enumerate() {
                 let cos = node.normal_in_world.dot(&source.dir_in_world);

@@ -13,7 +13,8 @@
 //!   sources, so with [`RelightStrategy::LinearResponses`] its direct irradiance and radiosity
 //!   are multiplied by the ratio, per channel, exactly and in O(elements).
 //! - **A sun move** re-traces only the sun's shadow rays (the same sample points and random
-//!   streams as [`super::solve`], so the direct term is the re-solve's bit for bit) and then
+//!   streams as [`super::solve`], so the direct term is the re-solve's bit for bit; the points
+//!   of the sun and sky groups are drawn once at build and kept) and then
 //!   iterates the sun group on the stored links; a sky whose luminance follows the sun (CIE
 //!   general skies, Perez) is re-clustered and re-traced as well.
 //! - **A sky type change** re-clusters the dome and re-traces the sky group's direct light.
@@ -51,7 +52,7 @@ use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
 use super::shooting::{ShotGroup, SourceRows, shoot};
 use super::solve::{GroundTerm, group_direct, initial_exitance};
-use super::sources::{self, LightWarning, PointSource};
+use super::sources::{self, DirectSamples, LightWarning, PointSource};
 use super::topology::Topology;
 use super::{
     GroupSolution, LightGroup, RadiosityError, Rgb, Solution, SolveParams, Solver, luminance,
@@ -246,6 +247,9 @@ pub struct Transfer {
     groups: Vec<LightGroup>,
     /// Per group, the initial exitance of the current solution.
     b0s: Vec<Vec<Rgb>>,
+    /// Per group whose distant sources a relight re-traces (sun, sky), its direct-light sample
+    /// points, drawn once.
+    direct_samples: Vec<Option<Arc<DirectSamples>>>,
     solution: Solution,
 }
 
@@ -406,6 +410,10 @@ impl Transfer {
         let n = mesh.elements.len();
         let mut directs = Vec::with_capacity(groups.len());
         let mut b0s = Vec::with_capacity(groups.len());
+        // Groups 0 and 1 are the sun and the sky (`kinds` below).
+        let direct_samples: Vec<Option<Arc<DirectSamples>>> = (0..groups.len())
+            .map(|g| (g < 2).then(|| Arc::new(DirectSamples::new(&engine, g as u64))))
+            .collect();
         for (g, group) in groups.iter().enumerate() {
             warnings.extend(sources::check_point_sources(
                 &tracer,
@@ -413,7 +421,13 @@ impl Transfer {
                 &group.points,
                 &mesh.object_names,
             ));
-            let direct = group_direct(&engine, group, g as u64, ground.as_ref())?;
+            let direct = group_direct(
+                &engine,
+                group,
+                g as u64,
+                ground.as_ref(),
+                direct_samples[g].as_deref(),
+            )?;
             b0s.push(initial_exitance(&mesh, &direct, group.emission));
             directs.push(direct);
         }
@@ -467,6 +481,7 @@ impl Transfer {
             kinds,
             groups,
             b0s,
+            direct_samples,
             solution: Solution {
                 mesh: Arc::new(mesh),
                 groups: solved,
@@ -644,6 +659,7 @@ impl Transfer {
                         &new_groups[g],
                         g as u64,
                         self.ground.as_ref(),
+                        self.direct_samples.get(g).and_then(Option::as_deref),
                     )?);
                 }
             }
