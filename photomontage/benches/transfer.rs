@@ -2,7 +2,9 @@
 //! 200 m ground): the precompute (mesh, links, form factors, every group's first solve) timed
 //! once (wall and CPU time), then relight latency on 2 threads for a sun move, a material change and a
 //! luminaire dimming, with both relight strategies and every sweep (criterion medians, then a
-//! summary of wall and CPU time per relight and the load average; docs/benchmarks.md).
+//! summary of wall and CPU time per relight and the load average; docs/benchmarks.md). Then the
+//! same relights with 32 m roots instead of 8 m (far fewer initial links), with how far that
+//! solution's interreflected radiosity lies from the 8 m one.
 #![allow(clippy::unwrap_used)]
 
 use std::sync::atomic::AtomicBool;
@@ -86,13 +88,23 @@ fn city_block() -> Scene {
     s
 }
 
+/// Longest patch edge (the hierarchy's roots) of the main measurements, metres.
+const PATCH_EDGE_M: f64 = 8.0;
+
+/// Roots of the coarse-root variant, metres: 16 × fewer patches, so far fewer initial links.
+const COARSE_PATCH_EDGE_M: f64 = 32.0;
+
 fn params(strategy: RelightStrategy, sweep: Sweep) -> TransferParams {
+    params_with_roots(strategy, sweep, PATCH_EDGE_M)
+}
+
+fn params_with_roots(strategy: RelightStrategy, sweep: Sweep, patch_edge_m: f64) -> TransferParams {
     let mut object_element_edge_m = std::collections::BTreeMap::new();
     object_element_edge_m.insert("ground".to_owned(), 8.0);
     TransferParams {
         solve: SolveParams {
             mesh: MeshParams {
-                max_patch_edge_m: 8.0,
+                max_patch_edge_m: patch_edge_m,
                 max_element_edge_m: 2.0,
                 object_element_edge_m,
                 ..MeshParams::default()
@@ -154,6 +166,44 @@ fn build(p: &TransferParams) -> Transfer {
         &|_| {},
     )
     .unwrap()
+}
+
+/// Interreflected radiosity (B − ρ·E_direct, green) per element, keyed by the element's centroid
+/// in millimetres (meshes with other roots have the same elements in another order).
+fn indirect_by_centroid(
+    s: &photomontage::radiosity::Solution,
+) -> std::collections::HashMap<[i64; 3], f64> {
+    let total = s.total_radiosity_rgb();
+    (0..total.len())
+        .map(|e| {
+            let node = s.mesh.element_node(e);
+            let rho = s.mesh.surfaces[node.surface as usize].reflectance_rgb[1];
+            let direct: f64 = s.groups.iter().map(|g| g.direct_irradiance_rgb[e][1]).sum();
+            let v = &node.vertices_in_world_m;
+            let c = (v[0].coords + v[1].coords + v[2].coords) / 3.0;
+            #[allow(clippy::cast_possible_truncation)]
+            let key = [c.x, c.y, c.z].map(|x| (x * 1000.0).round() as i64);
+            (key, total[e][1] - rho * direct)
+        })
+        .collect()
+}
+
+/// L1 difference of `other`'s interreflected radiosity from `reference`'s, relative to the
+/// reference's sum, and the relative difference of the means.
+fn indirect_difference(
+    reference: &photomontage::radiosity::Solution,
+    other: &photomontage::radiosity::Solution,
+) -> (f64, f64) {
+    let a = indirect_by_centroid(reference);
+    let b = indirect_by_centroid(other);
+    let (mut l1, mut sum_a, mut sum_b) = (0.0, 0.0, 0.0);
+    for (k, va) in &a {
+        let vb = b[k];
+        l1 += (vb - va).abs();
+        sum_a += va;
+        sum_b += vb;
+    }
+    (l1 / sum_a, sum_b / sum_a - 1.0)
 }
 
 /// A relight's change, alternating between two states.
@@ -345,6 +395,42 @@ fn bench_transfer(c: &mut Criterion) {
             } else {
                 m.groups.iter().map(|g| links(&g.convergence)).sum()
             }
+        ));
+    }
+    // The same relights on coarser roots (not the main figures: its solution differs, printed).
+    let coarse_params = params_with_roots(
+        RelightStrategy::LinearResponses,
+        Sweep::Shooting,
+        COARSE_PATCH_EDGE_M,
+    );
+    let (coarse, coarse_wall, coarse_cpu) = timed(|| pool.install(|| build(&coarse_params)));
+    let (l1, mean) = indirect_difference(base.solution(), coarse.solution());
+    summary.push(format!(
+        "roots {COARSE_PATCH_EDGE_M} m: {} patches, {} links, precompute wall {coarse_wall:.2} s, \
+         CPU {}; interreflected radiosity against the {PATCH_EDGE_M} m roots: L1 {:.2} %, mean \
+         {:+.2} %",
+        coarse.solution().mesh.patches.len(),
+        coarse.solution().interactions,
+        fmt_opt(coarse_cpu, 1.0, "s"),
+        100.0 * l1,
+        100.0 * mean
+    ));
+    let mut t = coarse;
+    let changes: [(&str, Change); 2] = [("sun_move", sun_change), ("material", material_change)];
+    for (what, change) in changes {
+        let mut flip = false;
+        group.bench_function(format!("coarse_roots/{what}"), |b| {
+            b.iter(|| {
+                flip = !flip;
+                let c = change(flip);
+                pool.install(|| t.relight(&c).unwrap())
+            });
+        });
+        let (wall_ms, cpu_ms) = wall_and_cpu(&pool, &mut t, 6, change);
+        summary.push(format!(
+            "coarse_roots/{what}: wall {wall_ms:.2} ms, CPU {} (median of 6, load {})",
+            fmt_opt(cpu_ms, 1.0, "ms"),
+            fmt_opt(load_average(), 1.0, "")
         ));
     }
     group.finish();
