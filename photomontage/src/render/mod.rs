@@ -51,7 +51,9 @@ use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-pub use differential::{DifferentialError, DifferentialTracer, Lighting, PrimaryHit, RaySample};
+pub use differential::{
+    DifferentialError, DifferentialTracer, Lighting, NaturalRatio, PrimaryHit, RaySample,
+};
 pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
 pub use irradiance_cache::IrradianceCacheSettings;
 pub use luminaire_light::{ArtificialLight, LuminaireLight};
@@ -361,6 +363,7 @@ fn render_tile(
             let mut natural_change = [0.0_f64; 3];
             let mut first_hit = None;
             let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
+            let mut ratios = PixelRatios::default();
             loop {
                 for s in 0..4 {
                     let (sx, sy) = (f64::from(s % 2), f64::from(s / 2));
@@ -378,6 +381,7 @@ fn render_tile(
                             natural_change[k] += sample.radiance_rgb[k] - photo_rgb[k];
                         }
                     }
+                    ratios.add(&sample, pixel);
                     changed |= sample.changed;
                     covered += u32::from(sample.hit_artificial);
                     for k in 0..3 {
@@ -388,6 +392,13 @@ fn render_tile(
                 n += 4;
                 if !settings.wants_more_rays(n, changed, &sum, &sum_sq) {
                     break;
+                }
+            }
+            if changed {
+                let fix = ratios.correction(tracer, photo_rgb);
+                for k in 0..3 {
+                    sum[k] += fix[k];
+                    natural_change[k] += fix[k];
                 }
             }
             out.rays += u64::from(n);
@@ -410,6 +421,51 @@ fn render_tile(
         }
     }
     out
+}
+
+/// A pixel's natural samples for the ratio of means of [`NaturalRatio`]: the changed ones'
+/// parts and the positions of the unchanged ones (their parts are traced only when the pixel
+/// changed).
+#[derive(Default)]
+struct PixelRatios {
+    changed: Vec<(NaturalRatio, Rgb)>,
+    unchanged_px: Vec<Point2<f64>>,
+}
+
+impl PixelRatios {
+    fn add(&mut self, sample: &RaySample, pixel: Point2<f64>) {
+        if let Some(r) = sample.natural_ratio {
+            self.changed.push((r, sample.radiance_rgb));
+        } else if !sample.changed && !sample.hit_artificial && sample.first_hit.is_some() {
+            self.unchanged_px.push(pixel);
+        }
+    }
+
+    /// What to add to the pixel's sum of sample radiances so that its natural samples count as
+    /// `L_photo + mean(τ·L₀)·ΣΔE/ΣE` each instead of their own `L_photo + τ·L₀·ΔE/E`.
+    fn correction(&self, tracer: &DifferentialTracer<'_>, photo_rgb: Rgb) -> Rgb {
+        if self.changed.is_empty() {
+            return [0.0; 3];
+        }
+        let camera = tracer.camera();
+        let unchanged = self.unchanged_px.iter().filter_map(|px| {
+            tracer
+                .unchanged_natural_ratio(&camera.ray_dir_in_world(*px), photo_rgb)
+                .map(|r| (r, photo_rgb))
+        });
+        let (mut tau_l0, mut e, mut de, mut old) = ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
+        let mut count = 0.0;
+        for (r, radiance) in self.changed.iter().copied().chain(unchanged) {
+            for k in 0..3 {
+                tau_l0[k] += r.tau_l0_rgb[k];
+                e[k] += r.e_natural_rgb[k];
+                de[k] += r.e_change_rgb[k];
+                old[k] += radiance[k];
+            }
+            count += 1.0;
+        }
+        std::array::from_fn(|k| count * photo_rgb[k] + tau_l0[k] * de[k] / e[k] - old[k])
+    }
 }
 
 /// Linear RGB of a loaded photo (sRGB-decoded when its transfer is sRGB).

@@ -12,7 +12,7 @@ use nalgebra::{Point3, Vector3};
 use super::glass::PhotoBehind;
 use super::radiosity_light::RadiosityLight;
 use super::specular::{SurfaceFrame, reflect_above};
-use super::{DifferentialTracer, PrimaryHit, RaySample, SURFACE_OFFSET_M};
+use super::{DifferentialTracer, NaturalRatio, PrimaryHit, RaySample, SURFACE_OFFSET_M};
 use crate::render::illumination::{
     DistantLight, Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour, mul,
     natural_irradiance_rgb, natural_irradiance_weighted_rgb, scale,
@@ -59,21 +59,17 @@ impl DifferentialTracer<'_> {
                         changed: true,
                         hit_artificial: true,
                         first_hit,
+                        natural_ratio: None,
                     },
                     ObjectKind::Natural => {
-                        let (radiance_rgb, changed) = self.case_d_natural_hit(
-                            &hit,
-                            &point,
-                            dir_in_world,
-                            photo_pixel_rgb,
-                            d,
-                            d,
-                        );
+                        let (radiance_rgb, changed, natural_ratio) =
+                            self.case_d_parts(&hit, &point, dir_in_world, photo_pixel_rgb, d, d);
                         RaySample {
                             radiance_rgb,
                             changed,
                             hit_artificial: false,
                             first_hit,
+                            natural_ratio,
                         }
                     }
                 }
@@ -85,6 +81,7 @@ impl DifferentialTracer<'_> {
     #[must_use]
     pub fn case_a_primary_miss(&self, photo_pixel_rgb: Rgb) -> RaySample {
         RaySample {
+            natural_ratio: None,
             radiance_rgb: photo_pixel_rgb,
             changed: false,
             hit_artificial: false,
@@ -237,6 +234,28 @@ impl DifferentialTracer<'_> {
         photo_distance_m: f64,
         distance_m: f64,
     ) -> (Rgb, bool) {
+        let (rgb, changed, _) = self.case_d_parts(
+            hit,
+            point,
+            dir_in_world,
+            photo_rgb,
+            photo_distance_m,
+            distance_m,
+        );
+        (rgb, changed)
+    }
+
+    /// [`Self::case_d_natural_hit`] with the parts of a changed point's radiance on the photo's
+    /// line of sight ([`NaturalRatio`]; `None` elsewhere and in the radiosity mode).
+    fn case_d_parts(
+        &self,
+        hit: &SceneHit,
+        point: &Point3<f64>,
+        dir_in_world: &Vector3<f64>,
+        photo_rgb: Rgb,
+        photo_distance_m: f64,
+        distance_m: f64,
+    ) -> (Rgb, bool, Option<NaturalRatio>) {
         let normal = self.normal_facing(hit, dir_in_world);
         if let Some(radiosity) = &self.lighting.radiosity
             && let (Some(e_with), Some(e_without)) = (
@@ -248,7 +267,7 @@ impl DifferentialTracer<'_> {
                 rgb: photo_rgb,
                 distance_m: photo_distance_m,
             };
-            return self.case_d_radiosity(
+            let (rgb, changed) = self.case_d_radiosity(
                 hit,
                 point,
                 &normal,
@@ -257,6 +276,7 @@ impl DifferentialTracer<'_> {
                 [e_with, e_without],
                 radiosity.as_ref(),
             );
+            return (rgb, changed, None);
         }
         let origin = point + normal * SURFACE_OFFSET_M;
         let daylight = &self.lighting.daylight;
@@ -288,10 +308,10 @@ impl DifferentialTracer<'_> {
         if unchanged {
             // D2 only: the natural light is already in the photo.
             if photo_distance_m.to_bits() == distance_m.to_bits() {
-                return (photo_rgb, false);
+                return (photo_rgb, false, None);
             }
             let l0 = self.true_colour(photo_rgb, photo_distance_m);
-            return (self.apparent(l0, distance_m), false);
+            return (self.apparent(l0, distance_m), false, None);
         }
         // Second inversions: atmosphere (eq. 8), then illumination (eq. 10) with the natural
         // irradiance as if there were no artificial objects.
@@ -314,7 +334,9 @@ impl DifferentialTracer<'_> {
                 .material_of(hit)
                 .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
             let delta = diffuse_radiance_rgb(rho, e_d1);
-            return self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m);
+            let (rgb, changed) =
+                self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m);
+            return (rgb, changed, None);
         };
         // D3: the blocked natural irradiance, negated.
         let mut e_d3 = [0.0; 3];
@@ -326,14 +348,68 @@ impl DifferentialTracer<'_> {
         }
         // D1 for the light the artificial objects reflect onto the point: `e_reflected`.
         let e_inter_change = add(e_inter_after, scale(e_inter_before, -1.0));
-        let delta = diffuse_radiance_rgb(
-            rho,
-            add(
-                add(add(e_d1, e_reflected), scale(e_d3, -1.0)),
-                e_inter_change,
-            ),
+        let e_change = add(
+            add(add(e_d1, e_reflected), scale(e_d3, -1.0)),
+            e_inter_change,
         );
-        self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m)
+        let delta = diffuse_radiance_rgb(rho, e_change);
+        let ratio = (photo_distance_m.to_bits() == distance_m.to_bits()).then(|| NaturalRatio {
+            tau_l0_rgb: mul(self.transmission(distance_m), l0),
+            e_natural_rgb: e_natural,
+            e_change_rgb: e_change,
+        });
+        let (rgb, changed) =
+            self.changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m);
+        (rgb, changed, ratio)
+    }
+
+    /// The [`NaturalRatio`] of an unchanged natural sample (ΔE = 0) of a primary ray, for a
+    /// pixel whose other samples changed: `None` when the ray's first hit is not natural, in
+    /// the radiosity mode, or where no natural light reaches the point.
+    #[must_use]
+    pub fn unchanged_natural_ratio(
+        &self,
+        dir_in_world: &Vector3<f64>,
+        photo_pixel_rgb: Rgb,
+    ) -> Option<NaturalRatio> {
+        if self.lighting.radiosity.is_some() {
+            return None;
+        }
+        let origin = self.camera.pose.camera_center_in_world;
+        let ray = self
+            .all
+            .ray_from_world(&origin, dir_in_world, 0.0, f32::INFINITY);
+        let hit = self.all.closest_hit(&ray)?;
+        if hit.kind != ObjectKind::Natural {
+            return None;
+        }
+        let point = self.all.hit_point_in_world_m(&ray, hit.hit.t);
+        let d = f64::from(hit.hit.t);
+        let normal = self.normal_facing(&hit, dir_in_world);
+        let origin = point + normal * SURFACE_OFFSET_M;
+        let daylight = &self.lighting.daylight;
+        let inf = f64::INFINITY;
+        let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
+            s.dir_in_world.dot(&normal) > 0.0 && !self.natural_blocks(&origin, &s.dir_in_world, inf)
+        });
+        let e_natural = natural_irradiance_rgb(daylight, &normal, sun_natural, |i| {
+            !self.natural_blocks(&origin, &daylight.sky[i].dir_in_world, inf)
+        });
+        // Gathered exactly, not through the tile's cache: these few samples at shadow edges do
+        // not add records, so the cache serves every other pixel as before.
+        let e_natural = add(
+            e_natural,
+            self.natural_interreflection_irradiance(&point, &normal),
+        );
+        if e_natural.iter().any(|&e| !(e > 0.0 && e.is_finite())) {
+            return None;
+        }
+        let l0 = self.true_colour(photo_pixel_rgb, d);
+        Some(NaturalRatio {
+            tau_l0_rgb: mul(self.transmission(d), l0),
+            e_natural_rgb: e_natural,
+            e_change_rgb: [0.0; 3],
+        })
     }
 
     /// Case D in the radiosity mode ([`super::radiosity_light`]): `e_rad` holds the sky and

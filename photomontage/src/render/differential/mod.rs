@@ -130,6 +130,30 @@ pub struct RaySample {
     pub hit_artificial: bool,
     /// The first hit (distance along the ray, object), for the depth and object-id layers.
     pub first_hit: Option<PrimaryHit>,
+    /// For a changed natural point on the photo's line of sight (case D by eq. 10), the parts
+    /// of its radiance `L_photo + τ·L₀·ΔE/E`; the pixel combines such samples as a ratio of
+    /// means ([`NaturalRatio`]).
+    pub natural_ratio: Option<NaturalRatio>,
+}
+
+/// The parts of a natural sample's change on the photo's line of sight: radiance
+/// `L_photo + τ·L₀·ΔE/E` per channel, with E the natural irradiance eq. 10 divides by and ΔE
+/// the irradiance the artificial objects and lights add or take away.
+///
+/// A pixel's photo value is the mean over its footprint, so where the footprint straddles an
+/// existing shadow edge, L₀ is a mix of lit and shadowed ground. Dividing that mix by each
+/// sample's own E (a mean of ratios) over-brightens the shadowed samples and darkens the lit
+/// ones, leaving a bright seam along the old edge inside a new shadow. The renderer instead
+/// takes the pixel's samples together: `L_photo + mean(τ·L₀)·ΣΔE/ΣE` (a ratio of means), which
+/// is exact for a footprint of one reflectance whatever its mix of light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NaturalRatio {
+    /// τ(d)·L₀: the photo's true colour carried back to the camera.
+    pub tau_l0_rgb: Rgb,
+    /// E: the natural irradiance at the point (sun, sky, interreflection), positive.
+    pub e_natural_rgb: Rgb,
+    /// ΔE: the change of irradiance (zero for an unchanged point).
+    pub e_change_rgb: Rgb,
 }
 
 /// Where a primary ray first hit the scene.
