@@ -15,12 +15,12 @@ use common::{WINDOW, add_box_model, copy_sample, harness, step_until};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use photomontage::radiosity::{Solution, luminance};
+use photomontage::render::differential::radiosity_light::RadiosityLight;
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::TransferUpdate;
 use photomontage::site::render::{prepare_view, site_scene};
 use photomontage::site::render_radiosity::site_radiosity_light;
-use photomontage::render::differential::radiosity_light::RadiosityLight;
 use photomontage_studio::Studio;
 use photomontage_studio::render_panel::{display_image, site_tone_map};
 use std::path::Path;
@@ -145,7 +145,11 @@ fn live_preview_follows_sky_and_colour_and_equals_the_library() {
     with_palette(&site, false);
     let mut h = live_studio(&site);
     // Live starts a render by itself, coarse pass first.
-    assert!(h.state().render_panel().busy(), "{:?}", h.state().messages());
+    assert!(
+        h.state().render_panel().busy(),
+        "{:?}",
+        h.state().messages()
+    );
     wait(&mut h, "first tiles", |s| {
         s.render_panel().progress().0 > 0 || !s.render_panel().busy()
     });
@@ -204,7 +208,11 @@ fn assert_matches_fresh_solve(label: &str, relit: &Solution, fresh: &Solution) {
         mean_b += luminance(y) * w;
     }
     assert!(mean_b > 0.0, "{label}: a lit scene");
-    assert!(diff / mean_b < RESOLVE_L1_REL_TOL, "{label}: L1 {}", diff / mean_b);
+    assert!(
+        diff / mean_b < RESOLVE_L1_REL_TOL,
+        "{label}: L1 {}",
+        diff / mean_b
+    );
     assert!(
         (mean_a - mean_b).abs() / mean_b < RESOLVE_MEAN_REL_TOL,
         "{label}: mean {mean_a} vs {mean_b}"
@@ -218,14 +226,26 @@ fn radiosity_mode_relights_the_kept_transfers() {
     with_palette(&site, true);
     let mut h = live_studio(&site);
     wait(&mut h, "first live render", caught_up);
-    let built = h.state().render_panel().live.last_relight().unwrap().clone();
+    let built = h
+        .state()
+        .render_panel()
+        .live
+        .last_relight()
+        .unwrap()
+        .clone();
     assert_eq!(built.update, TransferUpdate::Built);
 
     set_sky(&mut h, "cie_overcast");
     wait(&mut h, "live render after the sky", caught_up);
     set_brick_sienna(&mut h);
     wait(&mut h, "live render after the colour", caught_up);
-    let relit = h.state().render_panel().live.last_relight().unwrap().clone();
+    let relit = h
+        .state()
+        .render_panel()
+        .live
+        .last_relight()
+        .unwrap()
+        .clone();
     assert_eq!(relit.update, TransferUpdate::Relit);
     h.get_by_label("Render").click();
     steps(&mut h);

@@ -135,8 +135,7 @@ impl LivePreview {
     /// Whether the last finished live render shows `site` (photo and quality as started).
     #[must_use]
     pub fn shows(&self, site: &photomontage::site::Site) -> bool {
-        self.finished.as_ref().is_some_and(|k| k.site == *site)
-            && self.started == self.finished
+        self.finished.as_ref().is_some_and(|k| k.site == *site) && self.started == self.finished
     }
 
     /// The site's transfers (radiosity mode), shared with the render worker; tests compare
@@ -217,9 +216,12 @@ impl crate::Studio {
             return;
         }
         let quality = self.render.quality;
-        let current = self.render.live.started.as_ref().is_some_and(|k| {
-            k.photo == id && k.quality == quality && k.site == doc.site
-        });
+        let current = self
+            .render
+            .live
+            .started
+            .as_ref()
+            .is_some_and(|k| k.photo == id && k.quality == quality && k.site == doc.site);
         if current {
             return;
         }

@@ -175,7 +175,8 @@ pub fn lighting_change(
         if name != name_now || emission != emission_now {
             return None;
         }
-        if rho != rho_now {
+        // Bit comparison: any change of the value is a change to apply.
+        if rho.map(f64::to_bits) != rho_now.map(f64::to_bits) {
             change
                 .material_reflectance
                 .push((name.clone(), rho_now.map(|r| r.clamp(0.0, 1.0))));

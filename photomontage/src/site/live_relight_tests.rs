@@ -6,8 +6,8 @@ use nalgebra::Point3;
 
 use super::*;
 use crate::radiosity::{NamedLuminaire, PointSource, luminance};
-use crate::site::render::tests::fixture;
 use crate::site::render::site_scene;
+use crate::site::render::tests::fixture;
 use crate::site::render_radiosity::site_radiosity_light;
 use crate::site::{SiteMaterial, SkyModelName, SunManual};
 
@@ -132,7 +132,11 @@ fn assert_matches_fresh_solve(label: &str, relit: &Solution, fresh: &Solution) {
         mean_b += luminance(y) * w;
     }
     assert!(total > 0.0, "{label}: a lit scene");
-    assert!(diff / total < RESOLVE_L1_REL_TOL, "{label}: L1 {}", diff / total);
+    assert!(
+        diff / total < RESOLVE_L1_REL_TOL,
+        "{label}: L1 {}",
+        diff / total
+    );
     assert!(
         (mean_a - mean_b).abs() / mean_b < RESOLVE_MEAN_REL_TOL,
         "{label}: mean {mean_a} vs {mean_b}"
@@ -176,7 +180,10 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
         &fresh.without_artificial,
     );
     let kept = slot.as_ref().unwrap();
-    assert_eq!(kept.light_groups()[0].len(), fresh.with_artificial.groups.len());
+    assert_eq!(
+        kept.light_groups()[0].len(),
+        fresh.with_artificial.groups.len()
+    );
 
     // Moving the model changes the geometry: a build.
     doc.site.models[0].placement.translation[0] += 2.0;
