@@ -523,6 +523,7 @@ impl Studio {
     /// Draws the whole studio into `ui` and handles its input (called by eframe every frame,
     /// and by the tests).
     pub fn ui(&mut self, ui: &mut egui::Ui) {
+        let frame_start = Instant::now();
         let ctx = ui.ctx().clone();
         self.poll_workers(&ctx);
         self.shortcuts(&ctx);
@@ -579,6 +580,7 @@ impl Studio {
             self.create_polygon();
         }
         self.autosave_tick(&ctx);
+        self.render.live.frame_done(frame_start.elapsed());
     }
 
     fn toolbar_ui(&mut self, ui: &mut egui::Ui) {

@@ -46,6 +46,9 @@ use crate::viewport::ViewTransform;
 use crate::widgets::name_widget;
 use crate::worker::{Poll, Progress, Worker};
 
+pub mod live;
+use live::{JobOptions, LivePreview};
+
 /// What the render job streams to the panel before its outcome.
 pub enum RenderUpdate {
     /// The photo (linear, as the renderer sees it) tone-mapped for display: the preview's base.
@@ -55,6 +58,10 @@ pub enum RenderUpdate {
     },
     /// A finished tile with its pixels.
     Tile(TileProgress),
+    /// A refinement pass begins (index from 1, count): its tiles replace the last pass's.
+    Pass { index: u32, count: u32 },
+    /// The radiosity mode's transfers were updated ([`live`]).
+    Relit(photomontage::site::live_relight::RelightReport),
 }
 
 /// The render's worker: the montage (with the geometry of a re-projected view), or why not, with
@@ -93,6 +100,8 @@ pub struct RenderPanel {
     pub show_tiles: bool,
     /// The view (photo, planar 50/75 mm, cylindrical) and the sheet's paper.
     pub view_choice: ViewChoice,
+    /// The live preview ([`live`]).
+    pub live: LivePreview,
     worker: RenderWorker,
     /// Photo and AVR level of the running render.
     running: Option<(String, AvrLevel)>,
@@ -114,6 +123,7 @@ impl Default for RenderPanel {
             show_marks: true,
             show_tiles: true,
             view_choice: ViewChoice::default(),
+            live: LivePreview::default(),
             worker: Worker::new("render"),
             running: None,
             tiles_done: Vec::new(),
@@ -136,6 +146,7 @@ fn render_job(
     quality: Quality,
     tone_map: ToneMap,
     view: Option<(StandardView, PaperSize)>,
+    options: &JobOptions,
     progress: &Progress<RenderUpdate>,
 ) -> Result<(RenderedImage, Option<ViewGeometry>), RenderPanelError> {
     if let Some((view, paper)) = view {
@@ -146,15 +157,29 @@ fn render_job(
     if matches!(quality.avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
         return overlay_photo(doc, id, quality.avr).map(|image| (image, None));
     }
-    let job = prepare_photo(doc, id, quality)?;
+    let mut job = prepare_photo(doc, id, quality)?;
     let photo = &job.photo_linear;
     progress.send(RenderUpdate::Photo {
         size_px: [photo.width(), photo.height()],
         image: display_photo(photo, &tone_map),
     });
+    options.prepare_radiosity(doc, id, &mut job, progress)?;
     let tiles = progress.clone();
     let on_tile = move |t: TileProgress| tiles.send(RenderUpdate::Tile(t));
-    trace_photo(&job, id, &on_tile, progress.cancel_flag()).map(|image| (image, None))
+    let passes = live::passes(options, quality);
+    let count = u32::try_from(passes.len()).unwrap_or(u32::MAX);
+    let mut last = None;
+    for (index, (spp_min, spp_max)) in (1..).zip(passes) {
+        progress.send(RenderUpdate::Pass { index, count });
+        job.settings.min_rays_per_pixel = spp_min;
+        job.settings.max_rays_per_pixel = spp_max;
+        last = Some(trace_photo(&job, id, &on_tile, progress.cancel_flag())?);
+    }
+    last.map(|image| (image, None))
+        .ok_or_else(|| RenderPanelError::Render {
+            photo: id.to_owned(),
+            message: "no render pass".into(),
+        })
 }
 
 impl RenderPanel {
@@ -199,6 +224,21 @@ impl RenderPanel {
         photo_id: &str,
         ctx: &egui::Context,
     ) -> Result<(), RenderPanelError> {
+        self.start_with(doc, photo_id, ctx, JobOptions::default())
+    }
+
+    /// [`RenderPanel::start`] with the live preview's options (coarse pass first); in the
+    /// radiosity mode the site's transfers are kept ([`live`]).
+    ///
+    /// # Errors
+    /// As [`RenderPanel::start`].
+    pub fn start_with(
+        &mut self,
+        doc: &SiteDocument,
+        photo_id: &str,
+        ctx: &egui::Context,
+        mut options: JobOptions,
+    ) -> Result<(), RenderPanelError> {
         let busy = || RenderPanelError::Render {
             photo: photo_id.to_owned(),
             message: "a render is already running".into(),
@@ -223,8 +263,11 @@ impl RenderPanel {
             .view_choice
             .standard_view(photo_id)
             .map(|v| (v, self.view_choice.paper));
+        if doc.site.render.radiosity {
+            options.transfers = Some(self.live.transfers());
+        }
         let started = self.worker.spawn(ctx, move |progress| {
-            render_job(&doc, &id, quality, tone_map, view, progress)
+            render_job(&doc, &id, quality, tone_map, view, &options, progress)
         });
         if !started {
             return Err(busy());
@@ -247,7 +290,13 @@ impl RenderPanel {
         let (photo_id, avr) = self.running.clone()?;
         let (preview, tiles_done) = (&mut self.preview, &mut self.tiles_done);
         let (tile_count, tone_map) = (&mut self.tile_count, &self.tone_map);
+        let live = &mut self.live;
         let state = self.worker.poll_with(|update| match update {
+            RenderUpdate::Pass { index, count } => {
+                live.pass = Some((index, count));
+                tiles_done.clear();
+            }
+            RenderUpdate::Relit(report) => live.relit(report),
             RenderUpdate::Photo { size_px, image } => {
                 *preview = Some(Preview::new(&photo_id, size_px, image));
             }
@@ -273,6 +322,7 @@ impl RenderPanel {
             }),
         };
         self.running = None;
+        self.live.ended(result.is_ok());
         Some(result.map(|(image, geometry)| {
             let text = match &geometry {
                 Some(g) => format!(
@@ -461,10 +511,13 @@ impl crate::Studio {
 
     pub(crate) fn poll_render(&mut self, ctx: &egui::Context) {
         match self.render.poll() {
+            // A live render replaced by a newer one is not news.
+            Some(Err(RenderPanelError::Cancelled { .. })) if self.render.live.enabled => {}
             Some(Ok(text)) => self.say(text, false),
             Some(Err(e)) => self.say(e.to_string(), true),
             None => {}
         }
+        self.live_tick(ctx);
         if self.render.busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(50));
         }
@@ -543,6 +596,8 @@ impl Panel for RenderPanel {
                 ui.add(egui::ProgressBar::new(f).text(format!("{done}/{total} tiles")));
             }
         });
+        let busy = self.busy();
+        self.live.ui(ui, self.progress(), busy);
         let r = ui.add(egui::Slider::new(&mut self.ab_split, 0.0..=1.0).text("A/B"));
         name_widget(ui, &r, "A/B split");
         ui.label("photo left of the split, montage right");

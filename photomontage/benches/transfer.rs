@@ -11,143 +11,30 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::Point3;
+use photomontage::radiosity::city_block::{
+    self, RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
+};
 use photomontage::radiosity::form_factor::FormFactorEngine;
-use photomontage::radiosity::hierarchical::HierarchicalParams;
 use photomontage::radiosity::sources::direct_irradiance;
 use photomontage::radiosity::{
-    FormFactorParams, LightingChange, MeshParams, NamedLuminaire, PointSource, RelightStrategy,
-    Sky, SolveParams, Solver, Sun, Sweep, Transfer, TransferLighting, TransferParams,
+    LightingChange, RelightStrategy, Sun, Sweep, Transfer, TransferParams,
 };
-use photomontage::scene::{ImportedModel, Material, ObjectKind, Scene};
-use photomontage::sky::{SkyModel, direction_from_elevation_azimuth};
-
-type Tri = [Point3<f64>; 3];
 
 /// Threads of every measurement (the target is on 2 threads).
 const THREADS: usize = 2;
 
-fn quad(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> Vec<Tri> {
-    let p = |v: [f64; 3]| Point3::from(v);
-    vec![[p(a), p(b), p(c)], [p(a), p(c), p(d)]]
-}
-
-fn add(scene: &mut Scene, name: &str, triangles: Vec<Tri>, material: &str, albedo: f64) {
-    let n = triangles.len();
-    let model = ImportedModel {
-        triangles_in_world_m: triangles,
-        triangle_materials: vec![0; n],
-        materials: vec![Material::diffuse(material, [albedo; 3])],
-        warnings: Vec::new(),
-    };
-    scene.add_model(&model, name, ObjectKind::Natural).unwrap();
-}
-
-/// Walls and roof of a box (outward), no floor.
-fn building(x: f64, y: f64, w: f64, h: f64) -> Vec<Tri> {
-    let (x1, y1) = (x + w, y + w);
-    let mut t = Vec::new();
-    t.extend(quad([x, y, 0.], [x1, y, 0.], [x1, y, h], [x, y, h]));
-    t.extend(quad([x1, y, 0.], [x1, y1, 0.], [x1, y1, h], [x1, y, h]));
-    t.extend(quad([x1, y1, 0.], [x, y1, 0.], [x, y1, h], [x1, y1, h]));
-    t.extend(quad([x, y1, 0.], [x, y, 0.], [x, y, h], [x, y1, h]));
-    t.extend(quad([x, y, h], [x1, y, h], [x1, y1, h], [x, y1, h]));
-    t
-}
-
-/// 16 buildings (4 × 4, 20 m wide, 15 m high, 40 m apart) on a 200 m ground.
-fn city_block() -> Scene {
-    let mut s = Scene::new();
-    add(
-        &mut s,
-        "ground",
-        quad(
-            [-100., -100., 0.],
-            [100., -100., 0.],
-            [100., 100., 0.],
-            [-100., 100., 0.],
-        ),
-        "asphalt",
-        0.2,
-    );
-    let mut k = 0;
-    for i in 0..4 {
-        for j in 0..4 {
-            let (x, y) = (-70.0 + 40.0 * f64::from(i), -70.0 + 40.0 * f64::from(j));
-            let material = if k % 2 == 0 { "render" } else { "brick" };
-            add(
-                &mut s,
-                &format!("building{k}"),
-                building(x, y, 20.0, 15.0),
-                material,
-                if k % 2 == 0 { 0.6 } else { 0.35 },
-            );
-            k += 1;
-        }
-    }
-    s
-}
-
 /// Longest patch edge (the hierarchy's roots) of the main measurements, metres.
-const PATCH_EDGE_M: f64 = 8.0;
+const PATCH_EDGE_M: f64 = city_block::CITY_BLOCK_PATCH_EDGE_M;
 
 /// Roots of the coarse-root variant, metres: 16 × fewer patches, so far fewer initial links.
 const COARSE_PATCH_EDGE_M: f64 = 32.0;
 
 fn params(strategy: RelightStrategy, sweep: Sweep) -> TransferParams {
-    params_with_roots(strategy, sweep, PATCH_EDGE_M)
-}
-
-fn params_with_roots(strategy: RelightStrategy, sweep: Sweep, patch_edge_m: f64) -> TransferParams {
-    let mut object_element_edge_m = std::collections::BTreeMap::new();
-    object_element_edge_m.insert("ground".to_owned(), 8.0);
-    TransferParams {
-        solve: SolveParams {
-            mesh: MeshParams {
-                max_patch_edge_m: patch_edge_m,
-                max_element_edge_m: 2.0,
-                object_element_edge_m,
-                ..MeshParams::default()
-            },
-            form_factors: FormFactorParams {
-                samples_per_axis: 2,
-                seed: 0,
-                visibility: true,
-            },
-            solver: Solver::Hierarchical(HierarchicalParams::default()),
-            ..SolveParams::default()
-        },
-        sky_tolerance: 0.1,
-        strategy,
-        sweep,
-    }
+    city_block_params(strategy, sweep)
 }
 
 fn sun(elevation: f64, azimuth: f64) -> Sun {
-    Sun {
-        dir_in_world: direction_from_elevation_azimuth(elevation, azimuth),
-        normal_irradiance_rgb: [3.0, 2.9, 2.7],
-    }
-}
-
-fn lighting() -> TransferLighting {
-    TransferLighting {
-        sun: Some(sun(0.7, 2.6)),
-        sky: Some(Sky {
-            model: SkyModel::CieOvercast,
-            horizontal_irradiance_rgb: [0.4, 0.45, 0.5],
-        }),
-        luminaires: vec![NamedLuminaire {
-            name: "luminaire:street".into(),
-            source: PointSource {
-                position_in_world_m: Point3::new(0.0, 0.0, 6.0),
-                luminaire: None,
-                intensity_rgb: [500.0; 3],
-            },
-            dimming: 1.0,
-        }],
-        emitters: false,
-    }
+    city_block_sun(elevation, azimuth)
 }
 
 fn pool() -> rayon::ThreadPool {
@@ -159,8 +46,8 @@ fn pool() -> rayon::ThreadPool {
 
 fn build(p: &TransferParams) -> Transfer {
     Transfer::build(
-        &city_block(),
-        &lighting(),
+        &city_block(0, [RENDER_ALBEDO; 3]).unwrap(),
+        &city_block_lighting(),
         p,
         &AtomicBool::new(false),
         &|_| {},
@@ -398,7 +285,7 @@ fn bench_transfer(c: &mut Criterion) {
         ));
     }
     // The same relights on coarser roots (not the main figures: its solution differs, printed).
-    let coarse_params = params_with_roots(
+    let coarse_params = city_block::city_block_params_with_roots(
         RelightStrategy::LinearResponses,
         Sweep::Shooting,
         COARSE_PATCH_EDGE_M,

@@ -35,6 +35,7 @@
 //! (`render::differential::radiosity_light`). No spectral mode (RGB only). Luminaires are point
 //! sources. [`transfer`] relights on the links refined for the lighting it was built with.
 
+pub mod city_block;
 pub mod convergence;
 pub mod convergence_plot;
 pub mod covered;

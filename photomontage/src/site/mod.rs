@@ -15,6 +15,7 @@
 
 pub mod control_location;
 pub mod elevation;
+pub mod live_relight;
 mod locate;
 pub mod luminaires;
 pub mod models;

@@ -399,4 +399,4 @@ pub fn prepare_view_with(
 
 #[cfg(test)]
 #[path = "render_tests.rs"]
-mod tests;
+pub(crate) mod tests;

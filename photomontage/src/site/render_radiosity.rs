@@ -10,7 +10,8 @@
 //! [`SolveParams::default`] are used.
 //!
 //! # Known limitations
-//! Both solves run before every render (no cache between renders of the same site); a large
+//! Both solves run before every render of the CLI (the studio keeps them between renders as
+//! transfers, [`super::live_relight`]); a large
 //! ground plane takes the element size up for every object, blurring the sky a building blocks
 //! over that size (docs/methodology.md).
 
@@ -91,6 +92,28 @@ fn radiosity_error(e: &crate::radiosity::RadiosityError) -> SiteRenderError {
     }
 }
 
+/// The solve parameters of the site scene `scene` (module doc: element size from the budget,
+/// patches, the ground below the horizon) and the element edge used, metres.
+///
+/// # Errors
+/// [`SiteRenderError::Request`] for a ground albedo outside [0, 1].
+pub fn site_solve_params(
+    doc: &SiteDocument,
+    scene: &Scene,
+) -> Result<(SolveParams, f64), SiteRenderError> {
+    let element_edge_m = ELEMENT_EDGE_M.max((area_m2(scene) / ELEMENT_BUDGET).sqrt());
+    let params = SolveParams {
+        mesh: MeshParams {
+            max_patch_edge_m: PATCH_PER_ELEMENT * element_edge_m,
+            max_element_edge_m: element_edge_m,
+            ..MeshParams::default()
+        },
+        ground: site_ground_below_horizon(doc, scene)?,
+        ..SolveParams::default()
+    };
+    Ok((params, element_edge_m))
+}
+
 /// Solves the site scene `scene` (natural and artificial objects, as rendered) with and without
 /// its artificial objects under the lighting of photo `view` (module doc).
 ///
@@ -110,16 +133,7 @@ pub fn site_radiosity_light(
         .light_groups(&dome, SKY_TOLERANCE)
         .map_err(|e| radiosity_error(&e))?;
     let natural = natural_part(scene)?;
-    let element_edge_m = ELEMENT_EDGE_M.max((area_m2(scene) / ELEMENT_BUDGET).sqrt());
-    let params = SolveParams {
-        mesh: MeshParams {
-            max_patch_edge_m: PATCH_PER_ELEMENT * element_edge_m,
-            max_element_edge_m: element_edge_m,
-            ..MeshParams::default()
-        },
-        ground: site_ground_below_horizon(doc, scene)?,
-        ..SolveParams::default()
-    };
+    let (params, element_edge_m) = site_solve_params(doc, scene)?;
     let with = solve(scene, &groups, &params, cancel, &|_| {}).map_err(|e| radiosity_error(&e))?;
     // The photographed state has none of the project's luminaires.
     let natural_groups: Vec<_> = groups

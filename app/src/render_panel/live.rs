@@ -1,0 +1,262 @@
+//! The Render tab's live preview (issue 17: "the montage preview updates within a frame for the
+//! radiosity part and refines progressively for the rest. Show the frame time"): while **Live**
+//! is on, every edit that changes what the render depends on (the site — light, sky, sun and
+//! time, luminaires, materials, exposure, models —, the photo, the quality) cancels the running
+//! render and starts a new one, coarse first (4 rays per pixel over the whole view, shown tile
+//! by tile), then at the panel's quality, which is the montage. A cancelled render leaves no
+//! tiles behind: the new job starts from the photo.
+//!
+//! In the radiosity mode (`[render] radiosity = true`) the site's two transfers
+//! (`photomontage::site::live_relight::SiteTransfers`) stay alive here between renders, Live or
+//! not: built once on the render worker, relit with `Transfer::relight` for a light or material
+//! edit, built again only when the geometry changes; the renderer reads the relit solutions
+//! through `Lighting::radiosity`.
+//!
+//! The tab shows the last egui frame's time (the studio's whole `ui` call), the last radiosity
+//! update's time and kind, and the refinement's pass and tiles.
+//!
+//! # Known limitations
+//! Every new render decodes the photo again; the re-projected views (planar, cylindrical) are
+//! not rendered live (Start renders them).
+
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use eframe::egui;
+use photomontage::site::SiteDocument;
+use photomontage::site::live_relight::{RelightReport, SiteTransfers, TransferUpdate};
+use photomontage::site::render::ViewJob;
+
+use super::{Quality, RenderPanelError, RenderUpdate};
+use crate::widgets::name_widget;
+use crate::worker::Progress;
+
+/// Rays per pixel of the coarse pass.
+pub const COARSE_SPP: u32 = 4;
+
+/// The site's transfers, shared with the render worker.
+pub type SharedTransfers = Arc<Mutex<Option<SiteTransfers>>>;
+
+/// What the live preview rendered last: the site, photo and quality.
+#[derive(Debug, Clone, PartialEq)]
+struct LiveKey {
+    site: photomontage::site::Site,
+    photo: String,
+    quality: Quality,
+}
+
+/// State of the live preview.
+#[derive(Default)]
+pub struct LivePreview {
+    /// Live on: edits restart the render.
+    pub enabled: bool,
+    /// What the running (or last started) live render shows.
+    started: Option<LiveKey>,
+    /// What the last finished live render shows.
+    finished: Option<LiveKey>,
+    /// The site's radiosity transfers (radiosity mode).
+    pub(super) transfers: SharedTransfers,
+    last_frame: Option<Duration>,
+    last_relight: Option<RelightReport>,
+    /// Pass of the running render: (index from 1, count).
+    pub(super) pass: Option<(u32, u32)>,
+    cancelled: usize,
+}
+
+/// What a render job does beyond the panel's quality.
+#[derive(Clone, Default)]
+pub struct JobOptions {
+    /// Render a coarse pass ([`COARSE_SPP`]) first.
+    pub coarse_first: bool,
+    /// The site's transfers, in the radiosity mode.
+    pub transfers: Option<SharedTransfers>,
+}
+
+impl JobOptions {
+    /// In the radiosity mode: updates the site's transfers for `job`'s scene (build, relight or
+    /// nothing, reported to the panel) and hands their solutions to the renderer.
+    ///
+    /// # Errors
+    /// [`RenderPanelError::Prepare`] with the library's message.
+    pub(super) fn prepare_radiosity(
+        &self,
+        doc: &SiteDocument,
+        photo_id: &str,
+        job: &mut ViewJob,
+        progress: &Progress<RenderUpdate>,
+    ) -> Result<(), RenderPanelError> {
+        let Some(shared) = &self.transfers else {
+            return Ok(());
+        };
+        // A job that panicked while holding the lock may have left the transfers half-relit:
+        // start again from a build.
+        let mut slot = shared.lock().unwrap_or_else(|poisoned| {
+            let mut slot = poisoned.into_inner();
+            *slot = None;
+            slot
+        });
+        shared.clear_poison();
+        let (light, report) = SiteTransfers::update(
+            &mut slot,
+            doc,
+            &job.scene.scene,
+            photo_id,
+            progress.cancel_flag(),
+        )
+        .map_err(|e| RenderPanelError::Prepare {
+            photo: photo_id.to_owned(),
+            message: e.to_string(),
+        })?;
+        job.lighting.radiosity = Some(light);
+        progress.send(RenderUpdate::Relit(report));
+        Ok(())
+    }
+}
+
+impl LivePreview {
+    /// The last egui frame's time.
+    #[must_use]
+    pub fn last_frame(&self) -> Option<Duration> {
+        self.last_frame
+    }
+
+    /// The last radiosity update (build, relight or unchanged) and its time.
+    #[must_use]
+    pub fn last_relight(&self) -> Option<&RelightReport> {
+        self.last_relight.as_ref()
+    }
+
+    /// Live renders cancelled by a newer edit.
+    #[must_use]
+    pub fn cancelled(&self) -> usize {
+        self.cancelled
+    }
+
+    /// Whether the last finished live render shows `site` (photo and quality as started).
+    #[must_use]
+    pub fn shows(&self, site: &photomontage::site::Site) -> bool {
+        self.finished.as_ref().is_some_and(|k| k.site == *site) && self.started == self.finished
+    }
+
+    /// The site's transfers (radiosity mode), shared with the render worker; tests compare
+    /// their solutions with a fresh solve.
+    #[must_use]
+    pub fn transfers(&self) -> SharedTransfers {
+        Arc::clone(&self.transfers)
+    }
+
+    /// Records the time of the studio's last frame.
+    pub fn frame_done(&mut self, elapsed: Duration) {
+        self.last_frame = Some(elapsed);
+    }
+
+    pub(super) fn relit(&mut self, report: RelightReport) {
+        self.last_relight = Some(report);
+    }
+
+    /// A render ended: finished (`ok`) or not.
+    pub(super) fn ended(&mut self, ok: bool) {
+        self.pass = None;
+        if ok {
+            self.finished.clone_from(&self.started);
+        }
+    }
+
+    /// The Live toggle, the frame and relight times and the refinement's progress.
+    pub fn ui(&mut self, ui: &mut egui::Ui, tiles: (usize, usize), busy: bool) {
+        ui.horizontal(|ui| {
+            let r = ui.checkbox(&mut self.enabled, "Live");
+            name_widget(ui, &r, "Live preview");
+            if r.changed() && !self.enabled {
+                self.started = None;
+            }
+            let ms = |d: Duration| d.as_secs_f64() * 1e3;
+            let frame = self
+                .last_frame
+                .map_or_else(|| "–".to_owned(), |d| format!("{:.1} ms", ms(d)));
+            ui.label(format!("frame {frame}"));
+        });
+        if let Some(r) = &self.last_relight {
+            let what = match r.update {
+                TransferUpdate::Built => "built",
+                TransferUpdate::Relit => "relit",
+                TransferUpdate::Unchanged => "unchanged",
+            };
+            ui.label(format!(
+                "radiosity update {:.1} ms ({what})",
+                r.seconds * 1e3
+            ));
+        }
+        if busy && let Some((index, count)) = self.pass {
+            let name = if index < count { "coarse" } else { "full" };
+            let (done, total) = tiles;
+            ui.label(format!(
+                "refining: pass {index}/{count} ({name}), {done}/{total} tiles"
+            ));
+        }
+    }
+}
+
+impl crate::Studio {
+    /// Live preview: restarts the render when what it shows changed (called every frame after
+    /// the render worker was polled).
+    pub(crate) fn live_tick(&mut self, ctx: &egui::Context) {
+        if !self.render.live.enabled {
+            return;
+        }
+        let (Some(doc), Some(id)) = (self.doc.as_ref(), self.current_photo.as_deref()) else {
+            return;
+        };
+        if !doc
+            .site
+            .photos
+            .iter()
+            .any(|p| p.id == id && p.exterior.is_some())
+        {
+            return;
+        }
+        let quality = self.render.quality;
+        let current = self
+            .render
+            .live
+            .started
+            .as_ref()
+            .is_some_and(|k| k.photo == id && k.quality == quality && k.site == doc.site);
+        if current {
+            return;
+        }
+        if self.render.busy() {
+            // The worker stops at its next tile; the new render starts when it has ended.
+            if !self.render.worker.cancelling() {
+                self.render.cancel();
+                self.render.live.cancelled += 1;
+            }
+            return;
+        }
+        let key = LiveKey {
+            site: doc.site.clone(),
+            photo: id.to_owned(),
+            quality,
+        };
+        let options = JobOptions {
+            coarse_first: true,
+            transfers: None,
+        };
+        let id = id.to_owned();
+        let result = self.render.start_with(doc, &id, ctx, options);
+        // Started or refused (an error to read), either way not retried until the next edit.
+        self.render.live.started = Some(key);
+        if let Err(e) = result {
+            self.say(e.to_string(), true);
+        }
+    }
+}
+
+/// The coarse pass then the full one, as `progress` reports them.
+pub(super) fn passes(options: &JobOptions, quality: Quality) -> Vec<(u32, u32)> {
+    if options.coarse_first && (quality.spp_min, quality.spp_max) != (COARSE_SPP, COARSE_SPP) {
+        vec![(COARSE_SPP, COARSE_SPP), (quality.spp_min, quality.spp_max)]
+    } else {
+        vec![(quality.spp_min, quality.spp_max)]
+    }
+}

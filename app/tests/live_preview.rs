@@ -1,0 +1,266 @@
+//! The Render tab's live preview, driven by labels on the courtyard sample with the box model:
+//! with Live on, a sky-type change (Site & light tab) made mid-render cancels the running render
+//! and starts a new one, and a material colour (Materials tab) another; when the preview has
+//! caught up, its montage equals the library's `render_view` of the same site bit for bit (same
+//! rays per pixel and seed) and the preview shows exactly the montage (no tile of a cancelled
+//! render left). In the radiosity mode the studio's relit transfers match a fresh solve of the
+//! edited site within the transfer tests' tolerance, and the montage equals the library's render
+//! on those solutions bit for bit.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use common::{WINDOW, add_box_model, copy_sample, harness, step_until};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use photomontage::radiosity::{Solution, luminance};
+use photomontage::render::differential::radiosity_light::RadiosityLight;
+use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
+use photomontage::site::SiteDocument;
+use photomontage::site::live_relight::TransferUpdate;
+use photomontage::site::render::{prepare_view, site_scene};
+use photomontage::site::render_radiosity::site_radiosity_light;
+use photomontage_studio::Studio;
+use photomontage_studio::render_panel::{display_image, site_tone_map};
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+/// Relit against a fresh solve: the transfer tests' tolerance (`radiosity/transfer_tests.rs`
+/// `RESOLVE_L1_REL_TOL`, `RESOLVE_MEAN_REL_TOL`): the relight keeps the build's refinement, a
+/// fresh solve refines for the new lighting within the BF tolerance.
+const RESOLVE_L1_REL_TOL: f64 = 0.02;
+const RESOLVE_MEAN_REL_TOL: f64 = 0.01;
+
+const SPP: (u32, u32) = (4, 8);
+const SEED: u64 = 7;
+
+fn with_palette(site: &Path, radiosity: bool) {
+    let mut text = std::fs::read_to_string(site).unwrap();
+    text.push_str("\n[[palette]]\nname = \"Sienna\"\ncolour = \"#a0522d\"\n");
+    if radiosity {
+        text.push_str("\n[render]\nradiosity = true\n");
+    }
+    std::fs::write(site, text).unwrap();
+}
+
+/// Opens the site, solves it, sets the quality and turns Live on (by its label).
+fn live_studio(site: &Path) -> Harness<'static, Studio> {
+    let mut h = harness(site, WINDOW);
+    h.get_by_label("Solve").click();
+    step_until(&mut h, "solve", |s| s.solution().is_some() && s.is_idle());
+    h.get_by_label("Render").click();
+    h.run();
+    {
+        let q = &mut h.state_mut().render_panel_mut().quality;
+        (q.spp_min, q.spp_max, q.seed) = (SPP.0, SPP.1, SEED);
+    }
+    h.get_by_label("Live preview").click();
+    steps(&mut h);
+    h
+}
+
+/// Steps until `done` holds (at most 300 s), without waiting for the UI to settle.
+fn wait(h: &mut Harness<'static, Studio>, what: &str, done: impl Fn(&Studio) -> bool) {
+    let start = std::time::Instant::now();
+    while !done(h.state()) {
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        assert!(start.elapsed().as_secs() < 300, "{what} did not finish");
+    }
+}
+
+/// A few frames (a running render keeps repainting: `Harness::run` would not settle).
+fn steps(h: &mut Harness<'static, Studio>) {
+    for _ in 0..3 {
+        h.step();
+    }
+}
+
+fn caught_up(s: &Studio) -> bool {
+    let p = s.render_panel();
+    !p.busy() && p.live.shows(&s.document().unwrap().site) && p.montage().is_some()
+}
+
+/// Picks `model` in the Site & light tab's sky model list.
+fn set_sky(h: &mut Harness<'static, Studio>, model: &str) {
+    h.get_by_label("Site & light tab").click();
+    steps(h);
+    h.get_by_label("sky model").click();
+    steps(h);
+    h.get_by_label(model).click();
+    steps(h);
+}
+
+/// Gives the brick material the palette's Sienna in the Materials tab.
+fn set_brick_sienna(h: &mut Harness<'static, Studio>) {
+    h.get_by_label("Materials tab").click();
+    steps(h);
+    h.get_by_label("Material brick").click();
+    steps(h);
+    h.get_by_label("Use Sienna").click();
+    steps(h);
+}
+
+fn library_render(doc: &SiteDocument, radiosity: Option<Arc<RadiosityLight>>) -> RenderedImage {
+    let mut job = prepare_view(doc, "P1").unwrap();
+    job.settings.min_rays_per_pixel = SPP.0;
+    job.settings.max_rays_per_pixel = SPP.1;
+    job.settings.seed = SEED;
+    job.lighting.radiosity = radiosity;
+    let tracer = DifferentialTracer::new(
+        &job.scene.scene,
+        &job.lighting,
+        &job.camera,
+        &job.photo_linear,
+        job.settings.max_depth,
+    )
+    .unwrap();
+    render_view(&tracer, &job.settings, &|_| {}, &AtomicBool::new(false)).unwrap()
+}
+
+fn bits(im: &RenderedImage) -> Vec<u32> {
+    im.rgba.iter().flatten().map(|v| v.to_bits()).collect()
+}
+
+/// The finished montage equals `library` bit for bit and the preview shows it, nothing else.
+fn assert_montage_is(h: &Harness<'static, Studio>, library: &RenderedImage, label: &str) {
+    let doc = h.state().document().unwrap();
+    let panel = h.state().render_panel();
+    let montage = &panel.montage().unwrap().image;
+    assert!(library.changed_pixels > 1000, "{label}: the box is in view");
+    assert!(bits(montage) == bits(library), "{label}: montage differs");
+    assert!(
+        panel.preview().unwrap().image().pixels
+            == display_image(montage, &site_tone_map(doc)).pixels,
+        "{label}: the preview shows something other than the montage"
+    );
+}
+
+#[test]
+fn live_preview_follows_sky_and_colour_and_equals_the_library() {
+    let (_dir, site) = copy_sample();
+    add_box_model(&site);
+    with_palette(&site, false);
+    let mut h = live_studio(&site);
+    // Live starts a render by itself, coarse pass first.
+    assert!(
+        h.state().render_panel().busy(),
+        "{:?}",
+        h.state().messages()
+    );
+    wait(&mut h, "first tiles", |s| {
+        s.render_panel().progress().0 > 0 || !s.render_panel().busy()
+    });
+    assert!(
+        h.state().render_panel().busy(),
+        "the render ended before the edit"
+    );
+    // A sky type mid-render: the running render is cancelled and a new one starts.
+    set_sky(&mut h, "cie_general:5");
+    wait(&mut h, "live render after the sky", caught_up);
+    assert!(h.state().render_panel().live.cancelled() >= 1);
+    assert!(
+        h.state()
+            .messages()
+            .iter()
+            .all(|m| !m.is_error && !m.text.contains("cancelled")),
+        "{:?}",
+        h.state().messages()
+    );
+    let doc = h.state().document().unwrap().clone();
+    assert_eq!(doc.site.lighting.sky_model.to_string(), "cie_general:5");
+    assert_montage_is(&h, &library_render(&doc, None), "sky");
+    h.get_by_label("Render").click();
+    steps(&mut h);
+    assert!(h.query_by_label_contains("frame ").is_some());
+
+    set_brick_sienna(&mut h);
+    wait(&mut h, "live render after the colour", caught_up);
+    let doc = h.state().document().unwrap().clone();
+    assert!(
+        doc.site
+            .materials
+            .iter()
+            .any(|m| m.material.name == "brick"),
+        "the colour is a site material"
+    );
+    assert_montage_is(&h, &library_render(&doc, None), "colour");
+    assert!(h.state().render_panel().live.last_frame().is_some());
+}
+
+fn areas(s: &Solution) -> Vec<f64> {
+    (0..s.mesh.elements.len())
+        .map(|e| s.mesh.element_node(e).area_m2)
+        .collect()
+}
+
+fn assert_matches_fresh_solve(label: &str, relit: &Solution, fresh: &Solution) {
+    let w = areas(fresh);
+    let (a, b) = (relit.total_radiosity_rgb(), fresh.total_radiosity_rgb());
+    assert_eq!(a.len(), b.len(), "{label}: same mesh");
+    let (mut diff, mut mean_a, mut mean_b) = (0.0, 0.0, 0.0);
+    for ((x, y), w) in a.iter().zip(&b).zip(&w) {
+        let d: [f64; 3] = std::array::from_fn(|c| (x[c] - y[c]).abs());
+        diff += luminance(&d) * w;
+        mean_a += luminance(x) * w;
+        mean_b += luminance(y) * w;
+    }
+    assert!(mean_b > 0.0, "{label}: a lit scene");
+    assert!(
+        diff / mean_b < RESOLVE_L1_REL_TOL,
+        "{label}: L1 {}",
+        diff / mean_b
+    );
+    assert!(
+        (mean_a - mean_b).abs() / mean_b < RESOLVE_MEAN_REL_TOL,
+        "{label}: mean {mean_a} vs {mean_b}"
+    );
+}
+
+#[test]
+fn radiosity_mode_relights_the_kept_transfers() {
+    let (_dir, site) = copy_sample();
+    add_box_model(&site);
+    with_palette(&site, true);
+    let mut h = live_studio(&site);
+    wait(&mut h, "first live render", caught_up);
+    let built = h
+        .state()
+        .render_panel()
+        .live
+        .last_relight()
+        .unwrap()
+        .clone();
+    assert_eq!(built.update, TransferUpdate::Built);
+
+    set_sky(&mut h, "cie_overcast");
+    wait(&mut h, "live render after the sky", caught_up);
+    set_brick_sienna(&mut h);
+    wait(&mut h, "live render after the colour", caught_up);
+    let relit = h
+        .state()
+        .render_panel()
+        .live
+        .last_relight()
+        .unwrap()
+        .clone();
+    assert_eq!(relit.update, TransferUpdate::Relit);
+    h.get_by_label("Render").click();
+    steps(&mut h);
+    assert!(h.query_by_label_contains("radiosity update").is_some());
+
+    let doc = h.state().document().unwrap().clone();
+    let transfers = h.state().render_panel().live.transfers();
+    let light = transfers.lock().unwrap().as_ref().unwrap().light();
+    let scene = site_scene(&doc).unwrap().scene;
+    let (fresh, _) = site_radiosity_light(&doc, &scene, "P1", &AtomicBool::new(false)).unwrap();
+    assert_matches_fresh_solve("with", &light.with_artificial, &fresh.with_artificial);
+    assert_matches_fresh_solve(
+        "without",
+        &light.without_artificial,
+        &fresh.without_artificial,
+    );
+    assert_montage_is(&h, &library_render(&doc, Some(light)), "radiosity");
+}

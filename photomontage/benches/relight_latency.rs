@@ -1,0 +1,133 @@
+//! Relight latency of the studio's live preview in the radiosity mode (issue 17: "Relight
+//! latency in the studio (sun slider, material colour) measured in a bench with the 50 000-patch
+//! scene of the radiosity issue: median ≤ 16 ms for the radiosity update").
+//!
+//! The scene is the city block of `benches/transfer.rs` ([`photomontage::radiosity::city_block`])
+//! with its first building planned (artificial), so the studio keeps two transfers (with and
+//! without the planned building) as `photomontage::site::live_relight::SiteTransfers` does. Each
+//! step is the studio's path after the site has been read: the site's lighting and materials →
+//! [`photomontage::site::live_relight::lighting_change`] (geometry fingerprint, change) →
+//! `Transfer::relight` on both transfers side by side → the renderer's `RadiosityLight` (the
+//! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth; a
+//! material colour step changes the "render" material's colour. 2 threads; criterion medians,
+//! then medians of 8 alternating steps.
+//!
+//! `cargo bench -p photomontage --bench relight_latency` (release profile).
+#![allow(clippy::unwrap_used)]
+
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use photomontage::radiosity::city_block::{
+    RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
+};
+use photomontage::radiosity::{RelightStrategy, Sweep, TransferLighting};
+use photomontage::scene::Scene;
+use photomontage::site::live_relight::{SiteTransfers, TransferUpdate};
+
+/// Threads of every measurement (the issue's target is on 2 threads).
+const THREADS: usize = 2;
+/// Sun slider step: 1° of azimuth.
+const SUN_STEP_RAD: f64 = 1.0_f64 * std::f64::consts::PI / 180.0;
+/// The material colour step: "render" between its albedo and this colour.
+const RENDER_COLOUR: [f64; 3] = [0.7, 0.5, 0.4];
+
+fn sun_lighting(flip: bool) -> TransferLighting {
+    let mut l = city_block_lighting();
+    l.sun = Some(city_block_sun(
+        0.7,
+        2.6 + if flip { SUN_STEP_RAD } else { 0.0 },
+    ));
+    l
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn bench_relight_latency(c: &mut Criterion) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(THREADS)
+        .build()
+        .unwrap();
+    let params = city_block_params(RelightStrategy::LinearResponses, Sweep::Shooting);
+    let scenes: [Scene; 2] = [
+        city_block(1, [RENDER_ALBEDO; 3]).unwrap(),
+        city_block(1, RENDER_COLOUR).unwrap(),
+    ];
+    let t0 = Instant::now();
+    let mut transfers = pool.install(|| {
+        SiteTransfers::build_for(
+            &scenes[0],
+            &city_block_lighting(),
+            &params,
+            &AtomicBool::new(false),
+        )
+        .unwrap()
+    });
+    println!(
+        "relight latency: {} + {} elements (with / without the planned building), built in \
+         {:.1} s on {THREADS} threads",
+        transfers.with_artificial().mesh.elements.len(),
+        transfers.without_artificial().mesh.elements.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    let mut step = |scene: &Scene, lighting: &TransferLighting| {
+        let update = pool.install(|| transfers.relight_for(scene, lighting, &params).unwrap());
+        // Never a build: a step is a relight (or nothing, when it goes back to where it is).
+        assert!(matches!(
+            update,
+            Some(TransferUpdate::Relit | TransferUpdate::Unchanged)
+        ));
+        transfers.light()
+    };
+    let mut group = c.benchmark_group("studio_relight_50k");
+    group.sample_size(10);
+    group.warm_up_time(std::time::Duration::from_millis(500));
+    group.measurement_time(std::time::Duration::from_secs(2));
+    let mut flip = false;
+    group.bench_function("sun_slider_step", |b| {
+        b.iter(|| {
+            flip = !flip;
+            step(&scenes[0], &sun_lighting(flip))
+        });
+    });
+    // Back to the base sun, then colour steps.
+    step(&scenes[0], &sun_lighting(false));
+    let mut k = 0;
+    group.bench_function("material_colour_step", |b| {
+        b.iter(|| {
+            k = 1 - k;
+            step(&scenes[k], &sun_lighting(false))
+        });
+    });
+    group.finish();
+    let timed = |f: &mut dyn FnMut(usize)| {
+        let mut ms: Vec<f64> = (0..8)
+            .map(|i| {
+                let t = Instant::now();
+                f(i);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        median(&mut ms)
+    };
+    if k == 1 {
+        step(&scenes[0], &sun_lighting(false));
+    }
+    let sun_ms = timed(&mut |i| {
+        step(&scenes[0], &sun_lighting(i % 2 == 0));
+    });
+    step(&scenes[0], &sun_lighting(false));
+    let colour_ms = timed(&mut |i| {
+        step(&scenes[(i + 1) % 2], &sun_lighting(false));
+    });
+    println!("\n== studio relight ({THREADS} threads, median of 8 steps) ==");
+    println!("sun slider step (1° azimuth): {sun_ms:.1} ms");
+    println!("material colour step: {colour_ms:.1} ms");
+}
+
+criterion_group!(benches, bench_relight_latency);
+criterion_main!(benches);

@@ -1,0 +1,487 @@
+//! Interactive relighting of a site's radiosity mode (issue 17: "the montage preview updates
+//! within a frame for the radiosity part"; Tonn & Donath, seed 000: "the geometry-dependent part
+//! of the radiosity solution is calculated once … the lighting situation [sun position, sky type,
+//! artificial lights, materials] can then be changed interactively").
+//!
+//! [`SiteTransfers`] keeps the two precomputed transfers ([`Transfer`]) the renderer's radiosity
+//! mode reads ([`super::render_radiosity`]: the site with and without its artificial objects),
+//! built with the same light groups and solve parameters as [`super::render_radiosity`]'s
+//! solves, so that the first solution is theirs. [`SiteTransfers::update`] then takes the site as
+//! it is now and either:
+//!
+//! - finds nothing changed for the radiosity (the solutions are kept);
+//! - expresses the change as a [`LightingChange`] ([`lighting_change`]: a new sun, a new sky, a
+//!   luminaire's dimming, a material's diffuse reflectance) and applies it with
+//!   [`Transfer::relight`] on both transfers at once (never a form factor);
+//! - or, when the geometry, the solve parameters or anything a relight cannot express changed (a
+//!   model moved, a luminaire added, moved or re-aimed, an emitting material), builds both
+//!   transfers again.
+//!
+//! The geometry is compared through a fingerprint of the scene's triangles, objects and the
+//! solve parameters ([`scene_fingerprint`]).
+//!
+//! # Known limitations
+//! A relit solution keeps the links refined for the lighting the transfers were built with
+//! ([`crate::radiosity::transfer`]): it equals a fresh solve within the transfer's tolerance, not
+//! bit for bit. Both transfers are kept in memory (links of both scenes).
+
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use super::SiteDocument;
+use super::radiosity_lighting::site_transfer_lighting;
+use super::render_error::SiteRenderError;
+use super::render_radiosity::{RadiosityReport, natural_part, site_solve_params};
+use crate::radiosity::{
+    LightingChange, RadiosityError, Solution, Transfer, TransferLighting, TransferParams,
+};
+use crate::render::differential::radiosity_light::RadiosityLight;
+use crate::scene::Scene;
+
+/// Two luminaire outputs are the same source dimmed when their channel ratios agree within this
+/// relative difference (ratios of the same `f64` products differ by rounding only).
+pub const DIMMING_RATIO_REL_TOL: f64 = 1e-9;
+
+type Rgb = [f64; 3];
+
+/// What [`SiteTransfers::update`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TransferUpdate {
+    /// Both transfers were (re)built: first use, or a change a relight cannot express.
+    Built,
+    /// The change was applied with [`Transfer::relight`].
+    Relit,
+    /// Nothing the radiosity depends on changed.
+    Unchanged,
+}
+
+/// The outcome of an update: what was done and how long it took.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RelightReport {
+    /// Built, relit or unchanged.
+    pub update: TransferUpdate,
+    /// Wall time of the update (build or relight of both transfers), seconds.
+    pub seconds: f64,
+}
+
+/// The diffuse reflectance and emission of each material of `scene`, by name (what a relight
+/// can change, and what it cannot).
+#[must_use]
+pub fn material_state(scene: &Scene) -> Vec<(String, Rgb, Option<Rgb>)> {
+    scene
+        .materials()
+        .iter()
+        .map(|m| {
+            (
+                m.name.clone(),
+                m.diffuse_reflectance_rgb(),
+                m.emission_rgb_w_m2_sr,
+            )
+        })
+        .collect()
+}
+
+/// A fingerprint of what a transfer's links depend on: the triangles (vertex bits, object and
+/// material index), the objects' names and kinds, and the transfer parameters.
+#[must_use]
+pub fn scene_fingerprint(scene: &Scene, params: &TransferParams) -> u64 {
+    let mut h = DefaultHasher::new();
+    for t in scene.triangles() {
+        for v in &t.vertices_in_world_m {
+            for c in v.iter() {
+                c.to_bits().hash(&mut h);
+            }
+        }
+        t.object.0.hash(&mut h);
+        t.material.0.hash(&mut h);
+    }
+    for o in scene.objects() {
+        o.name.hash(&mut h);
+        format!("{:?}", o.kind).hash(&mut h);
+    }
+    // The parameters hold floats; their debug text is exact (shortest round-trip form).
+    format!("{params:?}").hash(&mut h);
+    h.finish()
+}
+
+/// The dimming that turns `built` (full output) into `now` (`now`'s own dimming applied), when
+/// `now` is `built` dimmed: same position and photometry, every channel in the same ratio.
+fn dimming_between(
+    built: &crate::radiosity::NamedLuminaire,
+    now: &crate::radiosity::NamedLuminaire,
+) -> Option<f64> {
+    let (a, b) = (&built.source, &now.source);
+    if built.name != now.name
+        || a.position_in_world_m != b.position_in_world_m
+        || a.luminaire != b.luminaire
+    {
+        return None;
+    }
+    let mut ratio: Option<f64> = None;
+    for c in 0..3 {
+        let (full, wanted) = (a.intensity_rgb[c], b.intensity_rgb[c] * now.dimming);
+        if full == 0.0 {
+            if wanted != 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let k = wanted / full;
+        match ratio {
+            None => ratio = Some(k),
+            Some(r) if (r - k).abs() <= DIMMING_RATIO_REL_TOL * r.abs().max(k.abs()) => {}
+            Some(_) => return None,
+        }
+    }
+    Some(ratio.unwrap_or(0.0))
+}
+
+/// The [`LightingChange`] that takes a transfer from `current` (its lighting and material
+/// state) to `target`, or `None` when a relight cannot express the difference (luminaires
+/// added, removed, moved, re-aimed or recoloured unevenly; emitters or emission changed; a
+/// material added or removed). An empty change means nothing changed.
+#[must_use]
+pub fn lighting_change(
+    current: &TransferLighting,
+    target: &TransferLighting,
+    current_materials: &[(String, Rgb, Option<Rgb>)],
+    target_materials: &[(String, Rgb, Option<Rgb>)],
+) -> Option<LightingChange> {
+    if current.emitters != target.emitters
+        || current.luminaires.len() != target.luminaires.len()
+        || current_materials.len() != target_materials.len()
+    {
+        return None;
+    }
+    let mut change = LightingChange::default();
+    if current.sun != target.sun {
+        change.sun = Some(target.sun);
+    }
+    if current.sky != target.sky {
+        change.sky = Some(target.sky.clone());
+    }
+    for (built, now) in current.luminaires.iter().zip(&target.luminaires) {
+        let dimming = dimming_between(built, now)?;
+        if dimming.to_bits() != built.dimming.to_bits() {
+            change.luminaire_dimming.push((built.name.clone(), dimming));
+        }
+    }
+    for ((name, rho, emission), (name_now, rho_now, emission_now)) in
+        current_materials.iter().zip(target_materials)
+    {
+        if name != name_now || emission != emission_now {
+            return None;
+        }
+        // Bit comparison: any change of the value is a change to apply.
+        if rho.map(f64::to_bits) != rho_now.map(f64::to_bits) {
+            change
+                .material_reflectance
+                .push((name.clone(), rho_now.map(|r| r.clamp(0.0, 1.0))));
+        }
+    }
+    Some(change)
+}
+
+/// Whether `change` changes nothing.
+#[must_use]
+pub fn is_empty(change: &LightingChange) -> bool {
+    *change == LightingChange::default()
+}
+
+/// One of the two transfers with what it was last solved for.
+struct Kept {
+    transfer: Transfer,
+    materials: Vec<(String, Rgb, Option<Rgb>)>,
+}
+
+/// The site's two transfers (with and without the artificial objects) kept between renders
+/// (module doc).
+pub struct SiteTransfers {
+    with_artificial: Kept,
+    without_artificial: Kept,
+    /// Fingerprints of the two scenes with their parameters.
+    fingerprint: [u64; 2],
+    light: Arc<RadiosityLight>,
+    /// The build's report (element size, element counts, notes).
+    pub report: RadiosityReport,
+}
+
+fn radiosity_error(e: &RadiosityError) -> SiteRenderError {
+    SiteRenderError::Request {
+        field: "render.radiosity",
+        reason: e.to_string(),
+    }
+}
+
+/// The lighting of the photographed state: the same, without the project's luminaires.
+fn natural_lighting(lighting: &TransferLighting) -> TransferLighting {
+    TransferLighting {
+        luminaires: Vec::new(),
+        ..lighting.clone()
+    }
+}
+
+/// What the transfers of `scene` need: both lightings, both scenes, the parameters and notes.
+struct Inputs {
+    lighting: [TransferLighting; 2],
+    scenes: [Scene; 2],
+    params: TransferParams,
+    element_edge_m: f64,
+    notes: Vec<String>,
+}
+
+fn inputs(doc: &SiteDocument, scene: &Scene, view: &str) -> Result<Inputs, SiteRenderError> {
+    let (lighting, notes) = site_transfer_lighting(doc, scene, view)?;
+    let (solve, _) = site_solve_params(doc, scene)?;
+    let params = TransferParams {
+        solve,
+        sky_tolerance: super::render_radiosity::SKY_TOLERANCE,
+        ..TransferParams::default()
+    };
+    let mut inputs = scene_inputs(scene, &lighting, &params)?;
+    inputs.notes = notes;
+    Ok(inputs)
+}
+
+fn scene_inputs(
+    scene: &Scene,
+    lighting: &TransferLighting,
+    params: &TransferParams,
+) -> Result<Inputs, SiteRenderError> {
+    Ok(Inputs {
+        lighting: [lighting.clone(), natural_lighting(lighting)],
+        scenes: [scene.clone(), natural_part(scene)?],
+        params: params.clone(),
+        element_edge_m: params.solve.mesh.max_element_edge_m,
+        notes: Vec::new(),
+    })
+}
+
+impl SiteTransfers {
+    /// Builds both transfers for the site scene `scene` (natural and artificial objects, as
+    /// rendered) lit for photo `view`; their solutions are [`super::render_radiosity`]'s.
+    ///
+    /// # Errors
+    /// The lighting's errors; a transfer error (a bad source, cancelled) as
+    /// [`SiteRenderError::Request`] naming `render.radiosity`.
+    pub fn build(
+        doc: &SiteDocument,
+        scene: &Scene,
+        view: &str,
+        cancel: &AtomicBool,
+    ) -> Result<Self, SiteRenderError> {
+        let start = Instant::now();
+        let inputs = inputs(doc, scene, view)?;
+        Self::from_inputs(inputs, cancel, start)
+    }
+
+    /// [`SiteTransfers::build`] for a scene and lighting given directly (benches, tests):
+    /// `lighting` for the scene with its artificial objects, the same without its luminaires
+    /// for the natural part.
+    ///
+    /// # Errors
+    /// As [`SiteTransfers::build`].
+    pub fn build_for(
+        scene: &Scene,
+        lighting: &TransferLighting,
+        params: &TransferParams,
+        cancel: &AtomicBool,
+    ) -> Result<Self, SiteRenderError> {
+        let start = Instant::now();
+        Self::from_inputs(scene_inputs(scene, lighting, params)?, cancel, start)
+    }
+
+    /// The relight step of [`SiteTransfers::update`] for a scene and lighting given directly
+    /// (the studio's path after the site has been read; the latency bench times it): `Ok(None)`
+    /// when the change needs a build.
+    ///
+    /// # Errors
+    /// A relight error.
+    pub fn relight_for(
+        &mut self,
+        scene: &Scene,
+        lighting: &TransferLighting,
+        params: &TransferParams,
+    ) -> Result<Option<TransferUpdate>, SiteRenderError> {
+        self.relight(&scene_inputs(scene, lighting, params)?)
+    }
+
+    fn from_inputs(
+        inputs: Inputs,
+        cancel: &AtomicBool,
+        start: Instant,
+    ) -> Result<Self, SiteRenderError> {
+        let Inputs {
+            lighting,
+            scenes,
+            params,
+            element_edge_m,
+            notes,
+        } = inputs;
+        let build = |k: usize| {
+            Transfer::build(&scenes[k], &lighting[k], &params, cancel, &|_| {})
+                .map(|transfer| Kept {
+                    transfer,
+                    materials: material_state(&scenes[k]),
+                })
+                .map_err(|e| radiosity_error(&e))
+        };
+        let with_artificial = build(0)?;
+        let without_artificial = build(1)?;
+        let light = Arc::new(RadiosityLight::new(
+            with_artificial.transfer.solution(),
+            without_artificial.transfer.solution(),
+            &RadiosityLight::traced_exactly,
+        ));
+        let report = RadiosityReport {
+            element_edge_m,
+            elements: [
+                with_artificial.transfer.solution().mesh.elements.len(),
+                without_artificial.transfer.solution().mesh.elements.len(),
+            ],
+            seconds: start.elapsed().as_secs_f64(),
+            notes,
+        };
+        Ok(Self {
+            fingerprint: [
+                scene_fingerprint(&scenes[0], &params),
+                scene_fingerprint(&scenes[1], &params),
+            ],
+            with_artificial,
+            without_artificial,
+            light,
+            report,
+        })
+    }
+
+    /// The lighting the renderer reads (both solutions, the traced groups' direct light out).
+    #[must_use]
+    pub fn light(&self) -> Arc<RadiosityLight> {
+        Arc::clone(&self.light)
+    }
+
+    /// The current solution with the artificial objects.
+    #[must_use]
+    pub fn with_artificial(&self) -> &Solution {
+        self.with_artificial.transfer.solution()
+    }
+
+    /// The current solution of the photographed state.
+    #[must_use]
+    pub fn without_artificial(&self) -> &Solution {
+        self.without_artificial.transfer.solution()
+    }
+
+    /// The transfers' current light groups, with and without the artificial objects.
+    #[must_use]
+    pub fn light_groups(&self) -> [&[crate::radiosity::LightGroup]; 2] {
+        [
+            self.with_artificial.transfer.light_groups(),
+            self.without_artificial.transfer.light_groups(),
+        ]
+    }
+
+    /// Relights both transfers to the lighting and materials of `doc`, `scene` and `view`
+    /// (module doc), or builds them again when that cannot be expressed as a relight; `slot`
+    /// holds the transfers between calls (`None` builds).
+    ///
+    /// # Errors
+    /// As [`SiteTransfers::build`]; a relight error. On error `slot` is emptied (the next call
+    /// builds).
+    pub fn update(
+        slot: &mut Option<Self>,
+        doc: &SiteDocument,
+        scene: &Scene,
+        view: &str,
+        cancel: &AtomicBool,
+    ) -> Result<(Arc<RadiosityLight>, RelightReport), SiteRenderError> {
+        let start = Instant::now();
+        let inputs = inputs(doc, scene, view)?;
+        if let Some(kept) = slot.as_mut() {
+            match kept.relight(&inputs) {
+                Ok(Some(update)) => {
+                    return Ok((
+                        kept.light(),
+                        RelightReport {
+                            update,
+                            seconds: start.elapsed().as_secs_f64(),
+                        },
+                    ));
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    *slot = None;
+                    return Err(e);
+                }
+            }
+        }
+        *slot = None;
+        let built = Self::from_inputs(inputs, cancel, start)?;
+        let light = built.light();
+        *slot = Some(built);
+        Ok((
+            light,
+            RelightReport {
+                update: TransferUpdate::Built,
+                seconds: start.elapsed().as_secs_f64(),
+            },
+        ))
+    }
+
+    /// Relights both transfers to `inputs`; `Ok(None)` when that needs a build.
+    fn relight(&mut self, inputs: &Inputs) -> Result<Option<TransferUpdate>, SiteRenderError> {
+        let fingerprint = [
+            scene_fingerprint(&inputs.scenes[0], &inputs.params),
+            scene_fingerprint(&inputs.scenes[1], &inputs.params),
+        ];
+        if fingerprint != self.fingerprint {
+            return Ok(None);
+        }
+        let targets: Vec<_> = inputs.scenes.iter().map(material_state).collect();
+        let kept = [&self.with_artificial, &self.without_artificial];
+        let mut changes = Vec::with_capacity(2);
+        for k in 0..2 {
+            let Some(change) = lighting_change(
+                kept[k].transfer.lighting(),
+                &inputs.lighting[k],
+                &kept[k].materials,
+                &targets[k],
+            ) else {
+                return Ok(None);
+            };
+            changes.push(change);
+        }
+        if changes.iter().all(is_empty) {
+            return Ok(Some(TransferUpdate::Unchanged));
+        }
+        let (with, without) = (&mut self.with_artificial, &mut self.without_artificial);
+        let relight = |kept: &mut Kept, change: &LightingChange| -> Result<(), RadiosityError> {
+            if !is_empty(change) {
+                kept.transfer.relight(change)?;
+            }
+            Ok(())
+        };
+        // The two relights are independent: run them side by side.
+        let (a, b) = rayon::join(
+            || relight(with, &changes[0]),
+            || relight(without, &changes[1]),
+        );
+        a.and(b).map_err(|e| radiosity_error(&e))?;
+        let [t0, t1] = targets.try_into().unwrap_or_else(|_| unreachable!());
+        self.with_artificial.materials = t0;
+        self.without_artificial.materials = t1;
+        self.light = Arc::new(RadiosityLight::new(
+            self.with_artificial.transfer.solution(),
+            self.without_artificial.transfer.solution(),
+            &RadiosityLight::traced_exactly,
+        ));
+        Ok(Some(TransferUpdate::Relit))
+    }
+}
+
+#[cfg(test)]
+#[path = "live_relight_tests.rs"]
+mod tests;

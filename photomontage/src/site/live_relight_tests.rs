@@ -1,0 +1,193 @@
+#![allow(clippy::unwrap_used, clippy::float_cmp)] // a change copies values: compared bit for bit
+
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::Point3;
+
+use super::*;
+use crate::radiosity::{NamedLuminaire, PointSource, luminance};
+use crate::site::render::site_scene;
+use crate::site::render::tests::fixture;
+use crate::site::render_radiosity::site_radiosity_light;
+use crate::site::{SiteMaterial, SkyModelName, SunManual};
+
+/// Relit against a fresh solve: the tolerance of the transfer's own tests
+/// (`radiosity/transfer_tests.rs`, `RESOLVE_L1_REL_TOL`, `RESOLVE_MEAN_REL_TOL`): the relight
+/// keeps the build's BF refinement, a fresh solve refines for the new lighting within the BF
+/// tolerance; the area-weighted L1 difference stays below 2 %, the mean within the stop rule's
+/// 1 %.
+const RESOLVE_L1_REL_TOL: f64 = 0.02;
+const RESOLVE_MEAN_REL_TOL: f64 = 0.01;
+
+fn lamp(intensity: f64, x_m: f64) -> NamedLuminaire {
+    NamedLuminaire {
+        name: "luminaire:lamp".into(),
+        source: PointSource {
+            position_in_world_m: Point3::new(x_m, 0.0, 4.0),
+            luminaire: None,
+            intensity_rgb: [intensity, intensity * 0.9, intensity * 0.8],
+        },
+        dimming: 1.0,
+    }
+}
+
+fn lighting_of(doc: &SiteDocument) -> (TransferLighting, Vec<(String, Rgb, Option<Rgb>)>) {
+    let scene = site_scene(doc).unwrap().scene;
+    let (lighting, _) = site_transfer_lighting(doc, &scene, "p1").unwrap();
+    (lighting, material_state(&scene))
+}
+
+#[test]
+fn site_edits_map_to_the_lighting_change_that_makes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = fixture(dir.path());
+    let (l0, m0) = lighting_of(&doc);
+    assert!(is_empty(&lighting_change(&l0, &l0, &m0, &m0).unwrap()));
+
+    // A sun slider step: only the sun changes, to the site's new sun.
+    let mut moved = doc.clone();
+    moved.site.lighting.sun_manual = Some(SunManual {
+        azimuth_deg: 150.0,
+        elevation_deg: 35.0,
+    });
+    let (l1, m1) = lighting_of(&moved);
+    let change = lighting_change(&l0, &l1, &m0, &m1).unwrap();
+    assert_eq!(change.sun, Some(l1.sun));
+    assert!(change.sky.is_none() && change.material_reflectance.is_empty());
+
+    // A sky type: only the sky.
+    let mut sky = doc.clone();
+    sky.site.lighting.sky_model = SkyModelName::CieOvercast;
+    let (l2, m2) = lighting_of(&sky);
+    let change = lighting_change(&l0, &l2, &m0, &m2).unwrap();
+    assert_eq!(change.sky, Some(l2.sky.clone()));
+    assert!(change.sun.is_none() && change.material_reflectance.is_empty());
+
+    // A material colour: that material's diffuse reflectance, nothing else.
+    let mut colour = doc.clone();
+    colour.site.materials.push(SiteMaterial {
+        material: crate::scene::Material::diffuse("brick", [0.6, 0.3, 0.2]),
+        colour: None,
+    });
+    let (l3, m3) = lighting_of(&colour);
+    let change = lighting_change(&l0, &l3, &m0, &m3).unwrap();
+    assert_eq!(
+        change.material_reflectance,
+        vec![("brick".to_owned(), [0.6, 0.3, 0.2])]
+    );
+    assert!(change.sun.is_none() && change.sky.is_none());
+
+    // An emitting material cannot be relit: a build.
+    let mut m4 = m0.clone();
+    m4[0].2 = Some([1.0; 3]);
+    assert!(lighting_change(&l0, &l0, &m0, &m4).is_none());
+}
+
+#[test]
+fn a_dimmed_luminaire_is_a_dimming_and_a_moved_one_a_build() {
+    let with = |l: NamedLuminaire| TransferLighting {
+        sun: None,
+        sky: None,
+        luminaires: vec![l],
+        emitters: false,
+    };
+    let built = with(lamp(500.0, 0.0));
+    // The site scales the intensity; the transfer knows it as a dimming of the built source.
+    let change = lighting_change(&built, &with(lamp(125.0, 0.0)), &[], &[]).unwrap();
+    assert_eq!(
+        change.luminaire_dimming,
+        vec![("luminaire:lamp".to_owned(), 0.25)]
+    );
+    // After that relight the transfer's lamp is the built source dimmed to 0.25: going back to
+    // full output is a dimming of 1.
+    let mut dimmed = built.clone();
+    dimmed.luminaires[0].dimming = 0.25;
+    let change = lighting_change(&dimmed, &with(lamp(500.0, 0.0)), &[], &[]).unwrap();
+    assert_eq!(
+        change.luminaire_dimming,
+        vec![("luminaire:lamp".to_owned(), 1.0)]
+    );
+    assert!(lighting_change(&built, &with(lamp(500.0, 1.0)), &[], &[]).is_none());
+    let mut recoloured = lamp(500.0, 0.0);
+    recoloured.source.intensity_rgb[2] = 100.0;
+    assert!(lighting_change(&built, &with(recoloured), &[], &[]).is_none());
+}
+
+fn areas(s: &Solution) -> Vec<f64> {
+    (0..s.mesh.elements.len())
+        .map(|e| s.mesh.element_node(e).area_m2)
+        .collect()
+}
+
+fn assert_matches_fresh_solve(label: &str, relit: &Solution, fresh: &Solution) {
+    let w = areas(fresh);
+    let (a, b) = (relit.total_radiosity_rgb(), fresh.total_radiosity_rgb());
+    assert_eq!(a.len(), b.len(), "{label}: same mesh");
+    let (mut diff, mut total, mut mean_a, mut mean_b) = (0.0, 0.0, 0.0, 0.0);
+    for ((x, y), w) in a.iter().zip(&b).zip(&w) {
+        let d: Rgb = std::array::from_fn(|c| (x[c] - y[c]).abs());
+        diff += luminance(&d) * w;
+        total += luminance(y) * w;
+        mean_a += luminance(x) * w;
+        mean_b += luminance(y) * w;
+    }
+    assert!(total > 0.0, "{label}: a lit scene");
+    assert!(
+        diff / total < RESOLVE_L1_REL_TOL,
+        "{label}: L1 {}",
+        diff / total
+    );
+    assert!(
+        (mean_a - mean_b).abs() / mean_b < RESOLVE_MEAN_REL_TOL,
+        "{label}: mean {mean_a} vs {mean_b}"
+    );
+}
+
+#[test]
+fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = fixture(dir.path());
+    doc.site.render.radiosity = true;
+    let cancel = AtomicBool::new(false);
+    let mut slot = None;
+    let scene = site_scene(&doc).unwrap().scene;
+    let (light, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    assert_eq!(report.update, TransferUpdate::Built);
+    // The build's solutions are the render's own solves, bit for bit.
+    let (fresh, _) = site_radiosity_light(&doc, &scene, "p1", &cancel).unwrap();
+    assert_eq!(light.with_artificial.groups, fresh.with_artificial.groups);
+    assert_eq!(
+        light.without_artificial.groups,
+        fresh.without_artificial.groups
+    );
+    let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    assert_eq!(report.update, TransferUpdate::Unchanged);
+
+    // The sky type (Site & light tab) and a material colour (Materials tab).
+    doc.site.lighting.sky_model = SkyModelName::CieGeneral(12);
+    doc.site.materials.push(SiteMaterial {
+        material: crate::scene::Material::diffuse("brick", [0.7, 0.35, 0.2]),
+        colour: None,
+    });
+    let scene = site_scene(&doc).unwrap().scene;
+    let (light, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    assert_eq!(report.update, TransferUpdate::Relit);
+    let (fresh, _) = site_radiosity_light(&doc, &scene, "p1", &cancel).unwrap();
+    assert_matches_fresh_solve("with", &light.with_artificial, &fresh.with_artificial);
+    assert_matches_fresh_solve(
+        "without",
+        &light.without_artificial,
+        &fresh.without_artificial,
+    );
+    let kept = slot.as_ref().unwrap();
+    assert_eq!(
+        kept.light_groups()[0].len(),
+        fresh.with_artificial.groups.len()
+    );
+
+    // Moving the model changes the geometry: a build.
+    doc.site.models[0].placement.translation[0] += 2.0;
+    let scene = site_scene(&doc).unwrap().scene;
+    let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    assert_eq!(report.update, TransferUpdate::Built);
+}
