@@ -27,7 +27,7 @@ const BOX_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1
 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
 
 /// A 64 × 48 photo looking north from (0, −10, 1.5) at a unit box on a 20 m ground square.
-fn fixture(dir: &Path) -> SiteDocument {
+pub(crate) fn fixture(dir: &Path) -> SiteDocument {
     image::RgbImage::from_pixel(64, 48, image::Rgb([120, 110, 100]))
         .save(dir.join("p1.png"))
         .unwrap();
