@@ -17,6 +17,7 @@ pub mod control_location;
 pub mod elevation;
 mod locate;
 pub mod luminaires;
+pub mod material_pick;
 pub mod models;
 pub mod new;
 pub mod photo_points;

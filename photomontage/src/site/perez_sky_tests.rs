@@ -48,15 +48,22 @@ fn the_site_perez_sky_is_the_library_perez_sky() {
     assert_eq!(model, SkyModel::Perez(direct));
     // Luminance at a few directions (elevation, azimuth east of north, degrees) equals the
     // library's lv(ζ, γ)/lv(0, Z) computed from the angles.
-    for (el, az) in [(90.0, 0.0), (10.0, 135.0), (40.0, 150.0), (30.0, 315.0), (5.0, 45.0)] {
-        let dir = crate::sky::direction_from_elevation_azimuth(
-            f64::to_radians(el),
-            f64::to_radians(az),
-        );
+    for (el, az) in [
+        (90.0, 0.0),
+        (10.0, 135.0),
+        (40.0, 150.0),
+        (30.0, 315.0),
+        (5.0, 45.0),
+    ] {
+        let dir =
+            crate::sky::direction_from_elevation_azimuth(f64::to_radians(el), f64::to_radians(az));
         let gamma = dir.dot(&sun).clamp(-1.0, 1.0).acos();
         let want = direct.lv(dir.z, gamma) / direct.lv(1.0, zenith);
         let got = model.relative_luminance(&dir, &sun);
-        assert!(rel(got, want) < SAME_FORMULA_REL_TOL, "({el}, {az}): {got} vs {want}");
+        assert!(
+            rel(got, want) < SAME_FORMULA_REL_TOL,
+            "({el}, {az}): {got} vs {want}"
+        );
     }
 }
 
@@ -77,7 +84,10 @@ fn the_irradiance_form_takes_the_day_from_the_site_time() {
     // Without any time the irradiance form cannot know the day: the error says so.
     doc.site.lighting.time = None;
     let e = site_sky_model(&doc, "p1", &sun).unwrap_err().to_string();
-    assert!(e.contains("lighting.perez") && e.contains("day of the year"), "{e}");
+    assert!(
+        e.contains("lighting.perez") && e.contains("day of the year"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -181,8 +191,11 @@ fn bad_perez_inputs_name_the_field() {
         assert!(e.contains(field), "`{e}` should name {field}");
     }
     // The file reader knows the name and refuses unknown keys in the table.
-    let text = "schema_version = 1\n[lighting]\nsky_model = \"perez\"\n[lighting.perez]\nclearnes = 2.0\n";
-    let e = toml::from_str::<crate::site::Site>(text).unwrap_err().to_string();
+    let text =
+        "schema_version = 1\n[lighting]\nsky_model = \"perez\"\n[lighting.perez]\nclearnes = 2.0\n";
+    let e = toml::from_str::<crate::site::Site>(text)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("clearnes"), "{e}");
     let ok = "schema_version = 1\n[lighting]\nsky_model = \"perez\"\n[lighting.perez]\nclearness = 2.0\nbrightness = 0.3\n";
     let site: crate::site::Site = toml::from_str(ok).unwrap();

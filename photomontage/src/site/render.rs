@@ -304,8 +304,7 @@ fn atmosphere(a: &super::Atmosphere) -> Result<Option<SchachterAtmosphere>, Site
 
 fn sun_needed(doc: &SiteDocument) -> bool {
     let l = &doc.site.lighting;
-    l.sun_weight.iter().any(|&k| k != 0.0)
-        || l.sky_model.needs_sun()
+    l.sun_weight.iter().any(|&k| k != 0.0) || l.sky_model.needs_sun()
 }
 
 /// The lighting of photo `photo_id`: sun (normal irradiance = `sun_weight`), sky facets
@@ -469,8 +468,8 @@ pub fn prepare_view_with(
 }
 
 #[cfg(test)]
-#[path = "render_tests.rs"]
-pub(crate) mod tests;
-#[cfg(test)]
 #[path = "perez_sky_tests.rs"]
 mod perez_tests;
+#[cfg(test)]
+#[path = "render_tests.rs"]
+pub(crate) mod tests;

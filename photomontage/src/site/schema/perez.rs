@@ -72,7 +72,8 @@ impl PerezInputs {
     /// [`PerezInputError`] naming the field that is missing, mixed in or out of range.
     pub fn form(&self) -> Result<PerezForm, PerezInputError> {
         let indices = self.clearness.is_some() || self.brightness.is_some();
-        let irradiance = self.direct_normal_w_m2.is_some() || self.diffuse_horizontal_w_m2.is_some();
+        let irradiance =
+            self.direct_normal_w_m2.is_some() || self.diffuse_horizontal_w_m2.is_some();
         let finite = |field: &'static str, v: Option<f64>| match v {
             None => Err(bad(field, "missing")),
             Some(v) if v.is_finite() => Ok(v),
