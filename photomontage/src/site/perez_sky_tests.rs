@@ -201,6 +201,15 @@ fn bad_perez_inputs_name_the_field() {
     let site: crate::site::Site = toml::from_str(ok).unwrap();
     assert_eq!(site.lighting.sky_model, SkyModelName::Perez);
     assert_eq!(site.lighting.perez, Some(indices(2.0, 0.3)));
+    // `validate` reports the same field.
+    doc.site.lighting.perez = Some(indices(0.5, 0.3));
+    let issues = doc.site.validate();
+    assert!(
+        issues
+            .iter()
+            .any(|i| i.field == "lighting.perez.clearness" && i.message.contains("below 1")),
+        "{issues:?}"
+    );
     // A sun below the horizon is refused with its elevation.
     let below = nalgebra::Vector3::new(0.0, 0.8, -0.6);
     doc.site.lighting.perez = Some(indices(2.0, 0.3));
