@@ -64,11 +64,13 @@ pub fn typed_location(
     })
 }
 
-/// Every sky model the site file names: uniform, CIE overcast, the 15 CIE general skies.
+/// Every sky model the site file names: uniform, CIE overcast, the 15 CIE general skies and
+/// the Perez all-weather sky.
 #[must_use]
 pub fn sky_models() -> Vec<SkyModelName> {
     let mut out = vec![SkyModelName::Uniform, SkyModelName::CieOvercast];
     out.extend((1..=15).map(SkyModelName::CieGeneral));
+    out.push(SkyModelName::Perez);
     out
 }
 /// A time typed in the panel: empty → `None`; else RFC 3339, or a local time in the site's
@@ -137,10 +139,16 @@ mod tests {
     }
 
     #[test]
-    fn all_seventeen_site_sky_models_are_offered_once() {
+    fn all_eighteen_site_sky_models_are_offered_once() {
         let m = sky_models();
-        assert_eq!(m.len(), 17);
-        for name in ["uniform", "cie_overcast", "cie_general:1", "cie_general:15"] {
+        assert_eq!(m.len(), 18);
+        for name in [
+            "uniform",
+            "cie_overcast",
+            "cie_general:1",
+            "cie_general:15",
+            "perez",
+        ] {
             assert!(m.iter().any(|s| s.to_string() == name), "{name}");
         }
     }

@@ -7,9 +7,11 @@
 //! `Command::Material` edit.
 //!
 //! # Known limitations
-//! Materials are picked from the list only (not by clicking a surface on the photo); the unfolded
-//! elevation is the CLI's `photomontage elevation` (no button here yet). The scene is rebuilt when
-//! the models, the site materials or the library path change.
+//! A material is picked from the list, or in "Pick from photo" mode by a click on the solved
+//! photo (the camera ray cast into the one scene, `material_pick.rs`; Escape leaves the
+//! mode). The "Unfolded elevation" section draws a model's façades on the worker
+//! ([`crate::elevation_view`]).
+//! The scene is rebuilt when the models, the site materials or the library path change.
 
 use eframe::egui;
 use photomontage::colour::designer::{
@@ -41,6 +43,12 @@ pub struct MaterialsPanel {
     cache_key: String,
     scene_materials: Vec<Material>,
     scene_error: Option<String>,
+    /// "Pick from photo" mode: a click on the photo selects the material it shows.
+    pick_mode: bool,
+    /// What the last pick found (or that it found no surface).
+    pick_result: Option<String>,
+    /// The unfolded elevation section.
+    elevation: crate::elevation_view::ElevationView,
 }
 
 /// The stored colour of `name`: the site entry's colour text, else the hex of its diffuse.
@@ -87,6 +95,43 @@ fn swatch(ui: &mut egui::Ui, rgb8: [u8; 3], name: &str) {
 }
 
 impl MaterialsPanel {
+    /// Whether a click on the photo picks a material.
+    #[must_use]
+    pub fn pick_mode(&self) -> bool {
+        self.pick_mode
+    }
+
+    /// The result of a pick: the material to select (`None`: no surface) and what to say.
+    pub fn picked(&mut self, material: Option<&str>, text: String) {
+        if let Some(name) = material {
+            self.selected = Some(name.to_owned());
+            self.error = None;
+        }
+        self.pick_result = Some(text);
+    }
+
+    fn pick_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let r = ui.selectable_label(self.pick_mode, "Pick from photo");
+            name_widget(ui, &r, "Pick from photo");
+            if r.clicked() {
+                self.pick_mode = !self.pick_mode;
+                self.pick_result = None;
+            }
+            if self.pick_mode {
+                let r = ui.label("click a surface on the photo (Escape leaves)");
+                name_widget(ui, &r, "picking materials");
+            }
+        });
+        if self.pick_mode && ui.input(|i| i.key_pressed(egui::Key::Escape)) {
+            self.pick_mode = false;
+        }
+        if let Some(text) = &self.pick_result {
+            let r = ui.label(text);
+            name_widget(ui, &r, &format!("pick result: {text}"));
+        }
+    }
+
     fn refresh(&mut self, doc: &SiteDocument) {
         let key = format!(
             "{:?}{:?}{:?}{}",
@@ -116,10 +161,14 @@ impl MaterialsPanel {
 
     fn load(&mut self, doc: &SiteDocument, base: &Material) {
         let colour = current_colour(doc, base);
-        let key = (
-            base.name.clone(),
-            format!("{colour}{:?}", doc.site.materials),
-        );
+        // Only this material's own values refill the fields: text typed but not applied
+        // survives edits (and undos) of other materials, the palette or the rest of the site.
+        let entry = doc
+            .site
+            .materials
+            .iter()
+            .find(|m| m.material.name == base.name);
+        let key = (base.name.clone(), format!("{colour}{entry:?}{base:?}"));
         if self.loaded_for.as_ref() == Some(&key) {
             return;
         }
@@ -318,6 +367,7 @@ impl Panel for MaterialsPanel {
         if let Some(e) = &self.scene_error {
             ui.colored_label(egui::Color32::RED, e);
         }
+        self.pick_ui(ui);
         ui.label("Materials of the scene (polygons, CAD models, library, site):");
         for m in &self.scene_materials {
             let selected = self.selected.as_deref() == Some(m.name.as_str());
@@ -341,13 +391,19 @@ impl Panel for MaterialsPanel {
             .as_ref()
             .and_then(|s| self.scene_materials.iter().find(|m| &m.name == s))
             .cloned();
-        match base {
+        let actions = match base {
             Some(base) => self.editor(ui, doc, &base),
             None => {
                 ui.label("Select a material.");
                 Vec::new()
             }
-        }
+        };
+        ui.separator();
+        let r = egui::CollapsingHeader::new("Unfolded elevation")
+            .default_open(false)
+            .show(ui, |ui| self.elevation.ui(ui, doc));
+        name_widget(ui, &r.header_response, "Unfolded elevation");
+        actions
     }
 }
 

@@ -94,8 +94,10 @@ impl Studio {
             | crate::SideTab::Fit
             | crate::SideTab::Ties
             | crate::SideTab::Light => {}
-            // The Materials tab selects from its list (picking on the photo is not built yet);
-            // the Study tab only shows its frames.
+            crate::SideTab::Materials if !space => {
+                self.material_pick_interaction(&response, &t, &id);
+            }
+            // The Study tab only shows its frames.
             crate::SideTab::Materials | crate::SideTab::Study => {}
             _ => self.observation_interaction(&response, &t, &id, space),
         }

@@ -7,24 +7,29 @@
 //!
 //! Every change is one undoable `Command::Light` ([`crate::light_commands`]) of the same site
 //! fields the CLI reads; nothing studio-only is written to the site file. Typed values are
-//! checked before anything is written: a bad value (unknown zone, latitude out of range, a
+//! checked before anything is written, and text typed but not applied survives other edits and
+//! their undo (each field refills only when its own site value changes): a bad value (unknown zone, latitude out of range, a
 //! non-finite number, an unreadable photometric file) shows a message in the panel and leaves
 //! the site and the typed text as they were. The sun angles shown are those the renderer uses
 //! (`photomontage::site::sun_path::site_sun_angles`: the SPA with the inputs of
 //! `photomontage sun`).
 //!
 //! # Known limitations
-//! The Perez sky is not offered: the site file's `sky_model` has no Perez entry (the renderer
-//! reads it; adding one belongs with the renderer wiring). Local times typed without an offset
+//! The Perez sky is set by its clearness ε and brightness Δ here; the site file's irradiance
+//! form (`direct_normal_w_m2`, `diffuse_horizontal_w_m2`) is shown but typed in the file. Local
+//! times typed without an offset
 //! are stored resolved to RFC 3339 with the offset in force (what `validate` asks of
 //! `lighting.time`). Luminaire files are typed paths (no file dialog).
 
 pub mod luminaires;
+pub mod perez;
 pub mod sky_map;
+
+use std::collections::HashMap;
 
 use eframe::egui::{self, Color32};
 use photomontage::site::sun_path::{SunSource, site_sun_angles};
-use photomontage::site::{Lighting, Location, SiteDocument, SunManual, site_time::site_time_zone};
+use photomontage::site::{SiteDocument, SkyModelName, SunManual, site_time::site_time_zone};
 
 use crate::commands::Command;
 use crate::light_commands::LightCommand;
@@ -35,21 +40,13 @@ use crate::widgets::name_widget;
 /// Colour of the panel's error message.
 const ERROR_COLOUR: Color32 = Color32::from_rgb(230, 80, 60);
 
-/// The values the text fields were last filled from (refilled when the site changes, e.g. on
-/// undo).
-#[derive(Debug, Clone, PartialEq)]
-struct Seen {
-    location: Option<Location>,
-    lighting: Lighting,
-    exposure: f64,
-    photo: Option<String>,
-    taken_at: Option<String>,
-}
-
 /// The Site & light tab's own state: the text being typed and the last message.
 #[derive(Default)]
 pub struct LightPanel {
-    seen: Option<Seen>,
+    /// Per text field, the site value it was last filled from: a field is refilled only when
+    /// its own value in the site changes (its apply, or an undo of it), so text typed but not
+    /// applied survives every other edit.
+    filled_from: HashMap<&'static str, String>,
     /// Latitude text, degrees north.
     pub latitude: String,
     /// Longitude text, degrees east.
@@ -70,6 +67,10 @@ pub struct LightPanel {
     pub sun_elevation: String,
     /// Exposure text.
     pub exposure: String,
+    /// Perez sky clearness ε text.
+    pub perez_clearness: String,
+    /// Perez sky brightness Δ text.
+    pub perez_brightness: String,
     /// The last refusal, shown in red until the next successful edit.
     pub error: Option<String>,
     /// Sky map and sliders.
@@ -78,6 +79,21 @@ pub struct LightPanel {
     pub luminaires: crate::light_panel::luminaires::LuminairesState,
     /// Counts drags/typing sessions so that each is one undo step.
     gesture: u64,
+}
+
+/// Sets `field` to `value` when the site value `source` differs from the one it was last
+/// filled from (or it was never filled).
+fn refill_field(
+    filled: &mut HashMap<&'static str, String>,
+    key: &'static str,
+    source: String,
+    value: String,
+    field: &mut String,
+) {
+    if filled.get(key) != Some(&source) {
+        *field = value;
+        filled.insert(key, source);
+    }
 }
 
 pub(crate) fn edit(c: LightCommand, key: Option<String>) -> Action {
@@ -93,35 +109,72 @@ impl LightPanel {
         let taken_at = photo
             .and_then(|id| site.photos.iter().find(|p| p.id == id))
             .and_then(|p| p.taken_at.clone());
-        let seen = Seen {
-            location: site.location.clone(),
-            lighting: site.lighting.clone(),
-            exposure: site.render.exposure,
-            photo: photo.map(str::to_owned),
-            taken_at: taken_at.clone(),
-        };
-        if self.seen.as_ref() == Some(&seen) {
-            return;
-        }
         let loc = site.location.as_ref();
-        self.latitude = loc.map(|l| l.latitude_deg.to_string()).unwrap_or_default();
-        self.longitude = loc.map(|l| l.longitude_deg.to_string()).unwrap_or_default();
-        self.elevation = loc.map(|l| l.elevation_m.to_string()).unwrap_or_default();
-        self.time_zone = loc.and_then(|l| l.time_zone.clone()).unwrap_or_default();
-        if let Some(crs) = loc.and_then(|l| l.crs.clone()) {
-            self.crs = crs;
-        }
-        self.lighting_time = site.lighting.time.clone().unwrap_or_default();
-        self.taken_at = taken_at.unwrap_or_default();
         let manual = site.lighting.sun_manual.as_ref();
-        self.sun_azimuth = manual
-            .map(|m| m.azimuth_deg.to_string())
-            .unwrap_or_default();
-        self.sun_elevation = manual
-            .map(|m| m.elevation_deg.to_string())
-            .unwrap_or_default();
-        self.exposure = site.render.exposure.to_string();
-        self.seen = Some(seen);
+        let perez = site.lighting.perez.as_ref();
+        let text = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
+        let filled = &mut self.filled_from;
+        for (key, source, field) in [
+            (
+                "latitude",
+                text(loc.map(|l| l.latitude_deg)),
+                &mut self.latitude,
+            ),
+            (
+                "longitude",
+                text(loc.map(|l| l.longitude_deg)),
+                &mut self.longitude,
+            ),
+            (
+                "elevation",
+                text(loc.map(|l| l.elevation_m)),
+                &mut self.elevation,
+            ),
+            (
+                "time zone",
+                loc.and_then(|l| l.time_zone.clone()).unwrap_or_default(),
+                &mut self.time_zone,
+            ),
+            (
+                "lighting time",
+                site.lighting.time.clone().unwrap_or_default(),
+                &mut self.lighting_time,
+            ),
+            (
+                "manual azimuth",
+                text(manual.map(|m| m.azimuth_deg)),
+                &mut self.sun_azimuth,
+            ),
+            (
+                "manual elevation",
+                text(manual.map(|m| m.elevation_deg)),
+                &mut self.sun_elevation,
+            ),
+            (
+                "exposure",
+                site.render.exposure.to_string(),
+                &mut self.exposure,
+            ),
+            (
+                "perez clearness",
+                text(perez.and_then(|p| p.clearness)),
+                &mut self.perez_clearness,
+            ),
+            (
+                "perez brightness",
+                text(perez.and_then(|p| p.brightness)),
+                &mut self.perez_brightness,
+            ),
+        ] {
+            refill_field(filled, key, source.clone(), source, field);
+        }
+        // The capture time belongs to the current photo: a change of photo refills it too.
+        let taken_at = taken_at.unwrap_or_default();
+        let source = format!("{photo:?} {taken_at}");
+        refill_field(filled, "capture time", source, taken_at, &mut self.taken_at);
+        if let Some(crs) = loc.and_then(|l| l.crs.clone()) {
+            refill_field(filled, "control CRS", crs.clone(), crs, &mut self.crs);
+        }
     }
 
     /// A key that is the same for every change of one drag or typing session of `field`.
@@ -350,6 +403,9 @@ impl LightPanel {
                     ui.selectable_value(&mut l.sky_model, m, text);
                 }
             });
+        if l.sky_model == SkyModelName::Perez {
+            crate::light_panel::perez::perez_ui(self, ui, &mut l);
+        }
         egui::Grid::new("light weights").show(ui, |ui| {
             for (label, values, max) in [
                 ("sun weight", &mut l.sun_weight, 1e6),

@@ -2,7 +2,8 @@
 //! sky seen from the site (zenith in the middle, horizon on the outer circle, north up, east
 //! right: `photomontage::site::sun_path::sky_map_xy`), with the compass points, elevation rings
 //! every 30°, the sun's path on the chosen date (hour marks in local time), the sun at the
-//! chosen time and a legend; below it date and time-of-day sliders that change
+//! chosen time (or the manual sun, `lighting.sun_manual`, which wins as in the renderer; its
+//! marker is named `sun marker (manual) …` for tests and screen readers) and a legend; below it date and time-of-day sliders that change
 //! `lighting.time`, one undo step per drag.
 //!
 //! The date and time are local to the site's `location.time_zone` (or, without one, at the UTC
@@ -20,7 +21,7 @@ use eframe::egui::{self, Color32, Pos2, Stroke};
 use photomontage::site::SiteDocument;
 use photomontage::site::site_time::{parse_site_time, site_time_zone};
 use photomontage::site::sun_path::{
-    SunPathPoint, SunSource, in_site_zone, site_sun_angles, site_sun_path, sky_map_xy,
+    SunAngles, SunPathPoint, SunSource, in_site_zone, site_sun_angles, site_sun_path, sky_map_xy,
 };
 use photomontage::time_zone::SiteTimeZone;
 
@@ -31,6 +32,11 @@ use crate::widgets::name_widget;
 
 /// Side of the sky map, screen points.
 pub const SKY_MAP_SIZE: f32 = 260.0;
+/// Radius of the horizon circle in the sky map, screen points.
+#[must_use]
+pub fn sky_map_radius() -> f32 {
+    SKY_MAP_SIZE * 0.5 - 16.0
+}
 /// Minutes between samples of the drawn sun path.
 const PATH_STEP_MIN: u32 = 10;
 const SUN_COLOUR: Color32 = Color32::from_rgb(255, 170, 0);
@@ -116,34 +122,62 @@ pub fn sky_map_ui(
     out: &mut Vec<Action>,
 ) {
     ui.strong("Sky map");
-    if doc.site.location.is_none() {
+    let manual = doc.site.lighting.sun_manual.as_ref().map(|m| SunAngles {
+        azimuth_deg: m.azimuth_deg,
+        elevation_deg: m.elevation_deg,
+        source: SunSource::Manual,
+    });
+    let has_location = doc.site.location.is_some();
+    if !has_location && manual.is_none() {
         ui.label("set the location to see the sun's path");
         return;
     }
     let zone = site_time_zone(&doc.site).ok().flatten();
     let shown = shown_time(doc, photo, zone.as_ref());
     let date = shown.date_naive();
-    let path = site_sun_path(&doc.site, date, *shown.offset(), PATH_STEP_MIN);
-    let sun = photo.and_then(|p| site_sun_angles(doc, p).ok());
+    let path = has_location.then(|| site_sun_path(&doc.site, date, *shown.offset(), PATH_STEP_MIN));
+    // A manual sun is shown whether or not a photo (or a location) gives a computed one.
+    let sun = manual.or_else(|| photo.and_then(|p| site_sun_angles(doc, p).ok()));
     let (response, painter) =
         ui.allocate_painter(egui::vec2(SKY_MAP_SIZE, SKY_MAP_SIZE), egui::Sense::hover());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "sky map"));
     name_widget(ui, &response, "sky map");
     let rect = response.rect;
     let centre = rect.center();
-    let radius = SKY_MAP_SIZE * 0.5 - 16.0;
+    let radius = sky_map_radius();
     let to_screen = |az: f64, el: f64| {
         let [x, y] = sky_map_xy(az, el);
         Pos2::new(centre.x + radius * x as f32, centre.y - radius * y as f32)
     };
     paint_grid(&painter, centre, radius);
-    if let Ok(path) = &path {
+    if let Some(Ok(path)) = &path {
         paint_path(&painter, path, &to_screen);
     }
+    let kind = |s: &SunAngles| match s.source {
+        SunSource::Manual => "manual",
+        SunSource::Computed(_) => "computed",
+    };
     if let Some(s) = &sun {
         if s.elevation_deg >= 0.0 {
             let p = to_screen(s.azimuth_deg, s.elevation_deg);
             painter.circle_filled(p, 7.0, SUN_COLOUR);
             painter.circle_stroke(p, 7.0, Stroke::new(1.0, Color32::BLACK));
+            let marker = ui.interact(
+                egui::Rect::from_center_size(p, egui::vec2(14.0, 14.0)),
+                egui::Id::unique("sky map sun marker"),
+                egui::Sense::hover(),
+            );
+            marker.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "sun marker"));
+            name_widget(
+                ui,
+                &marker,
+                &format!(
+                    "sun marker ({}) azimuth {:.3}° elevation {:.3}°",
+                    kind(s),
+                    s.azimuth_deg,
+                    s.elevation_deg
+                ),
+            );
         } else {
             painter.text(
                 centre,
@@ -156,13 +190,28 @@ pub fn sky_map_ui(
     }
     // Legend.
     ui.horizontal(|ui| {
-        legend_swatch(ui, false, PATH_COLOUR);
-        ui.label(format!("sun path {date} (hours local)"));
+        if has_location {
+            legend_swatch(ui, false, PATH_COLOUR);
+            ui.label(format!("sun path {date} (hours local)"));
+        }
         legend_swatch(ui, true, SUN_COLOUR);
-        ui.label(format!("sun at {}", shown.format("%H:%M %:z")));
+        match &sun {
+            Some(s) if matches!(s.source, SunSource::Manual) => {
+                ui.label("sun set by hand");
+            }
+            _ => {
+                ui.label(format!("sun at {}", shown.format("%H:%M %:z")));
+            }
+        }
     });
-    if let Err(e) = &path {
-        ui.label(format!("no sun path: {e}"));
+    match &path {
+        Some(Err(e)) => {
+            ui.label(format!("no sun path: {e}"));
+        }
+        None => {
+            ui.label("set the location to see the sun's path");
+        }
+        Some(Ok(_)) => {}
     }
     sliders_ui(panel, ui, doc, &shown, zone.as_ref(), out);
 }

@@ -77,6 +77,22 @@ pub struct SiteElevation {
     pub warnings: Vec<String>,
 }
 
+impl SiteElevation {
+    /// The picture as PNG bytes: what `photomontage elevation --out` writes and the studio's
+    /// export writes (one encoder, so the same pixels).
+    ///
+    /// # Errors
+    /// The PNG encoder's error (not expected for an in-memory RGB image).
+    pub fn png_bytes(&self) -> Result<Vec<u8>, image::ImageError> {
+        let mut bytes = Vec::new();
+        self.image.image.write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )?;
+        Ok(bytes)
+    }
+}
+
 /// Draws the unfolded elevation of model `model` of the site: colours, or irradiance when
 /// `lighting` is given.
 ///

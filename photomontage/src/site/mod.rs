@@ -18,6 +18,7 @@ pub mod elevation;
 pub mod live_relight;
 mod locate;
 pub mod luminaires;
+pub mod material_pick;
 pub mod models;
 pub mod new;
 pub mod photo_points;

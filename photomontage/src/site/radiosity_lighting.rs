@@ -18,7 +18,6 @@ use crate::radiosity::{
 };
 use crate::render::luminaire_light::ArtificialLight;
 use crate::scene::{ObjectKind, Scene};
-use crate::sky::SkyModel;
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
 /// A natural polygon whose normal is within 30° of the zenith is ground (cos 30°).
@@ -79,10 +78,9 @@ pub fn site_transfer_lighting(
     view: &str,
 ) -> Result<(TransferLighting, Vec<String>), SiteRenderError> {
     let l = &doc.site.lighting;
-    let model = site_sky_model(l.sky_model)?;
     let sun_weighted = l.sun_weight.iter().any(|&k| k != 0.0);
     let sky_weighted = l.sky_weight.iter().any(|&k| k != 0.0);
-    let needs_sun = sun_weighted || (sky_weighted && matches!(model, SkyModel::CieGeneral(_)));
+    let needs_sun = sun_weighted || (sky_weighted && l.sky_model.needs_sun());
     let sun_dir: Option<Vector3<f64>> = if needs_sun {
         Some(site_sun_dir(doc, view)?)
     } else {
@@ -92,10 +90,15 @@ pub fn site_transfer_lighting(
         dir_in_world: d,
         normal_irradiance_rgb: if sun_weighted { l.sun_weight } else { [0.0; 3] },
     });
-    let sky = sky_weighted.then_some(Sky {
-        model,
-        horizontal_irradiance_rgb: l.sky_weight,
-    });
+    let sky = if sky_weighted {
+        let model = site_sky_model(doc, view, &sun_dir.unwrap_or_else(Vector3::z))?;
+        Some(Sky {
+            model,
+            horizontal_irradiance_rgb: l.sky_weight,
+        })
+    } else {
+        None
+    };
     let lights = site_luminaire_lights(doc)?;
     let names = doc
         .site

@@ -27,12 +27,14 @@
 use image::Rgb32FImage;
 use nalgebra::Vector3;
 
-use super::{SiteDocument, SkyModelName};
+use chrono::Datelike;
+
+use super::{PerezForm, SiteDocument, SkyModelName};
 use crate::atmosphere::schachter::SchachterAtmosphere;
 use crate::camera::Camera;
 use crate::colour::Colour;
 use crate::render::{Daylight, DistantLight, Lighting, RenderSettings};
-use crate::sky::SkyModel;
+use crate::sky::{PerezSky, SkyModel};
 use crate::sky_dome::durisch_facets::durisch_dome;
 
 pub use super::render_error::{SiteRenderError, SiteWarning};
@@ -108,18 +110,87 @@ pub fn site_camera(doc: &SiteDocument, photo_id: &str) -> Result<Camera, SiteRen
     })
 }
 
-/// The sky model of `lighting.sky_model`.
+/// The sky model of `lighting.sky_model` for a sun in `sun_dir_in_world` (survey frame): the
+/// one builder of the site's sky, used by the renderer, the radiosity lighting and the fit.
+/// `perez` reads `[lighting.perez]` ([`super::PerezInputs`]) and the sun's zenith angle; its
+/// irradiance form takes the day of the year from the sun time of photo `photo_id`
+/// ([`super::site_time::site_sun_time`]).
 ///
 /// # Errors
 /// [`SiteRenderError::Sky`] for a CIE general sky type outside 1–15 (only possible for a value
-/// built in code; the site file's reader refuses it).
-pub fn site_sky_model(name: SkyModelName) -> Result<SkyModel, SiteRenderError> {
+/// built in code; the site file's reader refuses it) or a Perez sky with the sun at or below the
+/// horizon; [`SiteRenderError::Request`] naming the `[lighting.perez]` field that is missing or
+/// out of range, or when its irradiance form has no day of the year.
+pub fn site_sky_model(
+    doc: &SiteDocument,
+    photo_id: &str,
+    sun_dir_in_world: &Vector3<f64>,
+) -> Result<SkyModel, SiteRenderError> {
+    let name = doc.site.lighting.sky_model;
     match name {
         SkyModelName::Uniform => Ok(SkyModel::Uniform),
         SkyModelName::CieOvercast => Ok(SkyModel::CieOvercast),
         SkyModelName::CieGeneral(n) => SkyModel::cie_general(n).map_err(|e| SiteRenderError::Sky {
             reason: format!("`{name}`: {e}"),
         }),
+        SkyModelName::Perez => site_perez_sky(doc, photo_id, sun_dir_in_world).map(SkyModel::Perez),
+    }
+}
+
+fn site_perez_sky(
+    doc: &SiteDocument,
+    photo_id: &str,
+    sun_dir_in_world: &Vector3<f64>,
+) -> Result<PerezSky, SiteRenderError> {
+    let form = doc
+        .site
+        .lighting
+        .perez
+        .clone()
+        .unwrap_or_default()
+        .form()
+        .map_err(|e| SiteRenderError::Request {
+            field: e.field,
+            reason: e.reason,
+        })?;
+    let cos_zenith = sun_dir_in_world.z.clamp(-1.0, 1.0);
+    if cos_zenith <= 0.0 {
+        return Err(SiteRenderError::Sky {
+            reason: format!(
+                "`perez` needs the sun above the horizon; it is at elevation {:.3}°",
+                cos_zenith.asin().to_degrees()
+            ),
+        });
+    }
+    let sun_zenith = cos_zenith.acos();
+    match form {
+        PerezForm::Indices {
+            clearness,
+            brightness,
+        } => Ok(PerezSky::from_indices(clearness, brightness, sun_zenith)),
+        PerezForm::Irradiance {
+            direct_normal_w_m2,
+            diffuse_horizontal_w_m2,
+        } => {
+            let time = super::site_time::site_sun_time(doc, photo_id).map_err(|e| {
+                SiteRenderError::Request {
+                    field: "lighting.perez",
+                    reason: format!(
+                        "the irradiance form needs the day of the year from the sun time ({e}); \
+                         or give clearness and brightness"
+                    ),
+                }
+            })?;
+            PerezSky::from_irradiance(
+                direct_normal_w_m2,
+                diffuse_horizontal_w_m2,
+                sun_zenith,
+                time.ordinal(),
+            )
+            .map_err(|e| SiteRenderError::Sky {
+                reason: format!("`perez`: {e}"),
+            })
+        }
     }
 }
 
@@ -231,9 +302,9 @@ fn atmosphere(a: &super::Atmosphere) -> Result<Option<SchachterAtmosphere>, Site
     )?))
 }
 
-fn sun_needed(doc: &SiteDocument, sky: &SkyModel) -> bool {
-    doc.site.lighting.sun_weight.iter().any(|&k| k != 0.0)
-        || matches!(sky, SkyModel::CieGeneral(_) | SkyModel::Perez(_))
+fn sun_needed(doc: &SiteDocument) -> bool {
+    let l = &doc.site.lighting;
+    l.sun_weight.iter().any(|&k| k != 0.0) || l.sky_model.needs_sun()
 }
 
 /// The lighting of photo `photo_id`: sun (normal irradiance = `sun_weight`), sky facets
@@ -250,8 +321,7 @@ pub fn site_lighting(
     options: &SiteLightingOptions,
 ) -> Result<(Lighting, Option<Vector3<f64>>), SiteRenderError> {
     let l = &doc.site.lighting;
-    let model = site_sky_model(l.sky_model)?;
-    let sun_dir = if sun_needed(doc, &model) {
+    let sun_dir = if sun_needed(doc) {
         Some(site_sun_dir(doc, photo_id)?)
     } else {
         None
@@ -260,7 +330,7 @@ pub fn site_lighting(
     let sky_sun_dir = sun_dir.unwrap_or_else(Vector3::z);
     let sky = if l.sky_weight.iter().any(|&k| k != 0.0) {
         sky_lights(
-            &model,
+            &site_sky_model(doc, photo_id, &sky_sun_dir)?,
             &sky_sun_dir,
             &durisch_dome(options.sky_dome_m_h)?,
             l.sky_weight,
@@ -397,6 +467,9 @@ pub fn prepare_view_with(
     })
 }
 
+#[cfg(test)]
+#[path = "perez_sky_tests.rs"]
+mod perez_tests;
 #[cfg(test)]
 #[path = "render_tests.rs"]
 pub(crate) mod tests;

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 mod lighting_fit;
 mod materials;
 mod names;
+mod perez;
 mod variants;
 
 pub use lighting_fit::{
@@ -13,6 +14,7 @@ pub use lighting_fit::{
 };
 pub use materials::{PaletteColour, SiteMaterial};
 pub use names::{ModelUnits, ModelUpAxis, SkyModelName};
+pub use perez::{PerezForm, PerezInputError, PerezInputs};
 pub use variants::{Variant, VariantPlacement};
 
 fn default_true() -> bool {
@@ -322,8 +324,11 @@ pub struct Lighting {
     /// Sun direction given by hand (overrides the computed position).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sun_manual: Option<SunManual>,
-    /// Sky model: `uniform`, `cie_overcast`, or `cie_general:N` with N in 1–15.
+    /// Sky model: `uniform`, `cie_overcast`, `cie_general:N` with N in 1–15, or `perez`.
     pub sky_model: SkyModelName,
+    /// Inputs of the Perez sky (read when `sky_model = "perez"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub perez: Option<PerezInputs>,
     /// Weight of direct sunlight k_s (Durisch eq. 6).
     pub sun_weight: [f64; 3],
     /// Weight of ambient light k_u.
@@ -351,6 +356,7 @@ impl Default for Lighting {
             time: None,
             sun_manual: None,
             sky_model: SkyModelName::CieGeneral(12),
+            perez: None,
             sun_weight: [1.0; 3],
             ambient_weight: [0.0; 3],
             sky_weight: [1.0; 3],

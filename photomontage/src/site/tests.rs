@@ -168,11 +168,17 @@ fn closed_sets_are_refused_at_their_line_and_round_trip() {
     let msg = err.unwrap_err().to_string();
     assert!(msg.contains(&format!("test.toml:{sky_line}:")), "{msg}");
     assert!(msg.contains("cie_general:N"), "{msg}");
-    for name in ["uniform", "cie_overcast", "cie_general:1", "cie_general:15"] {
+    for name in [
+        "uniform",
+        "cie_overcast",
+        "cie_general:1",
+        "cie_general:15",
+        "perez",
+    ] {
         assert_eq!(name.parse::<SkyModelName>().unwrap().to_string(), name);
     }
     assert!("cie_general:0".parse::<SkyModelName>().is_err());
-    assert!("perez".parse::<SkyModelName>().is_err());
+    assert!("perez:1".parse::<SkyModelName>().is_err());
 }
 
 #[test]

@@ -299,6 +299,11 @@ impl Site {
                 format!("`{t}` is not an RFC 3339 time with offset"),
             ));
         }
+        if lighting.sky_model == super::SkyModelName::Perez
+            && let Err(e) = lighting.perez.clone().unwrap_or_default().form()
+        {
+            issues.push(issue(e.field.into(), e.reason));
+        }
         let r = &self.render;
         if r.spp_min == 0 || r.spp_max < r.spp_min {
             issues.push(issue(

@@ -78,15 +78,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for w in &elevation.warnings {
         eprintln!("warning: {w}");
     }
-    let mut bytes = Vec::new();
-    elevation
-        .image
-        .image
-        .write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .context("encoding PNG")?;
+    let bytes = elevation.png_bytes().context("encoding PNG")?;
     photomontage::site::write_atomically(&args.out, &bytes)
         .with_context(|| format!("writing {}", args.out.display()))?;
     if args.json {

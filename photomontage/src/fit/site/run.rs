@@ -233,8 +233,6 @@ pub(super) fn run_fits(
                 material: s.material.clone(),
             });
         }
-        let model = site_sky_model(site.lighting.sky_model)
-            .map_err(|e| SiteFitError::Sun(e.to_string()))?;
         let sun_dir = site_sun_dir(doc, &day_samples[0].photo)
             .map(|d| (d.z > 0.0).then_some(d))
             .map_err(|e| SiteFitError::Sun(e.to_string()))?;
@@ -243,6 +241,8 @@ pub(super) fn run_fits(
         }
         let dome = durisch_dome(options.sky_m_h).map_err(|e| SiteFitError::Sun(e.to_string()))?;
         let sky_sun = sun_dir.unwrap_or_else(Vector3::z);
+        let model = site_sky_model(doc, &day_samples[0].photo, &sky_sun)
+            .map_err(|e| SiteFitError::Sun(e.to_string()))?;
         let sky = normalised_sky_facets(&dome, &model, &sky_sun).map_err(|source| {
             SiteFitError::Daylight {
                 samples: id_list(&day_samples),

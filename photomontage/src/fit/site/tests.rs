@@ -204,7 +204,7 @@ fn synthetic_site(seed: u64, corrupt_every: Option<usize>) -> Synthetic {
     let sun = site_sun_dir(&doc0, "P1").unwrap();
     let sky = normalised_sky_facets(
         &durisch_dome(SiteFitOptions::default().sky_m_h).unwrap(),
-        &crate::site::render::site_sky_model(crate::site::SkyModelName::CieGeneral(12)).unwrap(),
+        &crate::site::render::site_sky_model(&doc0, "P1", &sun).unwrap(),
         &sun,
     )
     .unwrap();

@@ -129,8 +129,8 @@ impl std::fmt::Display for ModelUpAxis {
     }
 }
 
-/// The sky model of `[lighting]`: `uniform`, `cie_overcast` or `cie_general:N` (N = 1–15); a
-/// closed set, checked when the file is read.
+/// The sky model of `[lighting]`: `uniform`, `cie_overcast`, `cie_general:N` (N = 1–15) or
+/// `perez` (its inputs in `[lighting.perez]`); a closed set, checked when the file is read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum SkyModelName {
@@ -140,6 +140,16 @@ pub enum SkyModelName {
     CieOvercast,
     /// CIE standard general sky of this type (1–15).
     CieGeneral(u8),
+    /// The Perez all-weather sky of `[lighting.perez]`.
+    Perez,
+}
+
+impl SkyModelName {
+    /// Whether the sky's distribution depends on the sun's position.
+    #[must_use]
+    pub fn needs_sun(self) -> bool {
+        matches!(self, Self::CieGeneral(_) | Self::Perez)
+    }
 }
 
 impl std::str::FromStr for SkyModelName {
@@ -149,6 +159,7 @@ impl std::str::FromStr for SkyModelName {
         match name {
             "uniform" => Ok(Self::Uniform),
             "cie_overcast" => Ok(Self::CieOvercast),
+            "perez" => Ok(Self::Perez),
             other => other
                 .strip_prefix("cie_general:")
                 .and_then(|n| n.parse::<u8>().ok())
@@ -156,7 +167,8 @@ impl std::str::FromStr for SkyModelName {
                 .map(Self::CieGeneral)
                 .ok_or_else(|| {
                     format!(
-                        "`{name}` is not `uniform`, `cie_overcast` or `cie_general:N` (N = 1–15)"
+                        "`{name}` is not `uniform`, `cie_overcast`, `cie_general:N` (N = 1–15) \
+                         or `perez`"
                     )
                 }),
         }
@@ -183,6 +195,7 @@ impl std::fmt::Display for SkyModelName {
             Self::Uniform => f.write_str("uniform"),
             Self::CieOvercast => f.write_str("cie_overcast"),
             Self::CieGeneral(n) => write!(f, "cie_general:{n}"),
+            Self::Perez => f.write_str("perez"),
         }
     }
 }
