@@ -78,11 +78,12 @@ pub fn plan_variants(
         .into_iter()
         .map(|name| {
             let document = variant_document(doc, Some(&name))?;
-            let mut plan =
-                RenderPlan::new(&document, request).map_err(|source| VariantRenderError::Render {
+            let mut plan = RenderPlan::new(&document, request).map_err(|source| {
+                VariantRenderError::Render {
                     variant: name.clone(),
                     source,
-                })?;
+                }
+            })?;
             // Parts of two variants must not merge.
             plan.identity.insert("variant".into(), name.clone());
             Ok(VariantJob {
