@@ -455,6 +455,29 @@ impl ShownVariant {
     }
 }
 
+/// Writes the comparison sheet of `cells` to `path`: with a `subtitle`, the PDF (and the PNG
+/// grid beside it when `png_too`), else the PNG grid; returns the files written.
+fn write_comparison(
+    path: &std::path::Path,
+    subtitle: Option<&str>,
+    png_too: bool,
+    cells: &[ComparisonCell<'_>],
+) -> Result<Vec<std::path::PathBuf>, String> {
+    let Some(subtitle) = subtitle else {
+        write_comparison_png(path, cells).map_err(|e| e.to_string())?;
+        return Ok(vec![path.to_path_buf()]);
+    };
+    let pdf = comparison_pdf(cells, subtitle).map_err(|e| e.to_string())?;
+    write_sheet(path, &pdf).map_err(|e| e.to_string())?;
+    let mut written = vec![path.to_path_buf()];
+    if png_too {
+        let png = path.with_extension("png");
+        write_comparison_png(&png, cells).map_err(|e| e.to_string())?;
+        written.push(png);
+    }
+    Ok(written)
+}
+
 impl crate::Studio {
     /// Renders every variant of the current photo (errors become messages).
     pub fn start_variant_renders(&mut self, ctx: &egui::Context) {
@@ -500,35 +523,24 @@ impl crate::Studio {
                 image: &s.render.srgb,
             })
             .collect();
-        let mut written = Vec::new();
-        let result = if ext == "pdf" {
-            let subtitle =
-                comparison_subtitle(&doc.site.name, &renders.view, &first.render.plan.settings);
-            comparison_pdf(&cells, &subtitle)
-                .and_then(|pdf| write_sheet(&path, &pdf))
-                .map(|()| written.push(path.clone()))
-                .and_then(|()| {
-                    if self.variants.png_too {
-                        let png = path.with_extension("png");
-                        write_comparison_png(&png, &cells)?;
-                        written.push(png);
-                    }
-                    Ok(())
-                })
-        } else {
-            write_comparison_png(&path, &cells).map(|()| written.push(path.clone()))
-        };
+        let subtitle = (ext == "pdf").then(|| {
+            comparison_subtitle(&doc.site.name, &renders.view, &first.render.plan.settings)
+        });
+        let result = write_comparison(&path, subtitle.as_deref(), self.variants.png_too, &cells);
         let n = cells.len();
-        let listed: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
         match result {
-            Ok(()) => self.say(
+            Ok(written) => self.say(
                 format!(
                     "wrote the comparison sheet of {n} variant(s): {}",
-                    listed.join(", ")
+                    written
+                        .iter()
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
                 false,
             ),
-            Err(e) => self.say(e.to_string(), true),
+            Err(e) => self.say(e, true),
         }
     }
 

@@ -34,7 +34,7 @@ pub enum VariantRenderError {
     #[error("variant `{variant}`: {source}")]
     Render {
         variant: String,
-        source: SiteRenderError,
+        source: Box<SiteRenderError>,
     },
 }
 
@@ -81,7 +81,7 @@ pub fn plan_variants(
             let mut plan = RenderPlan::new(&document, request).map_err(|source| {
                 VariantRenderError::Render {
                     variant: name.clone(),
-                    source,
+                    source: Box::new(source),
                 }
             })?;
             // Parts of two variants must not merge.
@@ -122,7 +122,7 @@ impl VariantJob {
             .render(&self.document, on_tile, cancel)
             .map_err(|source| VariantRenderError::Render {
                 variant: self.name.clone(),
-                source,
+                source: Box::new(source),
             })?;
         let srgb = srgb_of(&photo, &self.plan);
         Ok(VariantRender {
