@@ -46,6 +46,20 @@ text = open(path).read()
 text = text.replace('grid_convergence_deg = 0.0\n',
                     'grid_convergence_deg = 0.0\ntime_zone = "Europe/Zurich"\n', 1)
 text = text.replace('\n[[photos]]', '\n[render]\nspp_min = 4\nspp_max = 8\n\n[[photos]]', 1)
+# Two design variants for the Variants tab: the planned building as drawn, and recoloured.
+text += '''
+[[variants]]
+name = "As planned"
+visible_models = ["planned"]
+
+[[variants]]
+name = "Terracotta"
+visible_models = ["planned"]
+
+[[variants.materials]]
+name = "cladding"
+diffuse_rgb = [0.52, 0.16, 0.08]
+'''
 open(path, 'w').write(text)
 PY
 "$bin/photomontage" solve "$site" >/dev/null
@@ -67,7 +81,11 @@ if [[ ${#tabs[@]} -eq 0 ]]; then
 fi
 for tab in "${tabs[@]}"; do
     slug=$(echo "$tab" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\+/-/g; s/-$//')
-    if "$bin/photomontage-studio" --help >/dev/null && shot "docs/images/studio-$slug.png" --tab "$tab"; then
+    extra=()
+    if [[ $tab == Variants ]]; then
+        extra=(--render-variants)  # both variants rendered, shown on the A/B slider
+    fi
+    if "$bin/photomontage-studio" --help >/dev/null && shot "docs/images/studio-$slug.png" --tab "$tab" "${extra[@]}"; then
         :
     else
         echo "note: no screenshot of tab \"$tab\" (the studio does not know it)" >&2

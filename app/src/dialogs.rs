@@ -31,6 +31,8 @@ pub enum DialogPurpose {
     NewSitePhotos,
     /// Choose where a new site file goes.
     NewSiteFile,
+    /// Export the Variants tab's comparison sheet (.pdf or .png).
+    ExportComparison,
 }
 
 impl DialogPurpose {
@@ -45,6 +47,7 @@ impl DialogPurpose {
             Self::ExportRender => "Export render",
             Self::NewSitePhotos => "Photos of the new site",
             Self::NewSiteFile => "New site file",
+            Self::ExportComparison => "Export comparison sheet",
         }
     }
 
@@ -53,7 +56,7 @@ impl DialogPurpose {
     pub fn is_save(self) -> bool {
         matches!(
             self,
-            Self::SaveSiteAs | Self::ExportRender | Self::NewSiteFile
+            Self::SaveSiteAs | Self::ExportRender | Self::NewSiteFile | Self::ExportComparison
         )
     }
 
@@ -88,6 +91,10 @@ impl DialogPurpose {
                 ("PNG", &["png"]),
                 ("JPEG", &["jpg", "jpeg"]),
                 ("TIFF", &["tif", "tiff"]),
+            ],
+            Self::ExportComparison => &[
+                ("PDF, one page per variant", &["pdf"]),
+                ("PNG grid", &["png"]),
             ],
         }
     }

@@ -63,6 +63,10 @@ impl crate::Studio {
                 .map(|n| n.to_string_lossy().into_owned()),
             DialogPurpose::ExportRender => self.current_photo.as_ref().map(|p| format!("{p}.png")),
             DialogPurpose::NewSiteFile => Some("site.toml".into()),
+            DialogPurpose::ExportComparison => self
+                .current_photo
+                .as_ref()
+                .map(|p| format!("{p}-variants.pdf")),
             _ => None,
         };
         let request = DialogRequest {
@@ -111,6 +115,10 @@ impl crate::Studio {
             }
             DialogPurpose::NewSiteFile => self.new_site.set_site_path(&path),
             DialogPurpose::NewSitePhotos => {}
+            DialogPurpose::ExportComparison => {
+                self.variants_panel_mut().export_path = path.to_string_lossy().into_owned();
+                self.export_comparison();
+            }
         }
     }
 

@@ -27,6 +27,7 @@ impl Studio {
             && !self.dialogs.busy()
             && !self.fit.worker.busy()
             && !self.study.busy()
+            && !self.variants.busy()
     }
 
     /// Starts a solve of the site as it is now on the worker thread.
@@ -100,6 +101,7 @@ impl Studio {
         self.poll_dialogs(ctx);
         self.poll_fit(ctx);
         self.poll_study(ctx);
+        self.poll_variants(ctx);
         // Start decoding the current photo.
         if let (Some(id), Some(doc)) = (self.current_photo.clone(), self.doc.as_ref())
             && !self.photos.contains_key(&id)

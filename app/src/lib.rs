@@ -68,6 +68,7 @@ pub mod study_panel;
 pub mod table_sort;
 pub mod tie_panel;
 pub mod variant_commands;
+pub mod variants_panel;
 pub mod viewport;
 pub mod widgets;
 pub mod window;
@@ -162,6 +163,7 @@ enum SideTab {
     Light,
     Study,
     Materials,
+    Variants,
 }
 
 /// The studio app.
@@ -210,6 +212,7 @@ pub struct Studio {
     light: light_panel::LightPanel,
     study: study_panel::StudyPanel,
     materials: materials_panel::MaterialsPanel,
+    variants: variants_panel::VariantsPanel,
 }
 
 impl Studio {
@@ -260,6 +263,7 @@ impl Studio {
             light: light_panel::LightPanel::default(),
             study: study_panel::StudyPanel::default(),
             materials: materials_panel::MaterialsPanel::default(),
+            variants: variants_panel::VariantsPanel::default(),
         };
         s.open(&options.site_path);
         s
@@ -611,6 +615,8 @@ impl Studio {
             widgets::name_widget(ui, &r, "Study tab");
             let r = ui.selectable_value(&mut self.tab, SideTab::Materials, "Materials");
             widgets::name_widget(ui, &r, "Materials tab");
+            let r = ui.selectable_value(&mut self.tab, SideTab::Variants, "Variants");
+            widgets::name_widget(ui, &r, "Variants tab");
         });
         ui.separator();
         let ctx = panel_context!(self);
@@ -625,6 +631,7 @@ impl Studio {
             SideTab::Light => &mut self.light,
             SideTab::Study => &mut self.study,
             SideTab::Materials => &mut self.materials,
+            SideTab::Variants => &mut self.variants,
         };
         let actions = panel.ui(ui, &ctx);
         self.actions.extend(actions);
@@ -668,6 +675,9 @@ impl Studio {
             Action::StartStudy => self.start_study(ctx),
             Action::CancelStudy => self.study.cancel(),
             Action::ExportStudy => self.export_study(),
+            Action::StartVariantRenders => self.start_variant_renders(ctx),
+            Action::CancelVariantRenders => self.variants.cancel(),
+            Action::ExportComparison => self.export_comparison(),
         }
     }
 

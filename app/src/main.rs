@@ -51,6 +51,10 @@ struct Args {
     /// Show the side tab with this label at start ("Study", "Render", …).
     #[arg(long, value_name = "LABEL")]
     tab: Option<String>,
+    /// Render every design variant of the first photo on the first frame (the Variants tab's
+    /// "Render all variants"; the screenshot waits for it).
+    #[arg(long)]
+    render_variants: bool,
     /// Run a sun study of the first photo on the first frame, at these dates (as the Study
     /// tab's and `photomontage study`'s --dates).
     #[arg(long, value_name = "LIST", requires = "study_times")]
@@ -101,6 +105,7 @@ struct Shell {
     solve_on_start: bool,
     study_on_start: bool,
     study_frame: Option<usize>,
+    variants_on_start: bool,
 }
 
 impl eframe::App for Shell {
@@ -112,6 +117,10 @@ impl eframe::App for Shell {
         if std::mem::take(&mut self.study_on_start) {
             let ctx = ui.ctx().clone();
             self.studio.start_study(&ctx);
+        }
+        if std::mem::take(&mut self.variants_on_start) {
+            let ctx = ui.ctx().clone();
+            self.studio.start_variant_renders(&ctx);
         }
         if let Some(n) = self.study_frame
             && !self.studio.study_panel().busy()
@@ -230,6 +239,7 @@ fn main() -> anyhow::Result<()> {
         solve_on_start: args.solve,
         study_on_start: args.study_dates.is_some(),
         study_frame: args.study_frame,
+        variants_on_start: args.render_variants,
     };
     eframe::run_native(
         "photomontage studio",

@@ -133,6 +133,12 @@ pub enum Action {
     CancelStudy,
     /// Write the last study to the Study tab's folder.
     ExportStudy,
+    /// Render every variant of the current photo (Variants tab).
+    StartVariantRenders,
+    /// Stop the variant renders at their next tile.
+    CancelVariantRenders,
+    /// Write the comparison sheet to the Variants tab's path.
+    ExportComparison,
 }
 
 /// A side-tab panel.

@@ -613,6 +613,7 @@ impl crate::Studio {
             ("Site & light", SideTab::Light),
             ("Materials", SideTab::Materials),
             ("Study", SideTab::Study),
+            ("Variants", SideTab::Variants),
         ];
         match known.iter().find(|(name, _)| *name == label) {
             Some((_, tab)) => {

@@ -3,9 +3,11 @@
 //! does not import `commands`: the dependency runs one way). Each edit returns its exact inverse
 //! (positions restored, so an undone edit leaves the saved file byte-identical).
 //!
+//! The Variants tab ([`crate::variants_panel`]) issues them: a variant's visibility, placements
+//! and materials are edited as a `Put` of the whole changed variant.
+//!
 //! # Known limitations
-//! The Variants tab that issues these commands is not built yet; the commands are complete and
-//! tested so the tab only wires them.
+//! A `Put` carries the whole variant, so an undo step of a placement drag holds a copy of it.
 
 use photomontage::site::{Site, Variant};
 

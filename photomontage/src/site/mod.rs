@@ -38,6 +38,7 @@ pub mod tie_matching;
 pub mod tie_points;
 pub mod toml_merge;
 mod validate;
+pub mod variant_renders;
 pub mod variants;
 
 pub use schema::*;

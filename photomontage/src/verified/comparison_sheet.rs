@@ -15,11 +15,13 @@
 //! print as `?` in the PDF and the PNG's bitmap font has ASCII only.
 
 use std::io::Cursor;
+use std::path::Path;
 
 use image::RgbImage;
 use pdf_writer::{Content, Filter, Finish, Name, Pdf, Rect, Ref};
 
 use super::sheet::{JPEG_QUALITY, SheetError, mm, text, write_font};
+use crate::render::RenderSettings;
 use crate::study::contact_sheet::{SheetCell, contact_sheet};
 
 /// A3 landscape, millimetres.
@@ -52,6 +54,39 @@ pub fn comparison_png(cells: &[ComparisonCell<'_>]) -> RgbImage {
         })
         .collect();
     contact_sheet(&sheet_cells, cells.len().clamp(1, PNG_COLUMNS))
+}
+
+/// The line under each page's title: the site, the view and what every variant shares
+/// (the seed and the rays per pixel of `settings`; the lighting is the site's).
+#[must_use]
+pub fn comparison_subtitle(site_name: &str, view: &str, settings: &RenderSettings) -> String {
+    format!(
+        "{} | view {view} | same lighting, seed {}, {}-{} rays/pixel",
+        if site_name.is_empty() {
+            "site"
+        } else {
+            site_name
+        },
+        settings.seed,
+        settings.min_rays_per_pixel,
+        settings.max_rays_per_pixel,
+    )
+}
+
+/// Writes the PNG grid ([`comparison_png`]) to `path` atomically.
+///
+/// # Errors
+/// [`SheetError::Encode`], [`SheetError::Write`].
+pub fn write_comparison_png(path: &Path, cells: &[ComparisonCell<'_>]) -> Result<(), SheetError> {
+    let sheet = comparison_png(cells);
+    let mut bytes = Vec::new();
+    sheet
+        .write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| SheetError::Encode {
+            photo: "comparison sheet".into(),
+            message: e.to_string(),
+        })?;
+    super::sheet::write_sheet(path, &bytes)
 }
 
 /// The image box on a page: `[x, y, width, height]` in millimetres (PDF origin bottom left) for

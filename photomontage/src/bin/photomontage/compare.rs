@@ -9,11 +9,13 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
 use anyhow::{Context, bail};
-use photomontage::colour::encode_srgb8;
 use photomontage::site::SiteDocument;
-use photomontage::site::render_photo::{RenderPlan, RenderRequest};
-use photomontage::site::variants::{checked_variant_names, variant_document};
-use photomontage::verified::comparison_sheet::{ComparisonCell, comparison_pdf, comparison_png};
+use photomontage::site::render_photo::RenderRequest;
+use photomontage::site::variant_renders::plan_variants;
+use photomontage::site::variants::checked_variant_names;
+use photomontage::verified::comparison_sheet::{
+    ComparisonCell, comparison_pdf, comparison_subtitle, write_comparison_png,
+};
 use photomontage::verified::image_metadata::write_render;
 use photomontage::verified::sheet::write_sheet;
 
@@ -106,13 +108,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         exposure: args.exposure,
         ..RenderRequest::view(&args.view)
     };
-    let mut jobs = Vec::with_capacity(names.len());
-    for name in &names {
-        let vdoc = variant_document(&doc, Some(name))?;
-        let mut plan = RenderPlan::new(&vdoc, &request)?;
-        plan.identity.insert("variant".into(), name.clone());
-        jobs.push((name, vdoc, plan));
-    }
+    let jobs = plan_variants(&doc, Some(&names), &request)?;
     if let Some(files) = names
         .iter()
         .map(|n| file_part(n))
@@ -131,18 +127,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 
     let cancel = install_cancel()?;
-    let [w, h] = jobs[0].2.full_size_px;
-    let bar = tile_bar(jobs.iter().map(|j| j.2.tile_count()).sum());
+    let [w, h] = jobs[0].plan.full_size_px;
+    let bar = tile_bar(jobs.iter().map(|j| j.plan.tile_count()).sum());
     eprintln!(
         "rendering {} variants of view {} at {w}×{h} px (Ctrl-C cancels)",
         jobs.len(),
         args.view
     );
     let mut rendered = Vec::with_capacity(jobs.len());
-    for (name, vdoc, plan) in &jobs {
-        let result = with_threads(args.threads, || {
-            Ok(plan.render(vdoc, &|_| bar.inc(1), cancel)?)
-        });
+    for job in &jobs {
+        let result = with_threads(args.threads, || Ok(job.render(&|_| bar.inc(1), cancel)?));
         if cancel.load(Ordering::SeqCst) {
             bar.finish_and_clear();
             bail!(
@@ -150,66 +144,43 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 args.out.display()
             );
         }
-        let photo = result.with_context(|| format!("variant `{name}`"))?;
-        for warning in &photo.warnings {
-            eprintln!("warning: variant {name}: {warning}");
+        let variant = result?;
+        for warning in &variant.photo.warnings {
+            eprintln!("warning: variant {}: {warning}", job.name);
         }
-        let tone_map = plan.tone_map();
-        let [fw, fh] = photo.image.size_px;
-        let srgb = image::RgbImage::from_fn(fw, fh, |x, y| {
-            let p = photo.image.rgba[(y * fw + x) as usize];
-            image::Rgb(encode_srgb8([p[0], p[1], p[2]], &tone_map))
-        });
-        rendered.push((photo, srgb));
+        rendered.push(variant);
     }
     bar.finish_and_clear();
 
     if let Some(dir) = &args.images {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create --images {}", dir.display()))?;
-        for ((name, vdoc, plan), (photo, _)) in jobs.iter().zip(&rendered) {
-            let path = dir.join(format!("{}_{}.png", file_part(&args.view), file_part(name)));
+        for (job, variant) in jobs.iter().zip(&rendered) {
+            let path = dir.join(format!(
+                "{}_{}.png",
+                file_part(&args.view),
+                file_part(&job.name)
+            ));
             write_render(
                 &path,
-                &photo.image,
-                &photo.layers,
-                &plan.tone_map(),
-                view_of(vdoc, &args.view).as_ref(),
+                &variant.photo.image,
+                &variant.photo.layers,
+                &job.plan.tone_map(),
+                view_of(&job.document, &args.view).as_ref(),
             )?;
-            println!("variant {name}: {}", path.display());
+            println!("variant {}: {}", job.name, path.display());
         }
     }
-    let cells: Vec<ComparisonCell<'_>> = names
+    let cells: Vec<ComparisonCell<'_>> = rendered
         .iter()
-        .zip(&rendered)
-        .map(|(name, (_, srgb))| ComparisonCell {
-            name: name.clone(),
-            image: srgb,
+        .map(|v| ComparisonCell {
+            name: v.name.clone(),
+            image: &v.srgb,
         })
         .collect();
-    let seed = jobs[0].2.settings.seed;
-    let subtitle = format!(
-        "{} | view {} | same lighting, seed {seed}, {}-{} rays/pixel",
-        if doc.site.name.is_empty() {
-            "site"
-        } else {
-            &doc.site.name
-        },
-        args.view,
-        jobs[0].2.settings.min_rays_per_pixel,
-        jobs[0].2.settings.max_rays_per_pixel,
-    );
+    let subtitle = comparison_subtitle(&doc.site.name, &args.view, &jobs[0].plan.settings);
     if let Some(png) = &args.png {
-        let sheet = comparison_png(&cells);
-        let mut bytes = Vec::new();
-        sheet
-            .write_to(
-                &mut std::io::Cursor::new(&mut bytes),
-                image::ImageFormat::Png,
-            )
-            .with_context(|| format!("encoding {}", png.display()))?;
-        photomontage::site::write_atomically(png, &bytes)
-            .with_context(|| format!("cannot write {}", png.display()))?;
+        write_comparison_png(png, &cells)?;
         println!("comparison sheet {}", png.display());
     }
     write_sheet(&args.out, &comparison_pdf(&cells, &subtitle)?)?;
