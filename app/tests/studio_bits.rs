@@ -13,6 +13,7 @@ use photomontage::scene::Material;
 use photomontage::site::{PerezInputs, SiteDocument, SiteMaterial, SkyModelName};
 use photomontage_studio::Studio;
 use photomontage_studio::commands::Command;
+use photomontage_studio::light_commands::LightCommand;
 use photomontage_studio::material_commands::MaterialCommand;
 use std::path::Path;
 
@@ -195,11 +196,19 @@ fn typed_hex_survives_an_edit_of_another_material() {
 #[test]
 fn the_perez_sky_is_set_by_clearness_and_brightness() {
     let (_dir, site) = copy_sample();
-    let mut doc = SiteDocument::load(&site).unwrap();
-    doc.site.lighting.sky_model = SkyModelName::Perez;
-    doc.save().unwrap();
-    let original = SiteDocument::load(&site).unwrap().site;
     let mut h = open_light_tab(&site);
+    // A site file naming `perez` without its inputs does not load (`validate`): the sky is
+    // chosen in the studio (the list's `SetLighting` command; `perez` is the 18th entry, below
+    // the list's visible part), and the panel says what it still needs.
+    let mut lighting = site_of(&h).lighting;
+    lighting.sky_model = SkyModelName::Perez;
+    h.state_mut().apply(
+        Command::Light(LightCommand::SetLighting(Box::new(lighting))),
+        None,
+    );
+    h.run();
+    let original = site_of(&h);
+    assert_eq!(original.lighting.sky_model, SkyModelName::Perez);
     assert!(
         has(&h, "needs clearness and brightness"),
         "a Perez sky without inputs says what it needs"
