@@ -316,12 +316,7 @@ impl DifferentialTracer<'_> {
         // Second inversions: atmosphere (eq. 8), then illumination (eq. 10) with the natural
         // irradiance as if there were no artificial objects.
         let l0 = self.true_colour(photo_rgb, photo_distance_m);
-        let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
-            s.dir_in_world.dot(&normal) > 0.0 && !self.natural_blocks(&origin, &s.dir_in_world, inf)
-        });
-        let e_natural = natural_irradiance_rgb(daylight, &normal, sun_natural, |i| {
-            !self.natural_blocks(&origin, &daylight.sky[i].dir_in_world, inf)
-        });
+        let e_natural = self.natural_daylight_irradiance(&origin, &normal);
         // Light the photographed surroundings reflect onto the point, before and after the
         // artificial objects arrive (they block some of it and shade the surfaces it comes from).
         let [e_inter_before, e_inter_after, e_reflected] =
@@ -363,6 +358,19 @@ impl DifferentialTracer<'_> {
         (rgb, changed, ratio)
     }
 
+    /// The daylight at a natural point as photographed (eq. 10's E without the interreflection):
+    /// the sun and the sky facets where the natural geometry lets them through, plus the ambient.
+    fn natural_daylight_irradiance(&self, origin: &Point3<f64>, normal: &Vector3<f64>) -> Rgb {
+        let daylight = &self.lighting.daylight;
+        let inf = f64::INFINITY;
+        let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
+            s.dir_in_world.dot(normal) > 0.0 && !self.natural_blocks(origin, &s.dir_in_world, inf)
+        });
+        natural_irradiance_rgb(daylight, normal, sun_natural, |i| {
+            !self.natural_blocks(origin, &daylight.sky[i].dir_in_world, inf)
+        })
+    }
+
     /// The [`NaturalRatio`] of an unchanged natural sample (ΔE = 0) of a primary ray, for a
     /// pixel whose other samples changed: `None` when the ray's first hit is not natural, in
     /// the radiosity mode, or where no natural light reaches the point.
@@ -387,14 +395,7 @@ impl DifferentialTracer<'_> {
         let d = f64::from(hit.hit.t);
         let normal = self.normal_facing(&hit, dir_in_world);
         let origin = point + normal * SURFACE_OFFSET_M;
-        let daylight = &self.lighting.daylight;
-        let inf = f64::INFINITY;
-        let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
-            s.dir_in_world.dot(&normal) > 0.0 && !self.natural_blocks(&origin, &s.dir_in_world, inf)
-        });
-        let e_natural = natural_irradiance_rgb(daylight, &normal, sun_natural, |i| {
-            !self.natural_blocks(&origin, &daylight.sky[i].dir_in_world, inf)
-        });
+        let e_natural = self.natural_daylight_irradiance(&origin, &normal);
         // Gathered exactly, not through the tile's cache: these few samples at shadow edges do
         // not add records, so the cache serves every other pixel as before.
         let e_natural = add(
