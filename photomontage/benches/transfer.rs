@@ -175,6 +175,34 @@ fn dimming_change(flip: bool) -> LightingChange {
     }
 }
 
+/// Criterion medians of `changes` on `t` (alternating states), then a summary line each with
+/// the median wall and CPU time of 6 more.
+fn measure(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    pool: &rayon::ThreadPool,
+    t: &mut Transfer,
+    label: &str,
+    changes: &[(&str, Change)],
+    summary: &mut Vec<String>,
+) {
+    for &(what, change) in changes {
+        let mut flip = false;
+        group.bench_function(format!("{label}/{what}"), |b| {
+            b.iter(|| {
+                flip = !flip;
+                let c = change(flip);
+                pool.install(|| t.relight(&c).unwrap())
+            });
+        });
+        let (wall_ms, cpu_ms) = wall_and_cpu(pool, t, 6, change);
+        summary.push(format!(
+            "{label}/{what}: wall {wall_ms:.2} ms, CPU {} (median of 6, load {})",
+            fmt_opt(cpu_ms, 1.0, "ms"),
+            fmt_opt(load_average(), 1.0, "")
+        ));
+    }
+}
+
 fn bench_transfer(c: &mut Criterion) {
     let pool = pool();
     println!(
@@ -236,22 +264,7 @@ fn bench_transfer(c: &mut Criterion) {
             ("material", material_change),
             ("dimming", dimming_change),
         ];
-        for (what, change) in changes {
-            let mut flip = false;
-            group.bench_function(format!("{label}/{what}"), |b| {
-                b.iter(|| {
-                    flip = !flip;
-                    let c = change(flip);
-                    pool.install(|| t.relight(&c).unwrap())
-                });
-            });
-            let (wall_ms, cpu_ms) = wall_and_cpu(&pool, &mut t, 6, change);
-            summary.push(format!(
-                "{label}/{what}: wall {wall_ms:.2} ms, CPU {} (median of 6, load {})",
-                fmt_opt(cpu_ms, 1.0, "ms"),
-                fmt_opt(load_average(), 1.0, "")
-            ));
-        }
+        measure(&mut group, &pool, &mut t, label, &changes, &mut summary);
         // Passes of one sun move and one material change (printed for the docs).
         let s = pool.install(|| t.relight(&sun_change(true)).unwrap());
         let m = pool.install(|| {
@@ -304,22 +317,14 @@ fn bench_transfer(c: &mut Criterion) {
     ));
     let mut t = coarse;
     let changes: [(&str, Change); 2] = [("sun_move", sun_change), ("material", material_change)];
-    for (what, change) in changes {
-        let mut flip = false;
-        group.bench_function(format!("coarse_roots/{what}"), |b| {
-            b.iter(|| {
-                flip = !flip;
-                let c = change(flip);
-                pool.install(|| t.relight(&c).unwrap())
-            });
-        });
-        let (wall_ms, cpu_ms) = wall_and_cpu(&pool, &mut t, 6, change);
-        summary.push(format!(
-            "coarse_roots/{what}: wall {wall_ms:.2} ms, CPU {} (median of 6, load {})",
-            fmt_opt(cpu_ms, 1.0, "ms"),
-            fmt_opt(load_average(), 1.0, "")
-        ));
-    }
+    measure(
+        &mut group,
+        &pool,
+        &mut t,
+        "coarse_roots",
+        &changes,
+        &mut summary,
+    );
     group.finish();
     println!("\n== transfer summary ({THREADS} threads; wall and CPU per relight) ==");
     println!(
