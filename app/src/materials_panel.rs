@@ -133,30 +133,12 @@ impl MaterialsPanel {
     }
 
     fn refresh(&mut self, doc: &SiteDocument) {
-        let key = format!(
-            "{:?}{:?}{:?}{}",
-            doc.site.models,
-            doc.site.materials,
-            doc.site.lighting.material_library,
-            doc.site.polygons.len()
+        refresh_scene_materials(
+            doc,
+            &mut self.cache_key,
+            &mut self.scene_materials,
+            &mut self.scene_error,
         );
-        if key == self.cache_key {
-            return;
-        }
-        self.cache_key = key;
-        match site_scene(doc) {
-            Ok(s) => {
-                let mut m = s.scene.materials().to_vec();
-                m.sort_by(|a, b| a.name.cmp(&b.name));
-                m.dedup_by(|a, b| a.name == b.name);
-                self.scene_materials = m;
-                self.scene_error = None;
-            }
-            Err(e) => {
-                self.scene_materials.clear();
-                self.scene_error = Some(e.to_string());
-            }
-        }
     }
 
     fn load(&mut self, doc: &SiteDocument, base: &Material) {
@@ -439,4 +421,38 @@ fn triple_row(
         })
     })
     .inner
+}
+
+/// Refills `materials` (the one scene's materials by name, or `error` when the scene cannot be
+/// built) when the site's models, materials, library or polygon count changed since `key`.
+pub(crate) fn refresh_scene_materials(
+    doc: &SiteDocument,
+    key: &mut String,
+    materials: &mut Vec<Material>,
+    error: &mut Option<String>,
+) {
+    let now = format!(
+        "{:?}{:?}{:?}{}",
+        doc.site.models,
+        doc.site.materials,
+        doc.site.lighting.material_library,
+        doc.site.polygons.len()
+    );
+    if now == *key {
+        return;
+    }
+    *key = now;
+    match site_scene(doc) {
+        Ok(s) => {
+            let mut m = s.scene.materials().to_vec();
+            m.sort_by(|a, b| a.name.cmp(&b.name));
+            m.dedup_by(|a, b| a.name == b.name);
+            *materials = m;
+            *error = None;
+        }
+        Err(e) => {
+            materials.clear();
+            *error = Some(e.to_string());
+        }
+    }
 }

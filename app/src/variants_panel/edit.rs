@@ -11,7 +11,6 @@ use std::collections::HashMap;
 use eframe::egui;
 use photomontage::colour::designer::{hex_from_linear, parse_colour, srgb8_from_linear};
 use photomontage::scene::Material;
-use photomontage::site::render::site_scene;
 use photomontage::site::variants::{VariantError, find_variant};
 use photomontage::site::{SiteDocument, Variant, VariantPlacement};
 
@@ -33,30 +32,12 @@ pub(crate) struct EditorCache {
 
 impl EditorCache {
     fn refresh(&mut self, doc: &SiteDocument) {
-        let key = format!(
-            "{:?}{:?}{:?}{}",
-            doc.site.models,
-            doc.site.materials,
-            doc.site.lighting.material_library,
-            doc.site.polygons.len()
+        crate::materials_panel::refresh_scene_materials(
+            doc,
+            &mut self.key,
+            &mut self.scene_materials,
+            &mut self.scene_error,
         );
-        if key == self.key {
-            return;
-        }
-        self.key = key;
-        match site_scene(doc) {
-            Ok(s) => {
-                let mut m = s.scene.materials().to_vec();
-                m.sort_by(|a, b| a.name.cmp(&b.name));
-                m.dedup_by(|a, b| a.name == b.name);
-                self.scene_materials = m;
-                self.scene_error = None;
-            }
-            Err(e) => {
-                self.scene_materials.clear();
-                self.scene_error = Some(e.to_string());
-            }
-        }
     }
 }
 
