@@ -14,7 +14,7 @@ mod common;
 use common::{WINDOW, add_box_model, copy_sample, harness, step_until};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use photomontage::radiosity::{Solution, luminance};
+use photomontage::radiosity::{RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, Solution};
 use photomontage::render::differential::radiosity_light::RadiosityLight;
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
@@ -26,12 +26,6 @@ use photomontage_studio::render_panel::{display_image, site_tone_map};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-
-/// Relit against a fresh solve: the transfer tests' tolerance (`radiosity/transfer_tests.rs`
-/// `RESOLVE_L1_REL_TOL`, `RESOLVE_MEAN_REL_TOL`): the relight keeps the build's refinement, a
-/// fresh solve refines for the new lighting within the BF tolerance.
-const RESOLVE_L1_REL_TOL: f64 = 0.02;
-const RESOLVE_MEAN_REL_TOL: f64 = 0.01;
 
 const SPP: (u32, u32) = (4, 8);
 const SEED: u64 = 7;
@@ -190,32 +184,16 @@ fn live_preview_follows_sky_and_colour_and_equals_the_library() {
     assert!(h.state().render_panel().live.last_frame().is_some());
 }
 
-fn areas(s: &Solution) -> Vec<f64> {
-    (0..s.mesh.elements.len())
-        .map(|e| s.mesh.element_node(e).area_m2)
-        .collect()
-}
-
 fn assert_matches_fresh_solve(label: &str, relit: &Solution, fresh: &Solution) {
-    let w = areas(fresh);
-    let (a, b) = (relit.total_radiosity_rgb(), fresh.total_radiosity_rgb());
-    assert_eq!(a.len(), b.len(), "{label}: same mesh");
-    let (mut diff, mut mean_a, mut mean_b) = (0.0, 0.0, 0.0);
-    for ((x, y), w) in a.iter().zip(&b).zip(&w) {
-        let d: [f64; 3] = std::array::from_fn(|c| (x[c] - y[c]).abs());
-        diff += luminance(&d) * w;
-        mean_a += luminance(x) * w;
-        mean_b += luminance(y) * w;
-    }
-    assert!(mean_b > 0.0, "{label}: a lit scene");
+    // The transfer's documented relight tolerances (`radiosity::RELIGHT_*_REL_TOL`).
+    let d = relit
+        .relative_difference(fresh)
+        .unwrap_or_else(|| panic!("{label}: same mesh and a lit scene"));
+    assert!(d.l1_rel < RELIGHT_L1_REL_TOL, "{label}: L1 {}", d.l1_rel);
     assert!(
-        diff / mean_b < RESOLVE_L1_REL_TOL,
-        "{label}: L1 {}",
-        diff / mean_b
-    );
-    assert!(
-        (mean_a - mean_b).abs() / mean_b < RESOLVE_MEAN_REL_TOL,
-        "{label}: mean {mean_a} vs {mean_b}"
+        d.mean_rel.abs() < RELIGHT_MEAN_REL_TOL,
+        "{label}: mean {}",
+        d.mean_rel
     );
 }
 

@@ -68,11 +68,14 @@ pub use convergence::{ConvergenceRow, StopRule};
 pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning};
 pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
-pub use solve::{GroupSolution, LightGroup, Solution, SolveParams, Solver, solve, solve_on_mesh};
+pub use solve::{
+    GroupSolution, LightGroup, RadiosityDifference, Solution, SolveParams, Solver, solve,
+    solve_on_mesh,
+};
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 pub use transfer::{
-    LightingChange, NamedLuminaire, RelightStrategy, Sky, Sun, Sweep, Transfer, TransferLighting,
-    TransferParams,
+    LightingChange, NamedLuminaire, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, RelightStrategy, Sky,
+    Sun, Sweep, Transfer, TransferLighting, TransferParams,
 };
 
 /// RGB triple (linear).

@@ -175,6 +175,15 @@ pub struct Solution {
     pub(crate) locator: std::sync::OnceLock<super::query::ElementLocator>,
 }
 
+/// [`Solution::relative_difference`]: area-weighted, in luminance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadiosityDifference {
+    /// Σ A·|L(B) − L(B_ref)| over Σ A·L(B_ref).
+    pub l1_rel: f64,
+    /// (mean − mean_ref) / mean_ref of the area-weighted mean brightness.
+    pub mean_rel: f64,
+}
+
 impl Solution {
     /// Σ over groups of the radiosity, per element.
     #[must_use]
@@ -189,6 +198,30 @@ impl Solution {
             }
         }
         total
+    }
+
+    /// How far this solution's total radiosity lies from `reference`'s on the same mesh, in
+    /// luminance weighted by element area: the L1 difference over the reference's L1 norm, and
+    /// the relative difference of the mean brightness. `None` when the meshes differ in size or
+    /// the reference is dark.
+    #[must_use]
+    pub fn relative_difference(&self, reference: &Solution) -> Option<RadiosityDifference> {
+        let (a, b) = (self.total_radiosity_rgb(), reference.total_radiosity_rgb());
+        if a.len() != b.len() {
+            return None;
+        }
+        let (mut diff, mut mean_a, mut mean_b) = (0.0, 0.0, 0.0);
+        for (e, (x, y)) in a.iter().zip(&b).enumerate() {
+            let w = reference.mesh.element_node(e).area_m2;
+            let d: Rgb = std::array::from_fn(|c| (x[c] - y[c]).abs());
+            diff += super::luminance(&d) * w;
+            mean_a += super::luminance(x) * w;
+            mean_b += super::luminance(y) * w;
+        }
+        (mean_b > 0.0).then(|| RadiosityDifference {
+            l1_rel: diff / mean_b,
+            mean_rel: (mean_a - mean_b) / mean_b,
+        })
     }
 
     /// The same solution without the direct irradiance of the groups `exact` names: their

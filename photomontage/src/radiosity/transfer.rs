@@ -62,6 +62,15 @@ use crate::scene::{Scene, SceneTracer};
 use crate::sky::SkyModel;
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
+/// How close a relit solution is to a fresh solve of the new lighting
+/// ([`Solution::relative_difference`]), as the transfer's tests check it: the relight keeps the
+/// links refined for the build's lighting, a fresh solve refines for the new lighting, each
+/// within the BF tolerance 0.002 × mean; the interreflected part differs by ≈ 1 %, the total
+/// (direct identical) by less, so 2 % bounds the area-weighted L1 difference.
+pub const RELIGHT_L1_REL_TOL: f64 = 0.02;
+/// The mean brightness of a relit solution against a fresh solve: within the stop rule's 1 %.
+pub const RELIGHT_MEAN_REL_TOL: f64 = 0.01;
+
 /// The sun as a distant source.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sun {

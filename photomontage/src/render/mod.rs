@@ -354,6 +354,8 @@ fn render_tile(
         changed: 0,
         rays: 0,
     };
+    // One buffer for every pixel of the tile (cleared per pixel).
+    let mut ratios = PixelRatios::default();
     for y in origin_px[1]..origin_px[1] + size_px[1] {
         for x in origin_px[0]..origin_px[0] + size_px[0] {
             let photo_f32 = photo.get_pixel(x, y).0;
@@ -363,7 +365,7 @@ fn render_tile(
             let mut natural_change = [0.0_f64; 3];
             let mut first_hit = None;
             let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
-            let mut ratios = PixelRatios::default();
+            ratios.clear();
             loop {
                 for s in 0..4 {
                     let (sx, sy) = (f64::from(s % 2), f64::from(s / 2));
@@ -433,6 +435,11 @@ struct PixelRatios {
 }
 
 impl PixelRatios {
+    fn clear(&mut self) {
+        self.changed.clear();
+        self.unchanged_px.clear();
+    }
+
     fn add(&mut self, sample: &RaySample, pixel: Point2<f64>) {
         if let Some(r) = sample.natural_ratio {
             self.changed.push((r, sample.radiance_rgb));

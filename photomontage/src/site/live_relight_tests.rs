@@ -5,19 +5,11 @@ use std::sync::atomic::AtomicBool;
 use nalgebra::Point3;
 
 use super::*;
-use crate::radiosity::{NamedLuminaire, PointSource, luminance};
+use crate::radiosity::{NamedLuminaire, PointSource, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL};
 use crate::site::render::site_scene;
 use crate::site::render::tests::fixture;
 use crate::site::render_radiosity::site_radiosity_light;
 use crate::site::{SiteMaterial, SkyModelName, SunManual};
-
-/// Relit against a fresh solve: the tolerance of the transfer's own tests
-/// (`radiosity/transfer_tests.rs`, `RESOLVE_L1_REL_TOL`, `RESOLVE_MEAN_REL_TOL`): the relight
-/// keeps the build's BF refinement, a fresh solve refines for the new lighting within the BF
-/// tolerance; the area-weighted L1 difference stays below 2 %, the mean within the stop rule's
-/// 1 %.
-const RESOLVE_L1_REL_TOL: f64 = 0.02;
-const RESOLVE_MEAN_REL_TOL: f64 = 0.01;
 
 fn lamp(intensity: f64, x_m: f64) -> NamedLuminaire {
     NamedLuminaire {
@@ -113,33 +105,16 @@ fn a_dimmed_luminaire_is_a_dimming_and_a_moved_one_a_build() {
     assert!(lighting_change(&built, &with(recoloured), &[], &[]).is_none());
 }
 
-fn areas(s: &Solution) -> Vec<f64> {
-    (0..s.mesh.elements.len())
-        .map(|e| s.mesh.element_node(e).area_m2)
-        .collect()
-}
-
 fn assert_matches_fresh_solve(label: &str, relit: &Solution, fresh: &Solution) {
-    let w = areas(fresh);
-    let (a, b) = (relit.total_radiosity_rgb(), fresh.total_radiosity_rgb());
-    assert_eq!(a.len(), b.len(), "{label}: same mesh");
-    let (mut diff, mut total, mut mean_a, mut mean_b) = (0.0, 0.0, 0.0, 0.0);
-    for ((x, y), w) in a.iter().zip(&b).zip(&w) {
-        let d: Rgb = std::array::from_fn(|c| (x[c] - y[c]).abs());
-        diff += luminance(&d) * w;
-        total += luminance(y) * w;
-        mean_a += luminance(x) * w;
-        mean_b += luminance(y) * w;
-    }
-    assert!(total > 0.0, "{label}: a lit scene");
+    // The transfer's documented relight tolerances (`radiosity::RELIGHT_*_REL_TOL`).
+    let d = relit
+        .relative_difference(fresh)
+        .unwrap_or_else(|| panic!("{label}: same mesh and a lit scene"));
+    assert!(d.l1_rel < RELIGHT_L1_REL_TOL, "{label}: L1 {}", d.l1_rel);
     assert!(
-        diff / total < RESOLVE_L1_REL_TOL,
-        "{label}: L1 {}",
-        diff / total
-    );
-    assert!(
-        (mean_a - mean_b).abs() / mean_b < RESOLVE_MEAN_REL_TOL,
-        "{label}: mean {mean_a} vs {mean_b}"
+        d.mean_rel.abs() < RELIGHT_MEAN_REL_TOL,
+        "{label}: mean {}",
+        d.mean_rel
     );
 }
 
