@@ -10,7 +10,7 @@
 //! `Transfer::relight` on both transfers side by side → the renderer's `RadiosityLight` (the
 //! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth; a
 //! material colour step changes the "render" material's colour. 2 threads; criterion medians,
-//! then medians of 8 alternating steps.
+//! then medians of 8 alternating steps (wall and CPU time, with the load average).
 //!
 //! `cargo bench -p photomontage --bench relight_latency` (release profile).
 #![allow(clippy::unwrap_used)]
@@ -19,6 +19,9 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+
+mod common;
+use common::{cpu_s, load_average};
 use photomontage::radiosity::city_block::{
     RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
 };
@@ -104,29 +107,40 @@ fn bench_relight_latency(c: &mut Criterion) {
         });
     });
     group.finish();
+    // Median wall and median CPU time (both threads) of 8 steps, milliseconds.
     let timed = |f: &mut dyn FnMut(usize)| {
-        let mut ms: Vec<f64> = (0..8)
+        let (mut wall, mut cpu): (Vec<f64>, Vec<f64>) = (0..8)
             .map(|i| {
-                let t = Instant::now();
+                let (c, t) = (cpu_s(), Instant::now());
                 f(i);
-                t.elapsed().as_secs_f64() * 1e3
+                let wall = t.elapsed().as_secs_f64() * 1e3;
+                (
+                    wall,
+                    cpu_s().zip(c).map_or(f64::NAN, |(a, b)| (a - b) * 1e3),
+                )
             })
-            .collect();
-        median(&mut ms)
+            .unzip();
+        (median(&mut wall), median(&mut cpu))
     };
     if k == 1 {
         step(&scenes[0], &sun_lighting(false));
     }
-    let sun_ms = timed(&mut |i| {
+    let load_before = load_average();
+    let (sun_ms, sun_cpu_ms) = timed(&mut |i| {
         step(&scenes[0], &sun_lighting(i % 2 == 0));
     });
     step(&scenes[0], &sun_lighting(false));
-    let colour_ms = timed(&mut |i| {
+    let (colour_ms, colour_cpu_ms) = timed(&mut |i| {
         step(&scenes[(i + 1) % 2], &sun_lighting(false));
     });
-    println!("\n== studio relight ({THREADS} threads, median of 8 steps) ==");
-    println!("sun slider step (1° azimuth): {sun_ms:.1} ms");
-    println!("material colour step: {colour_ms:.1} ms");
+    println!("\n== studio relight ({THREADS} threads, median of 8 steps, wall / CPU) ==");
+    println!("sun slider step (1° azimuth): {sun_ms:.1} ms / {sun_cpu_ms:.1} ms CPU");
+    println!("material colour step: {colour_ms:.1} ms / {colour_cpu_ms:.1} ms CPU");
+    println!(
+        "load average (1 min) before / after: {:?} / {:?}",
+        load_before,
+        load_average()
+    );
 }
 
 criterion_group!(benches, bench_relight_latency);

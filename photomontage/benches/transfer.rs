@@ -11,6 +11,9 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+
+mod common;
+use common::{cpu_s, load_average};
 use photomontage::radiosity::city_block::{
     self, RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
 };
@@ -95,27 +98,6 @@ fn indirect_difference(
 
 /// A relight's change, alternating between two states.
 type Change = fn(bool) -> LightingChange;
-
-/// CPU time of this process (all its threads, from each thread's `/proc/self/task/*/schedstat`,
-/// nanosecond resolution), seconds; `None` where there is no such file.
-fn cpu_s() -> Option<f64> {
-    let mut ns = 0u64;
-    for task in std::fs::read_dir("/proc/self/task").ok()? {
-        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
-        ns += stat.split_whitespace().next()?.parse::<u64>().ok()?;
-    }
-    Some(ns as f64 * 1e-9)
-}
-
-/// The 1-minute load average (`/proc/loadavg`), `None` where there is none.
-fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
 
 fn fmt_opt(v: Option<f64>, scale: f64, unit: &str) -> String {
     v.map_or_else(|| "n/a".to_owned(), |v| format!("{:.2} {unit}", v * scale))

@@ -19,6 +19,9 @@
 //! was refined for); every group is then solved on the same links, so group solutions add up
 //! exactly to the solution of the summed sources.
 //!
+//! When refinement is over, links whose factor is exactly 0 (all samples occluded) are dropped:
+//! they add nothing to any later gather.
+//!
 //! Links are kept grouped by receiver in a fixed order and each factor has its own random
 //! stream, so results are bit-identical on any number of threads.
 //!
@@ -225,7 +228,20 @@ impl Hierarchy {
                 break;
             }
         }
+        hierarchy.drop_occluded();
         Ok(hierarchy)
+    }
+
+    /// Drops, once refinement is over, the links whose factor is exactly 0 (every sample pair
+    /// occluded): they add nothing to any later gather, so every solve and relight gives the
+    /// same sums without reading them. On the city block of the relight benches they are 63 %
+    /// of the links (walls and ground hidden from each other by the buildings). Refinement
+    /// itself still sees them: its test uses the unoccluded estimate, so a shadowed link can
+    /// still be split. (Dropping *weak* links as well was tried and rejected: a budget on F
+    /// alone drops the links to small, bright sources — a lamp's emitting patch — and took 6 %
+    /// off the Cornell box's patch means.)
+    fn drop_occluded(&mut self) {
+        self.links.retain(|l| l.form_factor != 0.0);
     }
 
     fn sort(&mut self) {
@@ -473,4 +489,32 @@ fn push_pull(
 
 fn leaf_b(mesh: &Mesh, b: &[Rgb]) -> Vec<Rgb> {
     mesh.elements.iter().map(|&n| b[n as usize]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Dropping the occluded links keeps every other link, in order.
+    #[test]
+    fn only_links_of_factor_zero_are_dropped() {
+        let links: Vec<Link> = (0..40u32)
+            .map(|i| Link {
+                receiver: i / 8,
+                source: i,
+                form_factor: match i % 5 {
+                    0 => 0.0,
+                    1 => 1e-300,
+                    _ => f64::from(i) * 1e-3,
+                },
+            })
+            .collect();
+        let mut h = Hierarchy {
+            links: links.clone(),
+            refinement: Vec::new(),
+        };
+        h.drop_occluded();
+        let expected: Vec<Link> = links.into_iter().filter(|l| l.source % 5 != 0).collect();
+        assert_eq!(h.links, expected);
+    }
 }

@@ -41,6 +41,8 @@ pub mod convergence_plot;
 pub mod covered;
 pub mod direct;
 pub mod form_factor;
+#[cfg(target_arch = "x86_64")]
+mod gather_avx2;
 pub mod hierarchical;
 pub mod mesh;
 pub mod progressive;

@@ -17,10 +17,11 @@
 //! stops when its unshot power over its total power is below the residual (a bound on what one
 //! more round would add) and its mean brightness changed by less than the stop rule's mean
 //! change. Rounds are sequential. Within a round the links are read in parallel, split by a
-//! fixed set of receiver-node ranges ([`RECEIVER_RANGES`], balanced by links received, every
-//! source row cut at the range boundaries once at build): each range is one task writing only
-//! its own receivers, and a receiver's sum runs over the shot nodes in shooting order and each
-//! row in receiver order, exactly as one thread would, so the result is the same bit for bit on
+//! fixed set of receiver-node ranges ([`RECEIVER_RANGES`], balanced by links received): the links
+//! are stored range by range, and within a range source by source ([`SourceRows`]), so each range
+//! is one task that walks its own arrays forwards and writes only its own receivers. A receiver's
+//! sum runs over the shot nodes in node order and each run in receiver order, exactly as one
+//! thread would, so the result is the same bit for bit on
 //! any number of threads. A round's convergence row counts the links it read (`interactions`), the same in every
 //! group's row; its residual is the group's unshot power over its total.
 
@@ -36,44 +37,49 @@ use rayon::prelude::*;
 /// does not depend on the thread count.
 const RECEIVER_RANGES: usize = 16;
 
-/// The links as compressed rows per **source** node (receiver and factor), each row sorted by
-/// receiver and cut at the [`RECEIVER_RANGES`] receiver-range boundaries.
+/// The vector kernel's token where the CPU has one.
+#[cfg(target_arch = "x86_64")]
+type Simd = super::gather_avx2::Token;
+/// No vector kernel off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+type Simd = ();
+
+#[cfg(target_arch = "x86_64")]
+fn simd_token() -> Option<Simd> {
+    Simd::new()
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn simd_token() -> Option<Simd> {
+    None
+}
+
+/// Elements per parallel task of the per-element power sums.
+const POWER_CHUNK: usize = 4096;
+
+/// The links as compressed rows per **source** node (receiver and factor), stored per receiver
+/// range: range r holds, source by source, the links whose receiver lies in
+/// `bounds[r]..bounds[r + 1]`, each source's run sorted by receiver. A range's task so reads its
+/// own contiguous arrays in source order, with no cut of a long row to look up per source.
 #[derive(Debug, Clone)]
 pub(super) struct SourceRows {
-    /// Row of node n: `start[n]..start[n + 1]`.
+    nodes: usize,
+    /// Run of source n in range r: `start[r·(nodes+1) + n]..start[r·(nodes+1) + n + 1]`.
     start: Vec<u32>,
     receiver: Vec<u32>,
     form_factor: Vec<f32>,
     /// Receiver node ranges: range r is `bounds[r]..bounds[r + 1]` (balanced by links).
     bounds: Vec<u32>,
-    /// Row of node n, links into receiver range r: `cuts[n·(R+1) + r]..cuts[n·(R+1) + r + 1]`.
-    cuts: Vec<u32>,
 }
 
 impl SourceRows {
-    /// Transposes `links` (any order; rows are sorted by receiver, stably).
+    /// Transposes `links` (any order; each source's run is sorted by receiver, stably).
     #[allow(clippy::cast_possible_truncation)] // at most `max_links` links, node ids are u32
     pub(super) fn new(nodes: usize, links: &[Link]) -> Self {
-        let mut start = vec![0u32; nodes + 1];
         let mut into = vec![0u64; nodes];
         for l in links {
-            start[l.source as usize + 1] += 1;
             into[l.receiver as usize] += 1;
         }
-        for n in 0..nodes {
-            start[n + 1] += start[n];
-        }
-        let mut next: Vec<u32> = start[..nodes].to_vec();
-        let mut pairs = vec![(0u32, 0f32); links.len()];
-        for l in links {
-            let i = next[l.source as usize] as usize;
-            next[l.source as usize] += 1;
-            pairs[i] = (l.receiver, l.form_factor as f32);
-        }
-        for n in 0..nodes {
-            pairs[start[n] as usize..start[n + 1] as usize].sort_by_key(|&(r, _)| r);
-        }
-        let (receiver, form_factor) = pairs.into_iter().unzip();
         // Range boundaries at equal shares of the links received.
         let total: u64 = into.iter().sum();
         let mut bounds = vec![0u32; RECEIVER_RANGES + 1];
@@ -89,37 +95,60 @@ impl SourceRows {
         for b in &mut bounds[r..] {
             *b = nodes as u32;
         }
-        let mut rows = Self {
+        let range_of = |receiver: u32| bounds[1..].partition_point(|&b| b <= receiver);
+        let width = nodes + 1;
+        let mut start = vec![0u32; RECEIVER_RANGES * width];
+        for l in links {
+            start[range_of(l.receiver) * width + l.source as usize + 1] += 1;
+        }
+        // One prefix sum over range-major (range, source) runs.
+        let mut acc = 0u32;
+        for r in 0..RECEIVER_RANGES {
+            let row = &mut start[r * width..(r + 1) * width];
+            row[0] = acc;
+            for n in 0..nodes {
+                acc += row[n + 1];
+                row[n + 1] = acc;
+            }
+        }
+        let mut next: Vec<u32> = (0..RECEIVER_RANGES * width).map(|i| start[i]).collect();
+        let mut pairs = vec![(0u32, 0f32); links.len()];
+        for l in links {
+            let at = range_of(l.receiver) * width + l.source as usize;
+            let i = next[at] as usize;
+            next[at] += 1;
+            pairs[i] = (l.receiver, l.form_factor as f32);
+        }
+        for r in 0..RECEIVER_RANGES {
+            for n in 0..nodes {
+                let (a, z) = (
+                    start[r * width + n] as usize,
+                    start[r * width + n + 1] as usize,
+                );
+                pairs[a..z].sort_by_key(|&(rcv, _)| rcv);
+            }
+        }
+        let (receiver, form_factor) = pairs.into_iter().unzip();
+        Self {
+            nodes,
             start,
             receiver,
             form_factor,
             bounds,
-            cuts: Vec::new(),
-        };
-        rows.cuts = (0..nodes)
-            .flat_map(|n| {
-                let (a, z) = (rows.start[n] as usize, rows.start[n + 1] as usize);
-                let row = &rows.receiver[a..z];
-                rows.bounds
-                    .iter()
-                    .map(move |&b| (a + row.partition_point(|&r| r < b)) as u32)
-            })
-            .collect();
-        rows
+        }
     }
 
     /// The links of node `n`'s row into receiver range `r`.
     fn cut(&self, n: usize, r: usize) -> std::ops::Range<usize> {
-        let i = n * (RECEIVER_RANGES + 1) + r;
-        self.cuts[i] as usize..self.cuts[i + 1] as usize
+        let i = r * (self.nodes + 1) + n;
+        self.start[i] as usize..self.start[i + 1] as usize
     }
-}
 
-#[cfg(test)]
-impl SourceRows {
     /// Links whose source is node `n`.
     pub(super) fn row_len(&self, n: usize) -> u64 {
-        u64::from(self.start[n + 1] - self.start[n])
+        (0..RECEIVER_RANGES)
+            .map(|r| self.cut(n, r).len() as u64)
+            .sum()
     }
 }
 
@@ -143,9 +172,10 @@ pub(super) fn shoot(
 ) -> Vec<(Vec<Rgb>, Vec<ConvergenceRow>)> {
     let k = groups.len();
     let stride = 3 * k;
+    let simd = simd_token();
     let n_el = mesh.elements.len();
     let n_nodes = mesh.nodes.len();
-    let node_element = |n: usize| mesh.nodes[n].element;
+    let node_element = |n: usize| topology.element[n];
     let areas = &topology.areas;
     let area_sum: f64 = areas.iter().sum();
     // Leaves: B and the unshot part, `stride` values per element (group-major within).
@@ -163,35 +193,47 @@ pub(super) fn shoot(
             }
         }
     }
-    let power = |v: &[f64], e: usize, g: usize| -> f64 {
-        let i = e * stride + 3 * g;
-        luminance(&[v[i].abs(), v[i + 1].abs(), v[i + 2].abs()]) * areas[e]
+    // Luminance power A·|v|_Y of every element and group (`k` per element), in parallel; each
+    // value is computed on its own, so the result does not depend on the thread count.
+    let powers = |v: &[f64]| -> Vec<f64> {
+        let mut out = vec![0.0; n_el * k];
+        out.par_chunks_mut(k * POWER_CHUNK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                for (i, o) in out.iter_mut().enumerate() {
+                    let (e, g) = (chunk * POWER_CHUNK + i / k, i % k);
+                    let j = e * stride + 3 * g;
+                    *o = luminance(&[v[j].abs(), v[j + 1].abs(), v[j + 2].abs()]) * areas[e];
+                }
+            });
+        out
     };
-    let totals = |b: &[f64]| -> Vec<f64> {
+    let totals = |pw: &[f64]| -> Vec<f64> {
         (0..k)
-            .map(|g| (0..n_el).map(|e| power(b, e, g)).sum())
+            .map(|g| (0..n_el).map(|e| pw[e * k + g]).sum())
             .collect()
     };
     let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
-    let mut previous_mean: Vec<f64> = totals(&b).iter().map(|t| t / area_sum).collect();
+    let mut total = totals(&powers(&b));
+    let mut previous_mean: Vec<f64> = total.iter().map(|t| t / area_sum).collect();
+    let mut unshot_power = powers(&u);
     let mut un = vec![0.0; n_nodes * stride];
     let mut acc = vec![0.0; n_nodes * stride];
     let patches = &topology.patch_ranges;
     for pass in 1..=stop.max_passes {
-        let total = totals(&b);
         // Unshot power per patch, relative to each group's total.
         let scale: Vec<f64> = total
             .iter()
             .map(|&t| if t > 0.0 { 1.0 / t } else { 0.0 })
             .collect();
         let score: Vec<f64> = patches
-            .iter()
+            .par_iter()
             .map(|&(lo, hi)| {
                 (lo..hi)
                     .filter_map(node_element)
                     .map(|e| {
                         (0..k)
-                            .map(|g| power(&u, e as usize, g) * scale[g])
+                            .map(|g| unshot_power[e as usize * k + g] * scale[g])
                             .sum::<f64>()
                     })
                     .sum()
@@ -222,7 +264,7 @@ pub(super) fn shoot(
                     u[e * stride..(e + 1) * stride].fill(0.0);
                 } else {
                     own.fill(0.0);
-                    for kid in mesh.nodes[n].children.into_iter().flatten() {
+                    for kid in topology.children[n].into_iter().flatten() {
                         let kid = kid as usize;
                         let w = topology.weight[kid];
                         let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
@@ -236,12 +278,11 @@ pub(super) fn shoot(
                 (lo..hi).filter(|&n| un[n * stride..(n + 1) * stride].iter().any(|&v| v != 0.0)),
             );
         }
-        let interactions: u64 = active
-            .iter()
-            .map(|&n| u64::from(rows.start[n + 1] - rows.start[n]))
-            .sum();
+        // Gathered in node order, so that each range task walks its arrays forwards.
+        active.sort_unstable();
+        let interactions: u64 = active.iter().map(|&n| rows.row_len(n)).sum();
         // Each receiver range gathers on its own task; a receiver's sum runs over the shot
-        // nodes in shooting order and each row in receiver order, as one thread would.
+        // nodes in node order and each run in receiver order, as one thread would.
         let mut ranges: Vec<(usize, &mut [f64])> = Vec::with_capacity(RECEIVER_RANGES);
         let mut rest: &mut [f64] = &mut acc;
         for r in 0..RECEIVER_RANGES {
@@ -250,11 +291,12 @@ pub(super) fn shoot(
             ranges.push((r, chunk));
             rest = tail;
         }
+        let t = simd;
         ranges.into_par_iter().for_each(|(r, chunk)| match stride {
-            3 => gather_range::<3>(rows, r, &active, &un, chunk),
-            6 => gather_range::<6>(rows, r, &active, &un, chunk),
-            9 => gather_range::<9>(rows, r, &active, &un, chunk),
-            12 => gather_range::<12>(rows, r, &active, &un, chunk),
+            3 => gather_range::<3>(rows, r, &active, &un, chunk, t),
+            6 => gather_range::<6>(rows, r, &active, &un, chunk, t),
+            9 => gather_range::<9>(rows, r, &active, &un, chunk, t),
+            12 => gather_range::<12>(rows, r, &active, &un, chunk, t),
             _ => gather_range_dyn(rows, r, &active, &un, chunk, stride),
         });
         // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot.
@@ -281,10 +323,11 @@ pub(super) fn shoot(
             }
         }
         acc.fill(0.0);
-        let total = totals(&b);
+        total = totals(&powers(&b));
+        unshot_power = powers(&u);
         let mut all_met = true;
         for g in 0..k {
-            let unshot_g: f64 = (0..n_el).map(|e| power(&u, e, g)).sum();
+            let unshot_g: f64 = (0..n_el).map(|e| unshot_power[e * k + g]).sum();
             let mean = total[g] / area_sum;
             let row = ConvergenceRow {
                 group: groups[g].name.to_owned(),
@@ -320,13 +363,15 @@ pub(super) fn shoot(
 
 /// Receiver range `r` gathers the unshot values `un` (`S` per node) of the `active` nodes
 /// through their links into `acc` (the range's nodes, `S` per node): a receiver's sum runs over
-/// `active` in order and each row in receiver order.
+/// `active` in order and each row in receiver order. With an AVX2 `token` the same sums run in
+/// the vector kernel (bit for bit the same).
 fn gather_range<const S: usize>(
     rows: &SourceRows,
     r: usize,
     active: &[usize],
     un: &[f64],
     acc: &mut [f64],
+    token: Option<Simd>,
 ) {
     let base = rows.bounds[r] as usize;
     for &n in active {
@@ -334,10 +379,15 @@ fn gather_range<const S: usize>(
             .try_into()
             .unwrap_or_else(|_| unreachable!("S values per node"));
         let links = rows.cut(n, r);
-        for (rcv, f) in rows.receiver[links.clone()]
-            .iter()
-            .zip(&rows.form_factor[links])
-        {
+        let (receivers, factors) = (&rows.receiver[links.clone()], &rows.form_factor[links]);
+        #[cfg(target_arch = "x86_64")]
+        if let Some(token) = token {
+            token.gather_run::<S>(src, receivers, factors, base, acc);
+            continue;
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = token;
+        for (rcv, f) in receivers.iter().zip(factors) {
             let f = f64::from(*f);
             let at = (*rcv as usize - base) * S;
             let dst: &mut [f64; S] = (&mut acc[at..at + S])
@@ -380,8 +430,9 @@ fn gather_range_dyn(
 mod tests {
     use super::*;
 
-    /// Every link lands in exactly one receiver range, the one holding its receiver, rows keep
-    /// each source's links (sorted by receiver), and the ranges tile the nodes.
+    /// Every link lands in exactly one receiver range, the one holding its receiver; each
+    /// source's links in a range are sorted by receiver; a source's runs over all ranges are its
+    /// links; the ranges tile the nodes and the runs tile the arrays in (range, source) order.
     #[test]
     fn receiver_ranges_partition_every_row() {
         let nodes = 997;
@@ -404,38 +455,82 @@ mod tests {
         assert_eq!(rows.bounds[0], 0);
         assert_eq!(rows.bounds[RECEIVER_RANGES] as usize, nodes as usize);
         assert!(rows.bounds.windows(2).all(|w| w[0] <= w[1]));
-        let mut seen = 0;
+        let mut at = 0;
+        for r in 0..RECEIVER_RANGES {
+            for n in 0..nodes as usize {
+                let cut = rows.cut(n, r);
+                assert_eq!(
+                    cut.start, at,
+                    "runs tile the arrays in (range, source) order"
+                );
+                at = cut.end;
+            }
+        }
+        assert_eq!(at, links.len());
         for n in 0..nodes as usize {
-            let row = rows.start[n] as usize..rows.start[n + 1] as usize;
-            assert!(rows.receiver[row.clone()].windows(2).all(|w| w[0] <= w[1]));
             let mut expected: Vec<u32> = links
                 .iter()
                 .filter(|l| l.source as usize == n)
                 .map(|l| l.receiver)
                 .collect();
             expected.sort_unstable();
-            assert_eq!(rows.receiver[row.clone()], expected[..]);
-            let mut at = row.start;
+            let mut got = Vec::new();
             for r in 0..RECEIVER_RANGES {
-                let cut = rows.cut(n, r);
-                assert_eq!(cut.start, at, "ranges of row {n} are contiguous");
+                let run = &rows.receiver[rows.cut(n, r)];
+                assert!(run.windows(2).all(|w| w[0] <= w[1]));
                 let (lo, hi) = (rows.bounds[r], rows.bounds[r + 1]);
-                assert!(
-                    rows.receiver[cut.clone()]
-                        .iter()
-                        .all(|&x| lo <= x && x < hi)
-                );
-                seen += cut.len();
-                at = cut.end;
+                assert!(run.iter().all(|&x| lo <= x && x < hi));
+                got.extend_from_slice(run);
             }
-            assert_eq!(at, row.end);
+            assert_eq!(got, expected, "row of node {n}");
+            assert_eq!(rows.row_len(n), expected.len() as u64);
         }
-        assert_eq!(seen, links.len());
         // Balanced: no range holds more than twice its share of the links.
         let share = links.len() / RECEIVER_RANGES;
         for r in 0..RECEIVER_RANGES {
             let k: usize = (0..nodes as usize).map(|n| rows.cut(n, r).len()).sum();
             assert!(k <= 2 * share, "range {r} holds {k} links, share {share}");
         }
+    }
+
+    /// The AVX2 kernel gives the portable loop's sums bit for bit, for every stride the
+    /// shooting uses.
+    #[test]
+    fn vector_gather_equals_the_portable_loop() {
+        fn check<const S: usize>(rows: &SourceRows, nodes: usize, token: Simd) {
+            #[allow(clippy::cast_precision_loss)]
+            let un: Vec<f64> = (0..nodes * S)
+                .map(|i| ((i * 7919 % 1000) as f64 - 500.0) * 1.37e-3)
+                .collect();
+            let active: Vec<usize> = (0..nodes).filter(|n| n % 3 != 1).collect();
+            for r in 0..RECEIVER_RANGES {
+                let width = (rows.bounds[r + 1] - rows.bounds[r]) as usize * S;
+                let (mut a, mut b) = (vec![0.25; width], vec![0.25; width]);
+                gather_range::<S>(rows, r, &active, &un, &mut a, None);
+                gather_range::<S>(rows, r, &active, &un, &mut b, Some(token));
+                assert!(
+                    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "S = {S}, range {r}"
+                );
+            }
+        }
+        let Some(token) = simd_token() else {
+            eprintln!("notice: this CPU has no vector kernel; nothing to compare");
+            return;
+        };
+        let nodes = 301;
+        #[allow(clippy::cast_possible_truncation)]
+        let links: Vec<Link> = (0..6000u64)
+            .map(|i| Link {
+                receiver: (i * 2_654_435_761 % nodes) as u32,
+                source: (i * 40_503 % nodes) as u32,
+                form_factor: 1e-4 * (1 + i % 97) as f64,
+            })
+            .collect();
+        let rows = SourceRows::new(nodes as usize, &links);
+        check::<3>(&rows, nodes as usize, token);
+        check::<6>(&rows, nodes as usize, token);
+        check::<9>(&rows, nodes as usize, token);
+        check::<12>(&rows, nodes as usize, token);
     }
 }

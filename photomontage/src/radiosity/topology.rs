@@ -15,6 +15,13 @@ pub(super) struct Topology {
     pub(super) patch_ranges: Vec<(usize, usize)>,
     /// Element areas, m².
     pub(super) areas: Vec<f64>,
+    /// Per node, its element (leaves) — the mesh's `element` and `children`, kept compact so
+    /// that sweeps over all nodes read 4 and 16 bytes per node, not a whole mesh node.
+    pub(super) element: Vec<Option<u32>>,
+    /// Per node, its children.
+    pub(super) children: Vec<Option<[u32; 4]>>,
+    /// Per element, its mesh surface.
+    pub(super) element_surface: Vec<u32>,
 }
 
 impl Topology {
@@ -52,6 +59,11 @@ impl Topology {
             weight,
             patch_ranges,
             areas,
+            element: mesh.nodes.iter().map(|node| node.element).collect(),
+            children: mesh.nodes.iter().map(|node| node.children).collect(),
+            element_surface: (0..mesh.elements.len())
+                .map(|e| mesh.element_node(e).surface)
+                .collect(),
         }
     }
 }

@@ -649,6 +649,16 @@ impl Transfer {
     /// [`RadiosityError::InvalidSource`] for a bad or unknown light,
     /// [`RadiosityError::UnknownMaterial`] for a material the scene does not have.
     pub fn relight(&mut self, change: &LightingChange) -> Result<Solution, RadiosityError> {
+        self.relight_in_place(change)?;
+        Ok(self.solution.clone())
+    }
+
+    /// [`Self::relight`] without the copy of the solution it returns (read it with
+    /// [`Self::solution`]): the studio's live preview, which reads the transfer's own.
+    ///
+    /// # Errors
+    /// As [`Self::relight`]; on error nothing changes.
+    pub fn relight_in_place(&mut self, change: &LightingChange) -> Result<(), RadiosityError> {
         let (lighting, reflectance) = self.apply_to_lighting(change)?;
         let (new_groups, warnings) =
             lighting.light_groups(&self.dome, self.params.sky_tolerance)?;
@@ -802,7 +812,7 @@ impl Transfer {
         self.lighting = lighting;
         self.solution.warnings = solution_warnings;
         self.solution.locator = std::sync::OnceLock::new();
-        Ok(self.solution.clone())
+        Ok(())
     }
 
     /// Links whose source node lies on scene object `object` (tests of the shooting relight).
@@ -816,9 +826,11 @@ impl Transfer {
     }
 
     fn element_reflectance(&self) -> Vec<Rgb> {
-        let mesh = &self.solution.mesh;
-        (0..mesh.elements.len())
-            .map(|e| mesh.surfaces[mesh.element_node(e).surface as usize].reflectance_rgb)
+        let surfaces = &self.solution.mesh.surfaces;
+        self.topology
+            .element_surface
+            .iter()
+            .map(|&s| surfaces[s as usize].reflectance_rgb)
             .collect()
     }
 }
@@ -859,7 +871,7 @@ fn iterate(
                     for (n, a) in acc.iter_mut().enumerate().take(hi).skip(lo) {
                         *a = rows.gather(n, &b);
                     }
-                    update += push_pull(mesh, topology, rho, b0, &mut acc, &mut b, lo, hi);
+                    update += push_pull(topology, rho, b0, &mut acc, &mut b, lo, hi);
                 }
                 update
             }
@@ -873,7 +885,7 @@ fn iterate(
                     });
                 let mut update = 0.0;
                 for &(lo, hi) in &topology.patch_ranges {
-                    update += push_pull(mesh, topology, rho, b0, &mut acc, &mut b, lo, hi);
+                    update += push_pull(topology, rho, b0, &mut acc, &mut b, lo, hi);
                 }
                 update
             }
@@ -902,9 +914,7 @@ fn iterate(
 /// Push (gathered values down to the leaves, B = B₀ + ρ·G) and pull (area-weighted means up)
 /// over the subtree in nodes `lo..hi` (pre-order); `acc` holds each node's own gather on entry.
 /// Returns Σ A·|ΔB|_Y over its leaves.
-#[allow(clippy::too_many_arguments)]
 fn push_pull(
-    mesh: &Mesh,
     topology: &Topology,
     rho: &[Rgb],
     b0: &[Rgb],
@@ -921,7 +931,7 @@ fn push_pull(
                 acc[n][c] += down[c];
             }
         }
-        if let Some(e) = mesh.nodes[n].element {
+        if let Some(e) = topology.element[n] {
             let e = e as usize;
             let v: Rgb = std::array::from_fn(|c| b0[e][c] + rho[e][c] * acc[n][c]);
             let diff: Rgb = std::array::from_fn(|c| (v[c] - b[n][c]).abs());
@@ -930,14 +940,14 @@ fn push_pull(
         }
     }
     for n in (lo..hi).rev() {
-        pull_node(mesh, topology, n, b);
+        pull_node(topology, n, b);
     }
     update
 }
 
 /// An inner node takes the area-weighted mean of its children.
-fn pull_node(mesh: &Mesh, topology: &Topology, n: usize, b: &mut [Rgb]) {
-    if let Some(kids) = mesh.nodes[n].children {
+fn pull_node(topology: &Topology, n: usize, b: &mut [Rgb]) {
+    if let Some(kids) = topology.children[n] {
         let mut sum = [0.0; 3];
         for k in kids {
             let w = topology.weight[k as usize];
@@ -952,6 +962,6 @@ fn pull_node(mesh: &Mesh, topology: &Topology, n: usize, b: &mut [Rgb]) {
 /// Inner nodes take the area-weighted mean of their children (leaves already set).
 fn pull_all(mesh: &Mesh, topology: &Topology, b: &mut [Rgb]) {
     for n in (0..mesh.nodes.len()).rev() {
-        pull_node(mesh, topology, n, b);
+        pull_node(topology, n, b);
     }
 }

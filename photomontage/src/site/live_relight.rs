@@ -460,7 +460,7 @@ impl SiteTransfers {
         let (with, without) = (&mut self.with_artificial, &mut self.without_artificial);
         let relight = |kept: &mut Kept, change: &LightingChange| -> Result<(), RadiosityError> {
             if !is_empty(change) {
-                kept.transfer.relight(change)?;
+                kept.transfer.relight_in_place(change)?;
             }
             Ok(())
         };
