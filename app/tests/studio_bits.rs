@@ -446,3 +446,65 @@ fn the_perez_irradiance_form_is_typed_in_the_studio() {
     assert_eq!(site_of(&h), s);
     assert_eq!(value(&h, "perez direct normal"), "600");
 }
+
+#[test]
+fn the_irradiance_elevation_takes_the_clis_solve_options() {
+    let (dir, site) = copy_sample();
+    common::add_box_model(&site);
+    let mut h = harness(&site, TALL);
+    click(&mut h, "Materials tab");
+    click(&mut h, "Unfolded elevation");
+    click(&mut h, "elevation irradiance");
+    // Non-default options: 2 m elements (the CLI's `--element-edge-m 2`) and seed 3.
+    h.get_by_label("elevation element edge (m)")
+        .set_value_accesskit(2.0);
+    h.run();
+    h.get_by_label("elevation seed").set_value_accesskit(3.0);
+    h.run();
+    click(&mut h, "Draw elevation");
+    let start = std::time::Instant::now();
+    while !has(&h, "elevation ready") {
+        assert!(!has(&h, "elevation failed"), "the elevation failed");
+        assert!(
+            start.elapsed().as_secs() < 300,
+            "the elevation did not finish"
+        );
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    h.run();
+    let out = dir.path().join("box-irradiance.png");
+    set_text(&mut h, "elevation PNG path", out.to_str().unwrap());
+    click(&mut h, "Export elevation PNG");
+    let written = std::fs::read(&out).unwrap();
+    // What `photomontage elevation SITE --model box --irradiance --element-edge-m 2 --seed 3
+    // --out FILE.png` writes: the same options through the library's one mapping.
+    let doc = SiteDocument::load(&site).unwrap();
+    let options = photomontage::site::solve_options::SolveOptions {
+        element_edge_m: 2.0,
+        seed: 3,
+        ..Default::default()
+    };
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let draw = |options: &photomontage::site::solve_options::SolveOptions| {
+        photomontage::site::elevation::site_elevation(
+            &doc,
+            "box",
+            &photomontage::design::unfolded::UnfoldParams::default(),
+            Some(photomontage::site::elevation::ElevationLighting {
+                params: options.elevation_transfer_params(),
+                view: "P1".into(),
+                cancel: &cancel,
+            }),
+        )
+        .unwrap()
+        .png_bytes()
+        .unwrap()
+    };
+    assert_eq!(written, draw(&options), "the CLI's PNG, byte for byte");
+    // The options matter: the defaults give another picture.
+    assert_ne!(
+        written,
+        draw(&photomontage::site::solve_options::SolveOptions::default())
+    );
+}
