@@ -425,7 +425,10 @@ fn compare_settings_survive_a_killed_studio() {
     let names = |h: &Harness<'static, Studio>| {
         let r = h.state().variants_panel().renders().unwrap();
         let c = &h.state().variants_panel().compare;
-        (r.shown[c.a].name().to_owned(), r.shown[c.b].name().to_owned())
+        (
+            r.shown[c.a].name().to_owned(),
+            r.shown[c.b].name().to_owned(),
+        )
     };
     assert_eq!(names(&h), ("No box".to_owned(), "With box".to_owned()));
     click(&mut h, "Pause flicker");
