@@ -228,7 +228,7 @@ fn live_preview_frames() {
         let now = h.state().render_panel().live.last_relight().cloned();
         if now != last {
             if let Some(r) = &now {
-                relights.push(r.seconds);
+                relights.push((r.update, r.seconds));
             }
             last = now;
         }
@@ -247,9 +247,14 @@ fn live_preview_frames() {
         println!("no relight finished during the timed frames");
     } else {
         let n = relights.len();
+        let kinds: Vec<String> = relights.iter().map(|(k, _)| format!("{k:?}")).collect();
+        println!("transfer updates seen: {}", kinds.join(" "));
         stats(
-            &format!("live: relight ({n} seen)"),
-            relights.into_iter().map(Duration::from_secs_f64).collect(),
+            &format!("live: update ({n} seen)"),
+            relights
+                .into_iter()
+                .map(|(_, s)| Duration::from_secs_f64(s))
+                .collect(),
         );
     }
     println!(
