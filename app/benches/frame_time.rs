@@ -7,8 +7,16 @@
 //! `Harness::step`) and the GPU render with read-back (`Harness::render`), and prints the
 //! median, 95th percentile and worst of each and of their sum.
 //!
-//! `cargo bench -p photomontage-studio --bench frame_time` (release profile). On a machine
-//! without a GPU wgpu runs on lavapipe (CPU), which makes the render column pessimistic.
+//! Then, with the Live preview in the radiosity mode (issue 17's "relight latency reported
+//! with the frame time"): a temp copy of the courtyard sample with the box model and
+//! `[render] radiosity = true`, solved, Live on, a manual sun stepped 1° in azimuth every
+//! [`LIVE_STEP_EVERY`] frames (each step one undoable edit, as a slider drag gives), so that the
+//! studio relights its transfers and re-renders on its worker while the frames are timed. It
+//! prints the same statistics for those frames and the relight times the studio reported.
+//!
+//! `cargo bench -p photomontage-studio --bench frame_time` (release profile; `live` as the only
+//! argument runs the live part alone). On a machine without a GPU wgpu runs on lavapipe (CPU),
+//! which makes the render column pessimistic.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -19,8 +27,29 @@ use std::time::{Duration, Instant};
 
 mod common;
 use common::{FRAMES, HEIGHT_PX, WIDTH_PX, WINDOW, photo_site, stats};
+/// The kittest helpers: the courtyard sample's temp copy, the box model, waiting for workers.
+#[path = "../tests/common/mod.rs"]
+mod test_common;
+
+use photomontage_studio::commands::Command;
+use photomontage_studio::light_commands::LightCommand;
+
+/// Frames timed with the live preview.
+const LIVE_FRAMES: usize = 200;
+/// A sun step every this many frames (at 16 ms frames, about 6 steps per second: a slow drag).
+const LIVE_STEP_EVERY: usize = 10;
 
 fn main() {
+    println!(
+        "load average (1, 5, 15 min): {}",
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .trim()
+    );
+    if std::env::args().skip(1).any(|a| a == "live") {
+        live_preview_frames();
+        return;
+    }
     let dir = tempfile::tempdir().expect("tempdir");
     let t = Instant::now();
     let site_path = photo_site(dir.path(), "frame-time bench");
@@ -107,6 +136,133 @@ fn main() {
         base_t.push(a.elapsed());
     }
     stats("baseline render + read-back", base_t);
+    live_preview_frames();
+}
+
+/// Whether the live preview shows the current site, finished.
+fn caught_up(s: &Studio) -> bool {
+    let p = s.render_panel();
+    !p.busy() && p.live.shows(&s.document().expect("open").site) && p.montage().is_some()
+}
+
+/// Steps `h` until `done` holds (at most 600 s), without waiting for it to settle.
+fn wait(h: &mut Harness<'static, Studio>, what: &str, done: impl Fn(&Studio) -> bool) {
+    let start = Instant::now();
+    while !done(h.state()) {
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+        assert!(start.elapsed().as_secs() < 600, "{what} did not finish");
+    }
+}
+
+/// Sets the manual sun of the open site.
+fn set_sun(h: &mut Harness<'static, Studio>, azimuth_deg: f64, elevation_deg: f64) {
+    let mut lighting = h.state().document().expect("open").site.lighting.clone();
+    lighting.sun_manual = Some(photomontage::site::SunManual {
+        azimuth_deg,
+        elevation_deg,
+    });
+    h.state_mut().apply(
+        Command::Light(LightCommand::SetLighting(Box::new(lighting))),
+        Some("bench sun".into()),
+    );
+}
+
+/// The studio's frames while the Live preview relights its radiosity transfers.
+fn live_preview_frames() {
+    use egui_kittest::kittest::Queryable;
+    let (_dir, site) = test_common::copy_sample();
+    test_common::add_box_model(&site);
+    let mut text = std::fs::read_to_string(&site).expect("site");
+    text.push_str("\n[render]\nradiosity = true\n");
+    std::fs::write(&site, text).expect("site");
+    let studio = Studio::new(StudioOptions {
+        site_path: site,
+        state_path: None,
+    });
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(WINDOW[0], WINDOW[1]))
+        .with_max_steps(400)
+        .wgpu()
+        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio);
+    wait(&mut h, "opening", Studio::is_idle);
+    h.get_by_label("Solve").click();
+    wait(&mut h, "solve", |s| s.solution().is_some() && s.is_idle());
+    h.get_by_label("Render").click();
+    h.step();
+    {
+        let q = &mut h.state_mut().render_panel_mut().quality;
+        (q.spp_min, q.spp_max, q.seed) = (4, 8, 7);
+    }
+    h.get_by_label("Live preview").click();
+    h.step();
+    let t = Instant::now();
+    wait(&mut h, "first live render (transfers built)", caught_up);
+    println!(
+        "live preview, radiosity mode: transfers built and first montage in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+    let sun =
+        photomontage::site::sun_path::site_sun_angles(h.state().document().expect("open"), "P1")
+            .expect("the sample's sun");
+    let (mut azimuth_deg, elevation_deg) = (sun.azimuth_deg, sun.elevation_deg);
+    set_sun(&mut h, azimuth_deg, elevation_deg);
+    wait(&mut h, "live render of the manual sun", caught_up);
+
+    let (mut step_t, mut render_t, mut total_t) = (Vec::new(), Vec::new(), Vec::new());
+    let mut relights = Vec::new();
+    let mut last = h.state().render_panel().live.last_relight().cloned();
+    for i in 0..LIVE_FRAMES {
+        if i % LIVE_STEP_EVERY == 0 {
+            azimuth_deg += 1.0;
+            set_sun(&mut h, azimuth_deg, elevation_deg);
+        }
+        let a = Instant::now();
+        h.step();
+        let b = Instant::now();
+        h.render().expect("render");
+        let c = Instant::now();
+        step_t.push(b - a);
+        render_t.push(c - b);
+        total_t.push(c - a);
+        let now = h.state().render_panel().live.last_relight().cloned();
+        if now != last {
+            if let Some(r) = &now {
+                relights.push((r.update, r.seconds));
+            }
+            last = now;
+        }
+    }
+    println!(
+        "{LIVE_FRAMES} frames with Live on (radiosity mode), a 1° sun step every \
+         {LIVE_STEP_EVERY} frames ({} steps), window {}×{} points",
+        LIVE_FRAMES / LIVE_STEP_EVERY,
+        WINDOW[0],
+        WINDOW[1]
+    );
+    stats("live: studio pass (step)", step_t);
+    stats("live: render + read-back", render_t);
+    stats("live: frame (sum)", total_t);
+    if relights.is_empty() {
+        println!("no relight finished during the timed frames");
+    } else {
+        let n = relights.len();
+        let kinds: Vec<String> = relights.iter().map(|(k, _)| format!("{k:?}")).collect();
+        println!("transfer updates seen: {}", kinds.join(" "));
+        stats(
+            &format!("live: update ({n} seen)"),
+            relights
+                .into_iter()
+                .map(|(_, s)| Duration::from_secs_f64(s))
+                .collect(),
+        );
+    }
+    println!(
+        "load average (1, 5, 15 min): {}",
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .trim()
+    );
 }
 
 const BASELINE_FRAMES: usize = 30;

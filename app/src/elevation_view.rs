@@ -4,18 +4,22 @@
 //! function `photomontage elevation` calls) on the studio's worker, shown as an image and
 //! exported as the same PNG bytes the CLI writes (`SiteElevation::png_bytes`).
 //!
+//! The irradiance view has the CLI's solve options (`--view`, `--patch-edge-m`,
+//! `--element-edge-m`, `--object-element-edge`, `--samples`, `--seed`, `--bf-tolerance`,
+//! `--sky-tolerance`, `--mean-change`, `--residual`), held as the library's
+//! `photomontage::site::solve_options::SolveOptions` (its defaults are the CLI's) and turned into
+//! the solve by the same `SolveOptions::elevation_transfer_params`, so the studio's PNG is the
+//! CLI's for the same options.
+//!
 //! # Known limitations
-//! The irradiance view solves with the library's default transfer parameters
-//! (`TransferParams::default()`, the sun of the first photo), not with the CLI's solve options
-//! (`--patch-edge-m`, `--element-edge-m`, …), so its pixels equal the CLI's only where those
-//! options give the same parameters; the colour view's pixels are the CLI's. The picture is not
-//! redrawn by itself when the site changes: press Draw again.
+//! The CLI's `--threads` is not offered (the worker uses the studio's thread pool). The picture
+//! is not redrawn by itself when the site changes: press Draw again.
 
 use eframe::egui;
 use photomontage::design::unfolded::UnfoldParams;
-use photomontage::radiosity::TransferParams;
 use photomontage::site::SiteDocument;
 use photomontage::site::elevation::{ElevationLighting, SiteElevation, site_elevation};
+use photomontage::site::solve_options::SolveOptions;
 
 use crate::widgets::name_widget;
 use crate::worker::{Poll, Worker};
@@ -24,6 +28,12 @@ use crate::worker::{Poll, Worker};
 pub struct ElevationView {
     model: String,
     irradiance: bool,
+    /// The irradiance view's solve options (the CLI's, with its defaults).
+    options: SolveOptions,
+    /// The photo whose sun time lights the irradiance view (empty: the first photo).
+    view: String,
+    /// `--object-element-edge` as typed: `NAME=METRES`, comma-separated.
+    object_edges: String,
     export_path: String,
     worker: Worker<Result<SiteElevation, String>>,
     drawn: Option<(SiteElevation, egui::TextureHandle)>,
@@ -35,6 +45,9 @@ impl Default for ElevationView {
         Self {
             model: String::new(),
             irradiance: false,
+            options: SolveOptions::default(),
+            view: String::new(),
+            object_edges: String::new(),
             export_path: String::new(),
             worker: Worker::new("elevation"),
             drawn: None,
@@ -53,28 +66,64 @@ impl std::fmt::Debug for ElevationView {
     }
 }
 
-/// Draws the elevation of `model` of `doc` (colours, or irradiance when `irradiance`), as the
-/// CLI does with its default pixels per metre.
+/// The irradiance view's light: the solve options and the photo whose sun time places the sun
+/// (empty: the first photo, as the CLI's `--view`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IrradianceRequest {
+    /// Solve options.
+    pub options: SolveOptions,
+    /// Photo id, or empty.
+    pub view: String,
+}
+
+/// Draws the elevation of `model` of `doc` (colours, or the irradiance of a solve with the
+/// requested options), as `photomontage elevation` does with its default pixels per metre.
 ///
 /// # Errors
 /// The library's error as text.
 pub fn draw_elevation(
     doc: &SiteDocument,
     model: &str,
-    irradiance: bool,
+    irradiance: Option<&IrradianceRequest>,
     cancel: &std::sync::atomic::AtomicBool,
 ) -> Result<SiteElevation, String> {
-    let lighting = irradiance.then(|| ElevationLighting {
-        params: TransferParams::default(),
-        view: doc
-            .site
-            .photos
-            .first()
-            .map(|p| p.id.clone())
-            .unwrap_or_default(),
+    let lighting = irradiance.map(|r| ElevationLighting {
+        params: r.options.elevation_transfer_params(),
+        view: if r.view.is_empty() {
+            doc.site
+                .photos
+                .first()
+                .map(|p| p.id.clone())
+                .unwrap_or_default()
+        } else {
+            r.view.clone()
+        },
         cancel,
     });
     site_elevation(doc, model, &UnfoldParams::default(), lighting).map_err(|e| e.to_string())
+}
+
+/// Reads `NAME=METRES, NAME=METRES` (the CLI's repeated `--object-element-edge`).
+///
+/// # Errors
+/// A sentence naming the entry that is not `NAME=METRES` with a positive finite size.
+pub fn object_element_edges(text: &str) -> Result<std::collections::BTreeMap<String, f64>, String> {
+    text.split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(|t| {
+            let (name, size) = t
+                .rsplit_once('=')
+                .ok_or_else(|| format!("object element edge `{t}` is not NAME=METRES"))?;
+            match size.trim().parse::<f64>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok((name.trim().to_owned(), v)),
+                _ => Err(format!(
+                    "object element edge `{t}`: `{}` is not a positive number of metres",
+                    size.trim()
+                )),
+            }
+        })
+        .collect()
 }
 
 impl ElevationView {
@@ -100,6 +149,102 @@ impl ElevationView {
             }
             Poll::Cancelled => self.message = Some("elevation cancelled".into()),
         }
+    }
+
+    /// Starts the drawing on the worker, or says why the typed options are refused.
+    fn start(&mut self, ctx: &egui::Context, doc: &SiteDocument) {
+        let irradiance = if self.irradiance {
+            match object_element_edges(&self.object_edges) {
+                Ok(edges) => Some(IrradianceRequest {
+                    options: SolveOptions {
+                        object_element_edge_m: edges,
+                        ..self.options.clone()
+                    },
+                    view: self.view.clone(),
+                }),
+                Err(e) => {
+                    self.message = Some(format!("elevation failed: {e}"));
+                    return;
+                }
+            }
+        } else {
+            None
+        };
+        let doc = doc.clone();
+        let model = self.model.clone();
+        self.message = Some("drawing the elevation…".into());
+        self.worker.spawn(ctx, move |progress| {
+            progress.set(None, "drawing the unfolded elevation");
+            draw_elevation(&doc, &model, irradiance.as_ref(), progress.cancel_flag())
+        });
+    }
+
+    /// The irradiance view's solve options, as the CLI names them.
+    fn options_ui(&mut self, ui: &mut egui::Ui, doc: &SiteDocument) {
+        egui::CollapsingHeader::new("solve options")
+            .default_open(true)
+            .show(ui, |ui| {
+                egui::Grid::new("elevation solve options").show(ui, |ui| {
+                    ui.label("sun of photo");
+                    let shown = if self.view.is_empty() {
+                        "first photo".to_owned()
+                    } else {
+                        self.view.clone()
+                    };
+                    let combo = egui::ComboBox::from_id_salt("elevation view")
+                        .selected_text(shown)
+                        .show_ui(ui, |ui| {
+                            ui.selectable_value(&mut self.view, String::new(), "first photo");
+                            for p in &doc.site.photos {
+                                ui.selectable_value(&mut self.view, p.id.clone(), p.id.as_str());
+                            }
+                        });
+                    name_widget(ui, &combo.response, "elevation sun photo");
+                    ui.end_row();
+                    let o = &mut self.options;
+                    for (label, value, min, speed) in [
+                        ("patch edge (m)", &mut o.patch_edge_m, 1e-3, 0.05),
+                        ("element edge (m)", &mut o.element_edge_m, 1e-3, 0.05),
+                        ("BF tolerance", &mut o.bf_tolerance, 0.0, 1e-4),
+                        ("sky tolerance", &mut o.sky_tolerance, 1e-3, 1e-3),
+                        ("mean change", &mut o.mean_change, 0.0, 1e-4),
+                        ("residual", &mut o.residual, 0.0, 1e-5),
+                    ] {
+                        ui.label(label);
+                        let r = ui.add(
+                            egui::DragValue::new(value)
+                                .range(min..=1e6)
+                                .speed(speed)
+                                .max_decimals(6),
+                        );
+                        name_widget(ui, &r, &format!("elevation {label}"));
+                        ui.end_row();
+                    }
+                    ui.label("form-factor samples per axis");
+                    let r = ui.add(egui::DragValue::new(&mut o.samples_per_axis).range(1..=64));
+                    name_widget(ui, &r, "elevation samples per axis");
+                    ui.end_row();
+                    ui.label("seed");
+                    let r = ui.add(egui::DragValue::new(&mut o.seed));
+                    name_widget(ui, &r, "elevation seed");
+                    ui.end_row();
+                    ui.label("object element edges");
+                    let r = ui.add(
+                        egui::TextEdit::singleline(&mut self.object_edges)
+                            .hint_text("NAME=METRES, …")
+                            .desired_width(200.0),
+                    );
+                    name_widget(ui, &r, "elevation object element edges");
+                    ui.end_row();
+                });
+                let b = ui.button("Default solve options");
+                name_widget(ui, &b, "Default solve options");
+                if b.clicked() {
+                    self.options = SolveOptions::default();
+                    self.object_edges.clear();
+                    self.view.clear();
+                }
+            });
     }
 
     fn export(&mut self, doc: &SiteDocument) {
@@ -155,19 +300,15 @@ impl ElevationView {
             let b = ui.add_enabled(!busy, egui::Button::new("Draw elevation"));
             name_widget(ui, &b, "Draw elevation");
             if b.clicked() {
-                let doc = doc.clone();
-                let model = self.model.clone();
-                let irradiance = self.irradiance;
-                self.message = Some("drawing the elevation…".into());
-                self.worker.spawn(ui.ctx(), move |progress| {
-                    progress.set(None, "drawing the unfolded elevation");
-                    draw_elevation(&doc, &model, irradiance, progress.cancel_flag())
-                });
+                self.start(ui.ctx(), doc);
             }
             if busy && ui.button("Cancel").clicked() {
                 self.worker.cancel();
             }
         });
+        if self.irradiance {
+            self.options_ui(ui, doc);
+        }
         if let Some(m) = &self.message {
             let r = ui.label(m);
             name_widget(ui, &r, &format!("elevation status: {m}"));

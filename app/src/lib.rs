@@ -265,6 +265,8 @@ impl Studio {
             materials: materials_panel::MaterialsPanel::default(),
             variants: variants_panel::VariantsPanel::default(),
         };
+        s.variants.compare =
+            variants_panel::CompareState::from_settings(&s.ui_state.variant_compare);
         s.open(&options.site_path);
         s
     }
@@ -586,7 +588,18 @@ impl Studio {
             self.create_polygon();
         }
         self.autosave_tick(&ctx);
+        self.keep_compare_settings(&ctx);
         self.render.live.frame_done(frame_start.elapsed());
+    }
+
+    /// Writes the Variants tab's comparison settings to the UI state file when they changed
+    /// (once a drag has ended, not on every frame of it).
+    fn keep_compare_settings(&mut self, ctx: &egui::Context) {
+        let settings = self.variants.compare.settings();
+        if settings != self.ui_state.variant_compare && !ctx.input(|i| i.pointer.any_down()) {
+            self.ui_state.variant_compare = settings;
+            self.persist_ui_state();
+        }
     }
 
     fn toolbar_ui(&mut self, ui: &mut egui::Ui) {

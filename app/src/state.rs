@@ -1,4 +1,5 @@
-//! The studio's persisted UI state (recent sites, view settings), one serde struct with
+//! The studio's persisted UI state (recent sites, view settings, the Variants tab's comparison
+//! settings), one serde struct with
 //! `#[serde(default)]` in a small TOML file in the user's config folder
 //! (`$XDG_CONFIG_HOME/photomontage-studio/state.toml`, else `~/.config/…`), overridable with
 //! `PHOTOMONTAGE_STUDIO_CONFIG`. Written atomically; a missing or unreadable file gives the
@@ -27,6 +28,8 @@ pub struct UiState {
     pub loupe: bool,
     /// Loupe magnification in screen points per photo pixel.
     pub loupe_zoom: f64,
+    /// The Variants tab's comparison settings.
+    pub variant_compare: crate::variants_panel::CompareSettings,
 }
 
 impl Default for UiState {
@@ -37,6 +40,7 @@ impl Default for UiState {
             residual_exaggeration: 200.0,
             loupe: true,
             loupe_zoom: 8.0,
+            variant_compare: crate::variants_panel::CompareSettings::default(),
         }
     }
 }

@@ -34,7 +34,7 @@ use photomontage::verified::comparison_sheet::{
 };
 use photomontage::verified::sheet::write_sheet;
 
-pub use compare::{CompareMode, CompareState, FLICKER_PERIOD_S};
+pub use compare::{CompareMode, CompareSettings, CompareState, FLICKER_PERIOD_S};
 
 use crate::commands::Command;
 use crate::dialogs::DialogPurpose;
@@ -277,7 +277,7 @@ impl VariantsPanel {
                 view: view.clone(),
                 shown,
             });
-            self.compare.fit_to(names.len());
+            self.compare.fit_to(&names);
             format!(
                 "rendered {} variant(s) of {view}: {}",
                 names.len(),

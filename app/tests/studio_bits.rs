@@ -6,6 +6,7 @@
 
 mod common;
 
+use chrono::Datelike;
 use common::{copy_sample, harness};
 use eframe::egui;
 use egui_kittest::kittest::Queryable;
@@ -323,4 +324,187 @@ fn the_unfolded_elevation_is_drawn_on_the_worker_and_exported_as_the_cli_writes_
     assert_eq!(written, cli.png_bytes().unwrap());
     let decoded = image::load_from_memory(&written).unwrap().to_rgb8();
     assert_eq!(decoded, cli.image.image);
+}
+
+/// The sky at these (elevation, azimuth) degrees is compared.
+const SKY_DIRECTIONS_DEG: [(f64, f64); 4] =
+    [(5.0, 0.0), (30.0, 90.0), (60.0, 200.0), (85.0, 300.0)];
+/// The studio and the library evaluate the same formula on the same inputs; only the order of
+/// floating-point operations could differ.
+const SAME_SKY_REL_TOL: f64 = 1e-12;
+
+/// Relative luminance of the site's sky for photo P1 at [`SKY_DIRECTIONS_DEG`].
+fn sky_luminances(doc: &SiteDocument, sky: &photomontage::sky::SkyModel) -> Vec<f64> {
+    let sun = photomontage::site::render::site_sun_dir(doc, "P1").unwrap();
+    SKY_DIRECTIONS_DEG
+        .iter()
+        .map(|&(el, az)| {
+            let (el, az) = (el.to_radians(), az.to_radians());
+            // The sun's vector type (the studio has no nalgebra of its own), set to the
+            // direction: x east, y north, z up.
+            let mut dir = sun;
+            (dir.x, dir.y, dir.z) = (el.cos() * az.sin(), el.cos() * az.cos(), el.sin());
+            sky.relative_luminance(&dir, &sun)
+        })
+        .collect()
+}
+
+#[test]
+fn choosing_perez_in_the_list_fills_in_inputs_so_the_saved_site_loads() {
+    let (_dir, site) = copy_sample();
+    let mut h = open_light_tab(&site);
+    let before = site_of(&h);
+    assert_ne!(before.lighting.sky_model, SkyModelName::Perez);
+    assert_eq!(before.lighting.perez, None);
+    click(&mut h, "sky model");
+    // `perez` is the list's 18th entry, below its visible part: scrolled to, then clicked.
+    h.get_by_label("perez").scroll_to_me();
+    h.run();
+    click(&mut h, "perez");
+    let chosen = site_of(&h);
+    assert_eq!(chosen.lighting.sky_model, SkyModelName::Perez);
+    assert_eq!(
+        chosen.lighting.perez,
+        Some(PerezInputs::gendaylit_example())
+    );
+    // The inputs are visible in their fields.
+    assert_eq!(value(&h, "perez clearness"), "4.7065");
+    assert_eq!(value(&h, "perez brightness"), "0.1243");
+    click(&mut h, "Save");
+    h.run();
+    let saved = SiteDocument::load(&site).expect("the saved Perez site loads");
+    assert_eq!(saved.site.lighting, chosen.lighting);
+    // What the fix prevents: the same file without the inputs is refused, naming them.
+    let mut without = saved.clone();
+    without.site.lighting.perez = None;
+    without.save().unwrap();
+    let e = SiteDocument::load(&site).unwrap_err().to_string();
+    assert!(e.contains("lighting.perez"), "{e}");
+    // One undo restores the previous sky and (no) inputs.
+    undo(&mut h);
+    assert_eq!(site_of(&h).lighting, before.lighting);
+}
+
+#[test]
+fn the_perez_irradiance_form_is_typed_in_the_studio() {
+    let (_dir, site) = copy_sample();
+    let mut h = open_light_tab(&site);
+    click(&mut h, "sky model");
+    h.get_by_label("perez").scroll_to_me();
+    h.run();
+    click(&mut h, "perez");
+    let with_indices = site_of(&h);
+    click(&mut h, "perez from irradiance");
+    // A bad value: the library's message, nothing applied.
+    set_text(&mut h, "perez direct normal", "-5");
+    set_text(&mut h, "perez diffuse horizontal", "150");
+    click(&mut h, "Set Perez sky");
+    assert!(
+        has(&h, "lighting.perez.direct_normal_w_m2: -5 W/m² is negative"),
+        "{:?}",
+        h.state().messages()
+    );
+    assert_eq!(site_of(&h), with_indices);
+    set_text(&mut h, "perez direct normal", "600");
+    click(&mut h, "Set Perez sky");
+    h.run();
+    let s = site_of(&h);
+    assert_eq!(
+        s.lighting.perez,
+        Some(PerezInputs {
+            direct_normal_w_m2: Some(600.0),
+            diffuse_horizontal_w_m2: Some(150.0),
+            ..PerezInputs::default()
+        })
+    );
+    // The site's sky is the library's Perez sky for the same irradiance, sun and day.
+    let doc = h.state().document().unwrap().clone();
+    let sun = photomontage::site::render::site_sun_dir(&doc, "P1").unwrap();
+    let studio_sky = photomontage::site::render::site_sky_model(&doc, "P1", &sun).unwrap();
+    let day = photomontage::site::site_time::site_sun_time(&doc, "P1")
+        .unwrap()
+        .ordinal();
+    let library_sky = photomontage::sky::SkyModel::Perez(
+        photomontage::sky::perez::PerezSky::from_irradiance(600.0, 150.0, sun.z.acos(), day)
+            .unwrap(),
+    );
+    for (got, want) in sky_luminances(&doc, &studio_sky)
+        .into_iter()
+        .zip(sky_luminances(&doc, &library_sky))
+    {
+        assert!(
+            ((got - want) / want).abs() < SAME_SKY_REL_TOL,
+            "{got} vs {want}"
+        );
+    }
+    // Undo back to the indices, redo to the irradiance.
+    undo(&mut h);
+    assert_eq!(site_of(&h), with_indices);
+    assert_eq!(value(&h, "perez clearness"), "4.7065");
+    h.state_mut().redo();
+    h.run();
+    assert_eq!(site_of(&h), s);
+    assert_eq!(value(&h, "perez direct normal"), "600");
+}
+
+#[test]
+fn the_irradiance_elevation_takes_the_clis_solve_options() {
+    let (dir, site) = copy_sample();
+    common::add_box_model(&site);
+    let mut h = harness(&site, TALL);
+    click(&mut h, "Materials tab");
+    click(&mut h, "Unfolded elevation");
+    click(&mut h, "elevation irradiance");
+    // Non-default options: 2 m elements (the CLI's `--element-edge-m 2`) and seed 3.
+    h.get_by_label("elevation element edge (m)")
+        .set_value_accesskit(2.0);
+    h.run();
+    h.get_by_label("elevation seed").set_value_accesskit(3.0);
+    h.run();
+    click(&mut h, "Draw elevation");
+    let start = std::time::Instant::now();
+    while !has(&h, "elevation ready") {
+        assert!(!has(&h, "elevation failed"), "the elevation failed");
+        assert!(
+            start.elapsed().as_secs() < 300,
+            "the elevation did not finish"
+        );
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    h.run();
+    let out = dir.path().join("box-irradiance.png");
+    set_text(&mut h, "elevation PNG path", out.to_str().unwrap());
+    click(&mut h, "Export elevation PNG");
+    let written = std::fs::read(&out).unwrap();
+    // What `photomontage elevation SITE --model box --irradiance --element-edge-m 2 --seed 3
+    // --out FILE.png` writes: the same options through the library's one mapping.
+    let doc = SiteDocument::load(&site).unwrap();
+    let options = photomontage::site::solve_options::SolveOptions {
+        element_edge_m: 2.0,
+        seed: 3,
+        ..Default::default()
+    };
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let draw = |options: &photomontage::site::solve_options::SolveOptions| {
+        photomontage::site::elevation::site_elevation(
+            &doc,
+            "box",
+            &photomontage::design::unfolded::UnfoldParams::default(),
+            Some(photomontage::site::elevation::ElevationLighting {
+                params: options.elevation_transfer_params(),
+                view: "P1".into(),
+                cancel: &cancel,
+            }),
+        )
+        .unwrap()
+        .png_bytes()
+        .unwrap()
+    };
+    assert_eq!(written, draw(&options), "the CLI's PNG, byte for byte");
+    // The options matter: the defaults give another picture.
+    assert_ne!(
+        written,
+        draw(&photomontage::site::solve_options::SolveOptions::default())
+    );
 }

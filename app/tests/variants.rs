@@ -348,3 +348,88 @@ fn set_colour_text(h: &mut Harness<'static, Studio>, material: &str, text: &str)
         .set_colour_text("Red box", material, text);
     h.run();
 }
+
+/// Two variants of the box, written into the site file.
+const TWO_VARIANTS: &str = "\n[[variants]]\nname = \"With box\"\nvisible_models = [\"box\"]\n\n[[variants]]\nname = \"No box\"\nvisible_models = []\n";
+
+/// Renders every variant of the solved sample at [`SPP`] and waits for them.
+fn render_variants(h: &mut Harness<'static, Studio>) {
+    h.get_by_label("Solve").click();
+    step_until(h, "solve", |s| s.solution().is_some() && s.is_idle());
+    click(h, "Variants tab");
+    {
+        let q = &mut h.state_mut().variants_panel_mut().quality;
+        q.spp_min = SPP;
+        q.spp_max = SPP;
+        q.seed = SEED;
+    }
+    h.get_by_label("Render all variants").click();
+    h.step();
+    step_until(h, "variant renders", |s| {
+        !s.variants_panel().busy() && s.variants_panel().renders().is_some()
+    });
+    h.run();
+}
+
+#[test]
+fn compare_settings_survive_a_killed_studio() {
+    use photomontage_studio::StudioOptions;
+    let (dir, site) = copy_sample();
+    add_box_model(&site);
+    let mut text = std::fs::read_to_string(&site).unwrap();
+    text.push_str(TWO_VARIANTS);
+    std::fs::write(&site, text).unwrap();
+    let state = dir.path().join("config/state.toml");
+    let studio = || {
+        Studio::new(StudioOptions {
+            site_path: site.clone(),
+            state_path: Some(state.clone()),
+        })
+    };
+
+    let mut h = common::harness_for(studio(), WINDOW);
+    render_variants(&mut h);
+    let compare = |h: &Harness<'static, Studio>| {
+        let c = &h.state().variants_panel().compare;
+        (c.mode, c.a, c.b, c.split, c.flicker_running)
+    };
+    assert_eq!(compare(&h), (CompareMode::Slider, 0, 1, 0.5, false));
+    // A and B swapped in their lists, the split moved, then the flicker started.
+    h.get_by_label("Variant A").click();
+    h.run();
+    click(&mut h, "Variant A No box");
+    h.get_by_label("Variant B").click();
+    h.run();
+    click(&mut h, "Variant B With box");
+    h.get_by_label("A/B split").set_value_accesskit(0.25);
+    h.run();
+    click(&mut h, "Flicker");
+    click(&mut h, "Start flicker");
+    let chosen = (CompareMode::Flicker, 1, 0, 0.25, true);
+    assert_eq!(compare(&h), chosen);
+    // Killed: dropped without `on_exit`, so only what was written while running counts.
+    drop(h);
+    let written = std::fs::read_to_string(&state).expect("the UI state was written");
+    assert!(written.contains("flicker"), "{written}");
+
+    // Reopened: the mode, split and flicker come back at once; A and B by name once the
+    // variants are rendered again.
+    let mut h = common::harness_for(studio(), WINDOW);
+    let c = &h.state().variants_panel().compare;
+    assert_eq!(
+        (c.mode, c.split, c.flicker_running),
+        (CompareMode::Flicker, 0.25, true)
+    );
+    render_variants(&mut h);
+    assert_eq!(compare(&h), chosen);
+    let names = |h: &Harness<'static, Studio>| {
+        let r = h.state().variants_panel().renders().unwrap();
+        let c = &h.state().variants_panel().compare;
+        (
+            r.shown[c.a].name().to_owned(),
+            r.shown[c.b].name().to_owned(),
+        )
+    };
+    assert_eq!(names(&h), ("No box".to_owned(), "With box".to_owned()));
+    click(&mut h, "Pause flicker");
+}

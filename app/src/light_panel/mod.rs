@@ -15,9 +15,7 @@
 //! `photomontage sun`).
 //!
 //! # Known limitations
-//! The Perez sky is set by its clearness ε and brightness Δ here; the site file's irradiance
-//! form (`direct_normal_w_m2`, `diffuse_horizontal_w_m2`) is shown but typed in the file. Local
-//! times typed without an offset
+//! Local times typed without an offset
 //! are stored resolved to RFC 3339 with the offset in force (what `validate` asks of
 //! `lighting.time`). Luminaire files are typed paths (no file dialog).
 
@@ -71,6 +69,13 @@ pub struct LightPanel {
     pub perez_clearness: String,
     /// Perez sky brightness Δ text.
     pub perez_brightness: String,
+    /// Perez direct normal irradiance text, W/m².
+    pub perez_direct_normal: String,
+    /// Perez diffuse horizontal irradiance text, W/m².
+    pub perez_diffuse_horizontal: String,
+    /// Whether the Perez fields show the irradiance form (else ε and Δ); follows the site's
+    /// form whenever `[lighting.perez]` changes.
+    pub perez_irradiance_form: bool,
     /// The last refusal, shown in red until the next successful edit.
     pub error: Option<String>,
     /// Sky map and sliders.
@@ -165,10 +170,25 @@ impl LightPanel {
                 text(perez.and_then(|p| p.brightness)),
                 &mut self.perez_brightness,
             ),
+            (
+                "perez direct normal",
+                text(perez.and_then(|p| p.direct_normal_w_m2)),
+                &mut self.perez_direct_normal,
+            ),
+            (
+                "perez diffuse horizontal",
+                text(perez.and_then(|p| p.diffuse_horizontal_w_m2)),
+                &mut self.perez_diffuse_horizontal,
+            ),
         ] {
             refill_field(filled, key, source.clone(), source, field);
         }
         // The capture time belongs to the current photo: a change of photo refills it too.
+        let perez_source = format!("{perez:?}");
+        if filled.get("perez form") != Some(&perez_source) {
+            self.perez_irradiance_form = perez.is_some_and(|p| p.direct_normal_w_m2.is_some());
+            filled.insert("perez form", perez_source);
+        }
         let taken_at = taken_at.unwrap_or_default();
         let source = format!("{photo:?} {taken_at}");
         refill_field(filled, "capture time", source, taken_at, &mut self.taken_at);
@@ -390,7 +410,13 @@ impl LightPanel {
         }
     }
 
-    fn sky_ui(&mut self, ui: &mut egui::Ui, doc: &SiteDocument, out: &mut Vec<Action>) {
+    fn sky_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        doc: &SiteDocument,
+        photo: Option<&str>,
+        out: &mut Vec<Action>,
+    ) {
         ui.strong("Sky and weights");
         let lighting = &doc.site.lighting;
         let mut l = lighting.clone();
@@ -403,8 +429,12 @@ impl LightPanel {
                     ui.selectable_value(&mut l.sky_model, m, text);
                 }
             });
+        if l.sky_model == SkyModelName::Perez && lighting.sky_model != SkyModelName::Perez {
+            // Chosen now: valid inputs go with it, in the same edit, so a saved site loads.
+            l.perez = Some(crate::light_panel::perez::inputs_for_new_perez_sky(&l));
+        }
         if l.sky_model == SkyModelName::Perez {
-            crate::light_panel::perez::perez_ui(self, ui, &mut l);
+            crate::light_panel::perez::perez_ui(self, ui, doc, photo, &mut l);
         }
         egui::Grid::new("light weights").show(ui, |ui| {
             for (label, values, max) in [
@@ -508,7 +538,7 @@ impl Panel for LightPanel {
             ui.separator();
             crate::light_panel::sky_map::sky_map_ui(self, ui, doc, ctx.current_photo, &mut out);
             ui.separator();
-            self.sky_ui(ui, doc, &mut out);
+            self.sky_ui(ui, doc, ctx.current_photo, &mut out);
             ui.separator();
             crate::light_panel::luminaires::luminaires_ui(self, ui, doc, &mut out);
         });

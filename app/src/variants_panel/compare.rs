@@ -4,8 +4,14 @@
 //! Every picture carries its variant's name drawn on it; the names drawn in the last frame are
 //! kept in [`CompareState::drawn_labels`] (tests read them, screen readers get them through the
 //! pictures' accessible names).
+//!
+//! The settings (mode, A and B by variant name, the split, whether the flicker runs) are kept
+//! between sessions as [`CompareSettings`] in the studio's UI state file
+//! (`crate::state::UiState`), not in the site file: A and B are found again by name after the
+//! next "Render all variants".
 
 use eframe::egui::{self, Color32, Rect, pos2, vec2};
+use serde::{Deserialize, Serialize};
 
 use super::ShownVariant;
 use crate::widgets::name_widget;
@@ -17,9 +23,11 @@ pub const FLICKER_PERIOD_S: f64 = 1.0;
 pub const GRID_COLUMNS: usize = 3;
 
 /// How the rendered variants are compared.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum CompareMode {
     /// One picture, A left of a movable split and B right of it.
+    #[default]
     Slider,
     /// A and B next to each other.
     SideBySide,
@@ -27,6 +35,35 @@ pub enum CompareMode {
     Grid,
     /// A and B alternating in one place.
     Flicker,
+}
+
+/// What of the comparison is kept between sessions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CompareSettings {
+    /// The mode shown.
+    pub mode: CompareMode,
+    /// Name of variant A (`None`: the first render).
+    pub a: Option<String>,
+    /// Name of variant B (`None`: the second render).
+    pub b: Option<String>,
+    /// Where the A/B slider splits, as a fraction of the width from the left.
+    pub split: f32,
+    /// Whether the flicker alternates by itself.
+    pub flicker_running: bool,
+}
+
+impl Default for CompareSettings {
+    fn default() -> Self {
+        let s = CompareState::default();
+        Self {
+            mode: s.mode,
+            a: None,
+            b: None,
+            split: s.split,
+            flicker_running: s.flicker_running,
+        }
+    }
 }
 
 /// The comparison's state.
@@ -45,6 +82,10 @@ pub struct CompareState {
     /// Whether the flicker shows B now.
     pub showing_b: bool,
     last_switch_s: f64,
+    /// Names of A and B: those shown last, or those remembered from the last session until
+    /// the variants are rendered.
+    a_name: Option<String>,
+    b_name: Option<String>,
     /// The variant names drawn on the pictures in the last frame, left to right, top down.
     pub drawn_labels: Vec<String>,
 }
@@ -59,6 +100,8 @@ impl Default for CompareState {
             flicker_running: false,
             showing_b: false,
             last_switch_s: 0.0,
+            a_name: None,
+            b_name: None,
             drawn_labels: Vec::new(),
         }
     }
@@ -95,10 +138,41 @@ fn allocate(ui: &mut egui::Ui, width: f32, aspect: f32, name: &str) -> egui::Res
 }
 
 impl CompareState {
-    /// Keeps A and B inside `n` renders (A the first, B the second after new renders).
-    pub fn fit_to(&mut self, n: usize) {
-        self.a = 0;
-        self.b = usize::from(n > 1);
+    /// The state of a new session with `settings` (A and B are placed by name at the next
+    /// [`CompareState::fit_to`]).
+    #[must_use]
+    pub fn from_settings(settings: &CompareSettings) -> Self {
+        Self {
+            mode: settings.mode,
+            split: settings.split.clamp(0.0, 1.0),
+            flicker_running: settings.flicker_running,
+            a_name: settings.a.clone(),
+            b_name: settings.b.clone(),
+            ..Self::default()
+        }
+    }
+
+    /// What is kept between sessions.
+    #[must_use]
+    pub fn settings(&self) -> CompareSettings {
+        CompareSettings {
+            mode: self.mode,
+            a: self.a_name.clone(),
+            b: self.b_name.clone(),
+            split: self.split,
+            flicker_running: self.flicker_running,
+        }
+    }
+
+    /// Places A and B in new renders named `names`: the variants of those names when they
+    /// were rendered, else the first and the second.
+    pub fn fit_to(&mut self, names: &[String]) {
+        let find = |name: &Option<String>| {
+            name.as_ref()
+                .and_then(|n| names.iter().position(|m| m == n))
+        };
+        self.a = find(&self.a_name).unwrap_or(0);
+        self.b = find(&self.b_name).unwrap_or(usize::from(names.len() > 1));
     }
 
     /// Shows the other of A and B in the flicker.
@@ -133,6 +207,8 @@ impl CompareState {
         }
         self.a = self.a.min(n - 1);
         self.b = self.b.min(n - 1);
+        self.a_name = Some(shown[self.a].name().to_owned());
+        self.b_name = Some(shown[self.b].name().to_owned());
         ui.horizontal(|ui| {
             for (mode, label) in [
                 (CompareMode::Slider, "A/B slider"),
@@ -146,6 +222,8 @@ impl CompareState {
         });
         if self.mode != CompareMode::Grid {
             self.pick_ui(ui, shown);
+            self.a_name = Some(shown[self.a].name().to_owned());
+            self.b_name = Some(shown[self.b].name().to_owned());
         }
         let width = ui.available_width().max(50.0);
         let (a, b) = (self.a, self.b);

@@ -32,6 +32,7 @@ pub mod site_materials;
 pub mod site_scene;
 pub mod site_time;
 pub mod solve;
+pub mod solve_options;
 pub mod sun_path;
 #[cfg(feature = "opencv")]
 pub mod tie_matching;

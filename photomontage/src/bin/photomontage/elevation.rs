@@ -9,8 +9,6 @@ use std::sync::atomic::Ordering;
 
 use anyhow::{Context, bail};
 use photomontage::design::unfolded::UnfoldParams;
-use photomontage::radiosity::hierarchical::HierarchicalParams;
-use photomontage::radiosity::{RelightStrategy, Solver, Sweep, TransferParams};
 use photomontage::site::SiteDocument;
 use photomontage::site::elevation::{ElevationLighting, site_elevation};
 
@@ -50,18 +48,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let lighting = if args.irradiance {
         eprintln!("solving radiosity (Ctrl-C cancels)");
         Some(ElevationLighting {
-            params: TransferParams {
-                solve: args.solve.params(
-                    Solver::Hierarchical(HierarchicalParams {
-                        bf_tolerance: args.solve.bf_tolerance,
-                        ..HierarchicalParams::default()
-                    }),
-                    None,
-                )?,
-                sky_tolerance: args.solve.sky_tolerance,
-                strategy: RelightStrategy::LinearResponses,
-                sweep: Sweep::GaussSeidel,
-            },
+            params: args.solve.options()?.elevation_transfer_params(),
             view: args.solve.view_id(&doc),
             cancel,
         })

@@ -13,12 +13,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use photomontage::atomic_file::{probe_writable, write_atomically};
 use photomontage::radiosity::convergence::csv;
 use photomontage::radiosity::hierarchical::HierarchicalParams;
-use photomontage::radiosity::{
-    FormFactorParams, MeshParams, SolveParams, Solver, StopRule, luminance, solve,
-};
+use photomontage::radiosity::{SolveParams, Solver, StopRule, luminance, solve};
 use photomontage::site::SiteDocument;
 use photomontage::site::radiosity_lighting::{site_ground_below_horizon, site_light_groups};
 use photomontage::site::render::site_scene;
+use photomontage::site::solve_options::SolveOptions;
 
 use crate::render::{install_cancel, with_threads};
 
@@ -63,32 +62,32 @@ pub struct SolveArgs {
     #[arg(long, value_name = "PHOTO_ID")]
     pub view: Option<String>,
     /// Longest patch edge in metres (the global size).
-    #[arg(long, default_value_t = 4.0)]
+    #[arg(long, default_value_t = SolveOptions::default().patch_edge_m)]
     pub patch_edge_m: f64,
     /// Longest element edge in metres, unless the object has its own.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = SolveOptions::default().element_edge_m)]
     pub element_edge_m: f64,
     /// Element size of one object, `NAME=METRES` (repeatable; object names as `info` lists
     /// polygons and models).
     #[arg(long, value_name = "NAME=METRES")]
     pub object_element_edge: Vec<String>,
     /// Form-factor samples per axis (n² per pair).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = SolveOptions::default().samples_per_axis)]
     pub samples: u32,
     /// Random seed of the form factors and shadow rays.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = SolveOptions::default().seed)]
     pub seed: u64,
     /// HR BF tolerance (fraction of the mean brightness).
-    #[arg(long, default_value_t = HierarchicalParams::default().bf_tolerance)]
+    #[arg(long, default_value_t = SolveOptions::default().bf_tolerance)]
     pub bf_tolerance: f64,
     /// Sky clustering tolerance of the icosahedral dome.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = SolveOptions::default().sky_tolerance)]
     pub sky_tolerance: f64,
     /// Stop when the mean brightness changes by less than this between passes (Üncü & Kayakuş: 0.01).
-    #[arg(long, default_value_t = StopRule::default().mean_change)]
+    #[arg(long, default_value_t = SolveOptions::default().mean_change)]
     pub mean_change: f64,
     /// ... and the relative residual is below this.
-    #[arg(long, default_value_t = StopRule::default().residual)]
+    #[arg(long, default_value_t = SolveOptions::default().residual)]
     pub residual: f64,
     /// Worker threads (default: all cores).
     #[arg(long)]
@@ -104,29 +103,28 @@ impl SolveArgs {
             .unwrap_or_default()
     }
 
+    /// The options as the library's one set ([`SolveOptions`]).
+    pub fn options(&self) -> anyhow::Result<SolveOptions> {
+        Ok(SolveOptions {
+            patch_edge_m: self.patch_edge_m,
+            element_edge_m: self.element_edge_m,
+            object_element_edge_m: object_sizes(&self.object_element_edge)?,
+            samples_per_axis: self.samples,
+            seed: self.seed,
+            bf_tolerance: self.bf_tolerance,
+            sky_tolerance: self.sky_tolerance,
+            mean_change: self.mean_change,
+            residual: self.residual,
+        })
+    }
+
     /// Solve parameters with `solver`, and the ground below the horizon of the site.
     pub fn params(
         &self,
         solver: Solver,
         ground: Option<photomontage::radiosity::GroundBelowHorizon>,
     ) -> anyhow::Result<SolveParams> {
-        Ok(SolveParams {
-            mesh: MeshParams {
-                max_patch_edge_m: self.patch_edge_m,
-                max_element_edge_m: self.element_edge_m,
-                object_element_edge_m: object_sizes(&self.object_element_edge)?,
-                ..MeshParams::default()
-            },
-            form_factors: FormFactorParams {
-                samples_per_axis: self.samples,
-                seed: self.seed,
-                visibility: true,
-            },
-            solver,
-            stop: self.stop(),
-            ground,
-            ..SolveParams::default()
-        })
+        Ok(self.options()?.solve_params(solver, ground))
     }
 
     /// The stop rule.

@@ -64,7 +64,28 @@ fn bad(field: &'static str, reason: impl Into<String>) -> PerezInputError {
     }
 }
 
+/// ε of [`PerezInputs::gendaylit_example`]: what Radiance's `gendaylit 6 21 12 -a 47 -o -8 -m
+/// -15 -W 600 150` reports (`../shared/reference/lighting.md` §3.3, reproduced by
+/// `sky::perez`'s test `gendaylit_clearness_and_brightness`).
+pub const GENDAYLIT_EXAMPLE_CLEARNESS: f64 = 4.7065;
+/// Δ of [`PerezInputs::gendaylit_example`], from the same `gendaylit` run.
+pub const GENDAYLIT_EXAMPLE_BRIGHTNESS: f64 = 0.1243;
+
 impl PerezInputs {
+    /// The inputs the studio fills in when the Perez sky is chosen for a site without any:
+    /// ε = 4.7065 and Δ = 0.1243, the indices Radiance's `gendaylit` computes for a sunny
+    /// June noon in central Europe (47°N, 600 W/m² direct normal, 150 W/m² diffuse
+    /// horizontal; a sun-bright sky with some haze, clearness bin 6 of 8). Given as ε and Δ,
+    /// not as irradiance, so that they need no sun time and every site can use them.
+    #[must_use]
+    pub fn gendaylit_example() -> Self {
+        Self {
+            clearness: Some(GENDAYLIT_EXAMPLE_CLEARNESS),
+            brightness: Some(GENDAYLIT_EXAMPLE_BRIGHTNESS),
+            ..Self::default()
+        }
+    }
+
     /// The checked form: exactly one complete pair, each value finite and in range
     /// (ε ≥ 1, Δ > 0, E_bn ≥ 0, E_dh > 0).
     ///
@@ -134,5 +155,21 @@ impl PerezInputs {
                 })
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_gendaylit_example_is_a_valid_index_pair() {
+        assert_eq!(
+            PerezInputs::gendaylit_example().form(),
+            Ok(PerezForm::Indices {
+                clearness: GENDAYLIT_EXAMPLE_CLEARNESS,
+                brightness: GENDAYLIT_EXAMPLE_BRIGHTNESS,
+            })
+        );
     }
 }
