@@ -9,8 +9,13 @@
 //! [`photomontage::site::live_relight::lighting_change`] (geometry fingerprint, change) →
 //! `Transfer::relight` on both transfers side by side → the renderer's `RadiosityLight` (the
 //! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth; a
-//! material colour step changes the "render" material's colour. 2 threads; criterion medians,
-//! then medians of 8 alternating steps (wall and CPU time, with the load average).
+//! material colour step changes the "render" material's colour, which the planned building
+//! shares with seven existing ones, so both transfers relight (the worst case). A proposal
+//! colour step changes the colour of a planned building that has its own material
+//! ([`photomontage::radiosity::city_block::city_block_with_proposal`], as a design imported from
+//! CAD brings its own), so only the transfer with the planned building relights. 2 threads;
+//! criterion medians, then medians of 8 alternating steps (wall and CPU time, with the load
+//! average).
 //!
 //! `cargo bench -p photomontage --bench relight_latency` (release profile).
 #![allow(clippy::unwrap_used)]
@@ -22,8 +27,10 @@ use criterion::{Criterion, criterion_group, criterion_main};
 
 mod common;
 use common::{cpu_s, load_average};
+use photomontage::radiosity::TransferParams;
 use photomontage::radiosity::city_block::{
     RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
+    city_block_with_proposal,
 };
 use photomontage::radiosity::{RelightStrategy, Sweep, TransferLighting};
 use photomontage::scene::Scene;
@@ -35,6 +42,8 @@ const THREADS: usize = 2;
 const SUN_STEP_RAD: f64 = 1.0_f64 * std::f64::consts::PI / 180.0;
 /// The material colour step: "render" between its albedo and this colour.
 const RENDER_COLOUR: [f64; 3] = [0.7, 0.5, 0.4];
+/// The proposal colour step: "proposal" between the render albedo and this colour.
+const PROPOSAL_COLOUR: [f64; 3] = [0.45, 0.55, 0.7];
 
 fn sun_lighting(flip: bool) -> TransferLighting {
     let mut l = city_block_lighting();
@@ -50,22 +59,35 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
-fn bench_relight_latency(c: &mut Criterion) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(THREADS)
-        .build()
-        .unwrap();
-    let params = city_block_params(RelightStrategy::LinearResponses, Sweep::Shooting);
-    let scenes: [Scene; 2] = [
-        city_block(1, [RENDER_ALBEDO; 3]).unwrap(),
-        city_block(1, RENDER_COLOUR).unwrap(),
-    ];
+/// Median wall and median CPU time (both threads) of 8 calls of `f(i)`, milliseconds.
+fn timed(f: &mut dyn FnMut(usize)) -> (f64, f64) {
+    let (mut wall, mut cpu): (Vec<f64>, Vec<f64>) = (0..8)
+        .map(|i| {
+            let (c, t) = (cpu_s(), Instant::now());
+            f(i);
+            let wall = t.elapsed().as_secs_f64() * 1e3;
+            (
+                wall,
+                cpu_s().zip(c).map_or(f64::NAN, |(a, b)| (a - b) * 1e3),
+            )
+        })
+        .unzip();
+    (median(&mut wall), median(&mut cpu))
+}
+
+/// The studio's transfers for `scene` and a step function (one relight of both, as the
+/// live preview does); prints the build.
+fn studio_transfers(
+    pool: &rayon::ThreadPool,
+    scene: &Scene,
+    params: &TransferParams,
+) -> SiteTransfers {
     let t0 = Instant::now();
-    let mut transfers = pool.install(|| {
+    let transfers = pool.install(|| {
         SiteTransfers::build_for(
-            &scenes[0],
+            scene,
             &city_block_lighting(),
-            &params,
+            params,
             &AtomicBool::new(false),
         )
         .unwrap()
@@ -77,15 +99,37 @@ fn bench_relight_latency(c: &mut Criterion) {
         transfers.without_artificial().mesh.elements.len(),
         t0.elapsed().as_secs_f64()
     );
-    let mut step = |scene: &Scene, lighting: &TransferLighting| {
-        let update = pool.install(|| transfers.relight_for(scene, lighting, &params).unwrap());
-        // Never a build: a step is a relight (or nothing, when it goes back to where it is).
-        assert!(matches!(
-            update,
-            Some(TransferUpdate::Relit | TransferUpdate::Unchanged)
-        ));
-        transfers.light()
-    };
+    transfers
+}
+
+/// One studio step: relight both transfers to `scene` and `lighting` (never a build).
+fn step(
+    pool: &rayon::ThreadPool,
+    transfers: &mut SiteTransfers,
+    params: &TransferParams,
+    scene: &Scene,
+    lighting: &TransferLighting,
+) {
+    let update = pool.install(|| transfers.relight_for(scene, lighting, params).unwrap());
+    // Never a build: a step is a relight (or nothing, when it goes back to where it is).
+    assert!(matches!(
+        update,
+        Some(TransferUpdate::Relit | TransferUpdate::Unchanged)
+    ));
+    drop(transfers.light());
+}
+
+fn bench_relight_latency(c: &mut Criterion) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(THREADS)
+        .build()
+        .unwrap();
+    let params = city_block_params(RelightStrategy::LinearResponses, Sweep::Shooting);
+    let scenes: [Scene; 2] = [
+        city_block(1, [RENDER_ALBEDO; 3]).unwrap(),
+        city_block(1, RENDER_COLOUR).unwrap(),
+    ];
+    let mut transfers = studio_transfers(&pool, &scenes[0], &params);
     let mut group = c.benchmark_group("studio_relight_50k");
     group.sample_size(10);
     group.warm_up_time(std::time::Duration::from_millis(500));
@@ -94,48 +138,120 @@ fn bench_relight_latency(c: &mut Criterion) {
     group.bench_function("sun_slider_step", |b| {
         b.iter(|| {
             flip = !flip;
-            step(&scenes[0], &sun_lighting(flip))
+            step(
+                &pool,
+                &mut transfers,
+                &params,
+                &scenes[0],
+                &sun_lighting(flip),
+            );
         });
     });
     // Back to the base sun, then colour steps.
-    step(&scenes[0], &sun_lighting(false));
+    step(
+        &pool,
+        &mut transfers,
+        &params,
+        &scenes[0],
+        &sun_lighting(false),
+    );
     let mut k = 0;
     group.bench_function("material_colour_step", |b| {
         b.iter(|| {
             k = 1 - k;
-            step(&scenes[k], &sun_lighting(false))
+            step(
+                &pool,
+                &mut transfers,
+                &params,
+                &scenes[k],
+                &sun_lighting(false),
+            );
         });
     });
-    group.finish();
-    // Median wall and median CPU time (both threads) of 8 steps, milliseconds.
-    let timed = |f: &mut dyn FnMut(usize)| {
-        let (mut wall, mut cpu): (Vec<f64>, Vec<f64>) = (0..8)
-            .map(|i| {
-                let (c, t) = (cpu_s(), Instant::now());
-                f(i);
-                let wall = t.elapsed().as_secs_f64() * 1e3;
-                (
-                    wall,
-                    cpu_s().zip(c).map_or(f64::NAN, |(a, b)| (a - b) * 1e3),
-                )
-            })
-            .unzip();
-        (median(&mut wall), median(&mut cpu))
-    };
     if k == 1 {
-        step(&scenes[0], &sun_lighting(false));
+        step(
+            &pool,
+            &mut transfers,
+            &params,
+            &scenes[0],
+            &sun_lighting(false),
+        );
     }
     let load_before = load_average();
     let (sun_ms, sun_cpu_ms) = timed(&mut |i| {
-        step(&scenes[0], &sun_lighting(i % 2 == 0));
+        step(
+            &pool,
+            &mut transfers,
+            &params,
+            &scenes[0],
+            &sun_lighting(i % 2 == 0),
+        );
     });
-    step(&scenes[0], &sun_lighting(false));
+    step(
+        &pool,
+        &mut transfers,
+        &params,
+        &scenes[0],
+        &sun_lighting(false),
+    );
     let (colour_ms, colour_cpu_ms) = timed(&mut |i| {
-        step(&scenes[(i + 1) % 2], &sun_lighting(false));
+        step(
+            &pool,
+            &mut transfers,
+            &params,
+            &scenes[(i + 1) % 2],
+            &sun_lighting(false),
+        );
+    });
+    drop(transfers);
+    // The planned building in its own material.
+    let proposal: [Scene; 2] = [
+        city_block_with_proposal([RENDER_ALBEDO; 3], [RENDER_ALBEDO; 3]).unwrap(),
+        city_block_with_proposal([RENDER_ALBEDO; 3], PROPOSAL_COLOUR).unwrap(),
+    ];
+    let mut transfers = studio_transfers(&pool, &proposal[0], &params);
+    let mut k = 0;
+    group.bench_function("proposal_colour_step", |b| {
+        b.iter(|| {
+            k = 1 - k;
+            step(
+                &pool,
+                &mut transfers,
+                &params,
+                &proposal[k],
+                &sun_lighting(false),
+            );
+        });
+    });
+    group.finish();
+    if k == 1 {
+        step(
+            &pool,
+            &mut transfers,
+            &params,
+            &proposal[0],
+            &sun_lighting(false),
+        );
+    }
+    let (proposal_ms, proposal_cpu_ms) = timed(&mut |i| {
+        step(
+            &pool,
+            &mut transfers,
+            &params,
+            &proposal[(i + 1) % 2],
+            &sun_lighting(false),
+        );
     });
     println!("\n== studio relight ({THREADS} threads, median of 8 steps, wall / CPU) ==");
     println!("sun slider step (1° azimuth): {sun_ms:.1} ms / {sun_cpu_ms:.1} ms CPU");
-    println!("material colour step: {colour_ms:.1} ms / {colour_cpu_ms:.1} ms CPU");
+    println!(
+        "material colour step (shared by planned and existing buildings): {colour_ms:.1} ms / \
+         {colour_cpu_ms:.1} ms CPU"
+    );
+    println!(
+        "proposal colour step (the planned building's own material): {proposal_ms:.1} ms / \
+         {proposal_cpu_ms:.1} ms CPU"
+    );
     println!(
         "load average (1 min) before / after: {:?} / {:?}",
         load_before,

@@ -66,6 +66,27 @@ fn building(x: f64, y: f64, w: f64, h: f64) -> Vec<Tri> {
 /// # Errors
 /// Scene id overflow (not reachable for this size).
 pub fn city_block(artificial: usize, render_rgb: [f64; 3]) -> Result<Scene, SceneError> {
+    block(artificial, render_rgb, None)
+}
+
+/// [`city_block`] with building 0 planned and in its own material, "proposal" of reflectance
+/// `proposal_rgb` (as a design imported from CAD brings its own materials): a colour change of
+/// "proposal" touches the transfer with the planned building only.
+///
+/// # Errors
+/// Scene id overflow (not reachable for this size).
+pub fn city_block_with_proposal(
+    render_rgb: [f64; 3],
+    proposal_rgb: [f64; 3],
+) -> Result<Scene, SceneError> {
+    block(1, render_rgb, Some(proposal_rgb))
+}
+
+fn block(
+    artificial: usize,
+    render_rgb: [f64; 3],
+    proposal_rgb: Option<[f64; 3]>,
+) -> Result<Scene, SceneError> {
     let mut s = Scene::new();
     add(
         &mut s,
@@ -83,10 +104,10 @@ pub fn city_block(artificial: usize, render_rgb: [f64; 3]) -> Result<Scene, Scen
     for i in 0..4 {
         for j in 0..4 {
             let (x, y) = (-70.0 + 40.0 * f64::from(i), -70.0 + 40.0 * f64::from(j));
-            let material = if k % 2 == 0 {
-                Material::diffuse("render", render_rgb)
-            } else {
-                Material::diffuse("brick", [BRICK_ALBEDO; 3])
+            let material = match proposal_rgb {
+                Some(rgb) if k == 0 => Material::diffuse("proposal", rgb),
+                _ if k % 2 == 0 => Material::diffuse("render", render_rgb),
+                _ => Material::diffuse("brick", [BRICK_ALBEDO; 3]),
             };
             let kind = if k < artificial {
                 ObjectKind::Artificial
