@@ -35,6 +35,7 @@ use photomontage::radiosity::city_block::{
 use photomontage::radiosity::{RelightStrategy, Sweep, TransferLighting};
 use photomontage::scene::Scene;
 use photomontage::site::live_relight::{SiteTransfers, TransferUpdate};
+use photomontage::sky::SkyModel;
 
 /// Threads of every measurement (the issue's target is on 2 threads).
 const THREADS: usize = 2;
@@ -242,6 +243,30 @@ fn bench_relight_latency(c: &mut Criterion) {
             &sun_lighting(false),
         );
     });
+    drop(transfers);
+    // The sun step again under a CIE clear sky (type 12), which follows the sun: its clusters
+    // are re-made and re-traced at every step (report only, no criterion group).
+    let clear = |flip: bool| {
+        let mut l = sun_lighting(flip);
+        if let Some(sky) = l.sky.as_mut() {
+            sky.model = SkyModel::cie_general(12).unwrap();
+        }
+        l
+    };
+    let mut transfers = pool.install(|| {
+        SiteTransfers::build_for(&scenes[0], &clear(false), &params, &AtomicBool::new(false))
+            .unwrap()
+    });
+    let clear_step = |transfers: &mut SiteTransfers, flip: bool| {
+        let update = pool.install(|| {
+            transfers
+                .relight_for(&scenes[0], &clear(flip), &params)
+                .unwrap()
+        });
+        assert!(matches!(update, Some(TransferUpdate::Relit)));
+    };
+    clear_step(&mut transfers, true);
+    let (clear_ms, clear_cpu_ms) = timed(&mut |i| clear_step(&mut transfers, i % 2 == 1));
     println!("\n== studio relight ({THREADS} threads, median of 8 steps, wall / CPU) ==");
     println!("sun slider step (1° azimuth): {sun_ms:.1} ms / {sun_cpu_ms:.1} ms CPU");
     println!(
@@ -251,6 +276,10 @@ fn bench_relight_latency(c: &mut Criterion) {
     println!(
         "proposal colour step (the planned building's own material): {proposal_ms:.1} ms / \
          {proposal_cpu_ms:.1} ms CPU"
+    );
+    println!(
+        "sun slider step under a CIE clear sky (type 12, re-clustered with the sun): \
+         {clear_ms:.1} ms / {clear_cpu_ms:.1} ms CPU"
     );
     println!(
         "load average (1 min) before / after: {:?} / {:?}",
