@@ -5,15 +5,17 @@
 //! `cargo bench -p photomontage --bench link_refinement` (release profile; ≈ minutes).
 #![allow(clippy::unwrap_used)]
 
-use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
+
+mod common;
+use common::indirect_by_centroid;
 
 use photomontage::radiosity::city_block::{
     RENDER_ALBEDO, city_block, city_block_lighting, city_block_params_with_roots,
 };
 use photomontage::radiosity::hierarchical::HierarchicalParams;
-use photomontage::radiosity::{RelightStrategy, Solution, Solver, Sweep, Transfer, TransferParams};
+use photomontage::radiosity::{RelightStrategy, Solver, Sweep, Transfer, TransferParams};
 
 fn params(roots_m: f64, ff_tol: f64, bf_tol: f64, max_links: usize) -> TransferParams {
     let mut p =
@@ -24,22 +26,6 @@ fn params(roots_m: f64, ff_tol: f64, bf_tol: f64, max_links: usize) -> TransferP
         max_links,
     });
     p
-}
-
-fn indirect_by_centroid(s: &Solution) -> HashMap<[i64; 3], (f64, f64)> {
-    let total = s.total_radiosity_rgb();
-    (0..total.len())
-        .map(|e| {
-            let node = s.mesh.element_node(e);
-            let rho = s.mesh.surfaces[node.surface as usize].reflectance_rgb[1];
-            let direct: f64 = s.groups.iter().map(|g| g.direct_irradiance_rgb[e][1]).sum();
-            let v = &node.vertices_in_world_m;
-            let c = (v[0].coords + v[1].coords + v[2].coords) / 3.0;
-            #[allow(clippy::cast_possible_truncation)]
-            let key = [c.x, c.y, c.z].map(|x| (x * 1000.0).round() as i64);
-            (key, (total[e][1] - rho * direct, node.area_m2))
-        })
-        .collect()
 }
 
 fn main() {

@@ -13,7 +13,7 @@ use std::time::Instant;
 use criterion::{Criterion, criterion_group, criterion_main};
 
 mod common;
-use common::{cpu_s, load_average};
+use common::{cpu_s, indirect_by_centroid, load_average};
 use photomontage::radiosity::city_block::{
     self, RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
 };
@@ -58,26 +58,6 @@ fn build(p: &TransferParams) -> Transfer {
     .unwrap()
 }
 
-/// Interreflected radiosity (B − ρ·E_direct, green) per element, keyed by the element's centroid
-/// in millimetres (meshes with other roots have the same elements in another order).
-fn indirect_by_centroid(
-    s: &photomontage::radiosity::Solution,
-) -> std::collections::HashMap<[i64; 3], f64> {
-    let total = s.total_radiosity_rgb();
-    (0..total.len())
-        .map(|e| {
-            let node = s.mesh.element_node(e);
-            let rho = s.mesh.surfaces[node.surface as usize].reflectance_rgb[1];
-            let direct: f64 = s.groups.iter().map(|g| g.direct_irradiance_rgb[e][1]).sum();
-            let v = &node.vertices_in_world_m;
-            let c = (v[0].coords + v[1].coords + v[2].coords) / 3.0;
-            #[allow(clippy::cast_possible_truncation)]
-            let key = [c.x, c.y, c.z].map(|x| (x * 1000.0).round() as i64);
-            (key, total[e][1] - rho * direct)
-        })
-        .collect()
-}
-
 /// L1 difference of `other`'s interreflected radiosity from `reference`'s, relative to the
 /// reference's sum, and the relative difference of the means.
 fn indirect_difference(
@@ -87,8 +67,8 @@ fn indirect_difference(
     let a = indirect_by_centroid(reference);
     let b = indirect_by_centroid(other);
     let (mut l1, mut sum_a, mut sum_b) = (0.0, 0.0, 0.0);
-    for (k, va) in &a {
-        let vb = b[k];
+    for (k, &(va, _)) in &a {
+        let vb = b[k].0;
         l1 += (vb - va).abs();
         sum_a += va;
         sum_b += vb;
