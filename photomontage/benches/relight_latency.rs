@@ -76,22 +76,16 @@ fn timed(f: &mut dyn FnMut(usize)) -> (f64, f64) {
     (median(&mut wall), median(&mut cpu))
 }
 
-/// The studio's transfers for `scene` and a step function (one relight of both, as the
-/// live preview does); prints the build.
+/// The studio's transfers for `scene` lit by `lighting`; prints the build.
 fn studio_transfers(
     pool: &rayon::ThreadPool,
     scene: &Scene,
+    lighting: &TransferLighting,
     params: &TransferParams,
 ) -> SiteTransfers {
     let t0 = Instant::now();
     let transfers = pool.install(|| {
-        SiteTransfers::build_for(
-            scene,
-            &city_block_lighting(),
-            params,
-            &AtomicBool::new(false),
-        )
-        .unwrap()
+        SiteTransfers::build_for(scene, lighting, params, &AtomicBool::new(false)).unwrap()
     });
     println!(
         "relight latency: {} + {} elements (with / without the planned building), built in \
@@ -103,7 +97,8 @@ fn studio_transfers(
     transfers
 }
 
-/// One studio step: relight both transfers to `scene` and `lighting` (never a build).
+/// One studio step, as the live preview makes it: relight both transfers to `scene` and
+/// `lighting` (never a build).
 fn step(
     pool: &rayon::ThreadPool,
     transfers: &mut SiteTransfers,
@@ -130,7 +125,7 @@ fn bench_relight_latency(c: &mut Criterion) {
         city_block(1, [RENDER_ALBEDO; 3]).unwrap(),
         city_block(1, RENDER_COLOUR).unwrap(),
     ];
-    let mut transfers = studio_transfers(&pool, &scenes[0], &params);
+    let mut transfers = studio_transfers(&pool, &scenes[0], &city_block_lighting(), &params);
     let mut group = c.benchmark_group("studio_relight_50k");
     group.sample_size(10);
     group.warm_up_time(std::time::Duration::from_millis(500));
@@ -210,7 +205,7 @@ fn bench_relight_latency(c: &mut Criterion) {
         city_block_with_proposal([RENDER_ALBEDO; 3], [RENDER_ALBEDO; 3]).unwrap(),
         city_block_with_proposal([RENDER_ALBEDO; 3], PROPOSAL_COLOUR).unwrap(),
     ];
-    let mut transfers = studio_transfers(&pool, &proposal[0], &params);
+    let mut transfers = studio_transfers(&pool, &proposal[0], &city_block_lighting(), &params);
     let mut k = 0;
     group.bench_function("proposal_colour_step", |b| {
         b.iter(|| {
@@ -253,20 +248,17 @@ fn bench_relight_latency(c: &mut Criterion) {
         }
         l
     };
-    let mut transfers = pool.install(|| {
-        SiteTransfers::build_for(&scenes[0], &clear(false), &params, &AtomicBool::new(false))
-            .unwrap()
+    let mut transfers = studio_transfers(&pool, &scenes[0], &clear(false), &params);
+    step(&pool, &mut transfers, &params, &scenes[0], &clear(true));
+    let (clear_ms, clear_cpu_ms) = timed(&mut |i| {
+        step(
+            &pool,
+            &mut transfers,
+            &params,
+            &scenes[0],
+            &clear(i % 2 == 1),
+        );
     });
-    let clear_step = |transfers: &mut SiteTransfers, flip: bool| {
-        let update = pool.install(|| {
-            transfers
-                .relight_for(&scenes[0], &clear(flip), &params)
-                .unwrap()
-        });
-        assert!(matches!(update, Some(TransferUpdate::Relit)));
-    };
-    clear_step(&mut transfers, true);
-    let (clear_ms, clear_cpu_ms) = timed(&mut |i| clear_step(&mut transfers, i % 2 == 1));
     println!("\n== studio relight ({THREADS} threads, median of 8 steps, wall / CPU) ==");
     println!("sun slider step (1° azimuth): {sun_ms:.1} ms / {sun_cpu_ms:.1} ms CPU");
     println!(
