@@ -246,38 +246,52 @@ pub(super) fn shoot(
         let mut order: Vec<usize> = (0..patches.len()).filter(|&p| score[p] > 0.0).collect();
         order.sort_by(|&a, &c| score[c].total_cmp(&score[a]).then(a.cmp(&c)));
         let mut left = unshot;
-        // The shot nodes, in shooting order.
-        let mut active: Vec<usize> = Vec::new();
+        let mut shot_now = vec![false; patches.len()];
         for &p in &order {
             if left <= 0.5 * stop.residual {
                 break;
             }
             left -= score[p];
-            let (lo, hi) = patches[p];
-            // Node values of the unshot part (leaves up), then clear the leaves.
-            for n in (lo..hi).rev() {
-                let (head, tail) = un.split_at_mut((n + 1) * stride);
-                let own = &mut head[n * stride..];
-                if let Some(e) = node_element(n) {
-                    let e = e as usize;
-                    own.copy_from_slice(&u[e * stride..(e + 1) * stride]);
-                    u[e * stride..(e + 1) * stride].fill(0.0);
-                } else {
-                    own.fill(0.0);
-                    for kid in topology.children[n].into_iter().flatten() {
-                        let kid = kid as usize;
-                        let w = topology.weight[kid];
-                        let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
-                        for (o, v) in own.iter_mut().zip(kid_vals) {
-                            *o += w * v;
+            shot_now[p] = true;
+        }
+        // Node values of the unshot part of every shot patch (leaves up), then clear its leaves;
+        // patch by patch in parallel (each writes only its own nodes and elements).
+        let active_per_patch: Vec<Vec<usize>> = patch_slices(topology, stride, &mut un, &mut u)
+            .into_par_iter()
+            .map(|(p, un, u)| {
+                if !shot_now[p] {
+                    return Vec::new();
+                }
+                let ((lo, hi), (elo, _)) = (patches[p], topology.patch_elements[p]);
+                for n in (lo..hi).rev() {
+                    let (head, tail) = un.split_at_mut((n - lo + 1) * stride);
+                    let own = &mut head[(n - lo) * stride..];
+                    if let Some(e) = node_element(n) {
+                        let e = e as usize - elo;
+                        own.copy_from_slice(&u[e * stride..(e + 1) * stride]);
+                        u[e * stride..(e + 1) * stride].fill(0.0);
+                    } else {
+                        own.fill(0.0);
+                        for kid in topology.children[n].into_iter().flatten() {
+                            let kid = kid as usize;
+                            let w = topology.weight[kid];
+                            let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
+                            for (o, v) in own.iter_mut().zip(kid_vals) {
+                                *o += w * v;
+                            }
                         }
                     }
                 }
-            }
-            active.extend(
-                (lo..hi).filter(|&n| un[n * stride..(n + 1) * stride].iter().any(|&v| v != 0.0)),
-            );
-        }
+                (lo..hi)
+                    .filter(|&n| {
+                        un[(n - lo) * stride..(n - lo + 1) * stride]
+                            .iter()
+                            .any(|&v| v != 0.0)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut active: Vec<usize> = active_per_patch.into_iter().flatten().collect();
         // Gathered in node order, so that each range task walks its arrays forwards.
         active.sort_unstable();
         let interactions: u64 = active.iter().map(|&n| rows.row_len(n)).sum();
@@ -299,29 +313,33 @@ pub(super) fn shoot(
             12 => gather_range::<12>(rows, r, &active, &un, chunk, t),
             _ => gather_range_dyn(rows, r, &active, &un, chunk, stride),
         });
-        // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot.
-        for &(lo, hi) in patches {
-            for n in lo..hi {
-                if n > lo {
-                    let parent = topology.parent[n] as usize;
-                    let (head, tail) = acc.split_at_mut(n * stride);
-                    for (d, s) in tail[..stride]
-                        .iter_mut()
-                        .zip(&head[parent * stride..(parent + 1) * stride])
-                    {
-                        *d += s;
+        // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot; patch
+        // by patch in parallel (each writes only its own nodes and elements).
+        patch_slices3(topology, stride, &mut acc, &mut b, &mut u)
+            .into_par_iter()
+            .for_each(|(p, acc, b, u)| {
+                let ((lo, hi), (elo, _)) = (patches[p], topology.patch_elements[p]);
+                for n in lo..hi {
+                    if n > lo {
+                        let parent = topology.parent[n] as usize - lo;
+                        let (head, tail) = acc.split_at_mut((n - lo) * stride);
+                        for (d, s) in tail[..stride]
+                            .iter_mut()
+                            .zip(&head[parent * stride..(parent + 1) * stride])
+                        {
+                            *d += s;
+                        }
+                    }
+                    if let Some(e) = node_element(n) {
+                        let (e, el) = (e as usize, e as usize - elo);
+                        for j in 0..stride {
+                            let db = rho[e][j % 3] * acc[(n - lo) * stride + j];
+                            b[el * stride + j] += db;
+                            u[el * stride + j] += db;
+                        }
                     }
                 }
-                if let Some(e) = node_element(n) {
-                    let e = e as usize;
-                    for j in 0..stride {
-                        let db = rho[e][j % 3] * acc[n * stride + j];
-                        b[e * stride + j] += db;
-                        u[e * stride + j] += db;
-                    }
-                }
-            }
-        }
+            });
         acc.fill(0.0);
         total = totals(&powers(&b));
         unshot_power = powers(&u);
@@ -357,6 +375,54 @@ pub(super) fn shoot(
                 .map(|e| std::array::from_fn(|c| b[e * stride + 3 * g + c]))
                 .collect();
             (values, rows)
+        })
+        .collect()
+}
+
+/// Per patch p: `(p, its nodes' values in `nodes`, its elements' values in `elements`)`, `stride`
+/// values per node and per element (nodes between patches, above them, are skipped).
+fn patch_slices<'a>(
+    topology: &Topology,
+    stride: usize,
+    nodes: &'a mut [f64],
+    elements: &'a mut [f64],
+) -> Vec<(usize, &'a mut [f64], &'a mut [f64])> {
+    let mut out = Vec::with_capacity(topology.patch_ranges.len());
+    let (mut node_rest, mut node_at) = (nodes, 0);
+    let mut element_rest = elements;
+    for (p, (&(lo, hi), &(elo, ehi))) in topology
+        .patch_ranges
+        .iter()
+        .zip(&topology.patch_elements)
+        .enumerate()
+    {
+        let (_, rest) = std::mem::take(&mut node_rest).split_at_mut((lo - node_at) * stride);
+        let (mine, rest) = rest.split_at_mut((hi - lo) * stride);
+        node_rest = rest;
+        node_at = hi;
+        let (el, rest) = std::mem::take(&mut element_rest).split_at_mut((ehi - elo) * stride);
+        element_rest = rest;
+        out.push((p, mine, el));
+    }
+    out
+}
+
+/// [`patch_slices`] with two element arrays.
+fn patch_slices3<'a>(
+    topology: &Topology,
+    stride: usize,
+    nodes: &'a mut [f64],
+    a: &'a mut [f64],
+    b: &'a mut [f64],
+) -> Vec<(usize, &'a mut [f64], &'a mut [f64], &'a mut [f64])> {
+    let mut b_rest = b;
+    patch_slices(topology, stride, nodes, a)
+        .into_iter()
+        .map(|(p, n, a)| {
+            let (elo, ehi) = topology.patch_elements[p];
+            let (mine, rest) = std::mem::take(&mut b_rest).split_at_mut((ehi - elo) * stride);
+            b_rest = rest;
+            (p, n, a, mine)
         })
         .collect()
 }

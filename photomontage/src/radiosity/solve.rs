@@ -1,6 +1,7 @@
 //! One entry point: mesh the scene, light each group directly, solve the interreflection with the
 //! chosen solver, keep every group's solution apart (they add linearly).
 
+use rayon::prelude::*;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
@@ -499,7 +500,9 @@ pub(crate) fn group_direct(
 
 /// B₀ = ρ·E_direct (+ the emission when the group owns it), per element.
 pub(crate) fn initial_exitance(mesh: &Mesh, direct: &[Rgb], emission: bool) -> Vec<Rgb> {
+    // Each element on its own: the same values on any number of threads.
     (0..mesh.elements.len())
+        .into_par_iter()
         .map(|e| {
             let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
             std::array::from_fn(|c| {

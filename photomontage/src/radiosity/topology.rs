@@ -22,6 +22,9 @@ pub(super) struct Topology {
     pub(super) children: Vec<Option<[u32; 4]>>,
     /// Per element, its mesh surface.
     pub(super) element_surface: Vec<u32>,
+    /// Per patch, its elements' range: the mesh numbers elements depth first, so each patch's
+    /// elements are contiguous and the patches' ranges follow one another in patch order.
+    pub(super) patch_elements: Vec<(usize, usize)>,
 }
 
 impl Topology {
@@ -46,11 +49,28 @@ impl Topology {
                 last[i] = kids.iter().map(|&k| last[k as usize]).max().unwrap_or(i);
             }
         }
-        let patch_ranges = mesh
+        let patch_ranges: Vec<(usize, usize)> = mesh
             .patches
             .iter()
             .map(|&p| (p as usize, last[p as usize] + 1))
             .collect();
+        let mut patch_elements: Vec<(usize, usize)> = Vec::with_capacity(mesh.patches.len());
+        for &(lo, hi) in &patch_ranges {
+            let at = patch_elements.last().map_or(0, |r| r.1);
+            let count = (lo..hi)
+                .filter(|&n| mesh.nodes[n].element.is_some())
+                .count();
+            patch_elements.push((at, at + count));
+        }
+        for (&(lo, hi), &(elo, _)) in patch_ranges.iter().zip(&patch_elements) {
+            let mut e = elo;
+            for n in lo..hi {
+                if let Some(el) = mesh.nodes[n].element {
+                    assert_eq!(el as usize, e, "mesh elements are numbered depth first");
+                    e += 1;
+                }
+            }
+        }
         let areas = (0..mesh.elements.len())
             .map(|e| mesh.element_node(e).area_m2)
             .collect();
@@ -64,6 +84,7 @@ impl Topology {
             element_surface: (0..mesh.elements.len())
                 .map(|e| mesh.element_node(e).surface)
                 .collect(),
+            patch_elements,
         }
     }
 }

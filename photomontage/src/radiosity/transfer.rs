@@ -748,7 +748,9 @@ impl Transfer {
             } else {
                 [1.0; 3]
             };
+            // Each element on its own, in parallel: the same values on any number of threads.
             let start: Vec<Rgb> = (0..b0_new.len())
+                .into_par_iter()
                 .map(|e| {
                     let (b, b0_old) = (group.radiosity_rgb[e], self.b0s[g][e]);
                     let rho_old = old_rho.as_ref().map_or(new_rho[e], |r| r[e]);
