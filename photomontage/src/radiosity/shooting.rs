@@ -407,6 +407,9 @@ fn patch_slices<'a>(
     out
 }
 
+/// A patch's index, its node values and its values in two element arrays.
+type PatchSlices3<'a> = (usize, &'a mut [f64], &'a mut [f64], &'a mut [f64]);
+
 /// [`patch_slices`] with two element arrays.
 fn patch_slices3<'a>(
     topology: &Topology,
@@ -414,7 +417,7 @@ fn patch_slices3<'a>(
     nodes: &'a mut [f64],
     a: &'a mut [f64],
     b: &'a mut [f64],
-) -> Vec<(usize, &'a mut [f64], &'a mut [f64], &'a mut [f64])> {
+) -> Vec<PatchSlices3<'a>> {
     let mut b_rest = b;
     patch_slices(topology, stride, nodes, a)
         .into_iter()
