@@ -70,6 +70,8 @@ pub(super) struct SourceRows {
     form_factor: Vec<f32>,
     /// Receiver node ranges: range r is `bounds[r]..bounds[r + 1]` (balanced by links).
     bounds: Vec<u32>,
+    /// Links per source node, all ranges.
+    row_len: Vec<u32>,
 }
 
 impl SourceRows {
@@ -129,12 +131,17 @@ impl SourceRows {
             }
         }
         let (receiver, form_factor) = pairs.into_iter().unzip();
+        let mut row_len = vec![0u32; nodes];
+        for l in links {
+            row_len[l.source as usize] += 1;
+        }
         Self {
             nodes,
             start,
             receiver,
             form_factor,
             bounds,
+            row_len,
         }
     }
 
@@ -146,9 +153,7 @@ impl SourceRows {
 
     /// Links whose source is node `n`.
     pub(super) fn row_len(&self, n: usize) -> u64 {
-        (0..RECEIVER_RANGES)
-            .map(|r| self.cut(n, r).len() as u64)
-            .sum()
+        u64::from(self.row_len[n])
     }
 }
 
@@ -181,18 +186,21 @@ pub(super) fn shoot(
     // Leaves: B and the unshot part, `stride` values per element (group-major within).
     let mut b = vec![0.0; n_el * stride];
     let mut u = vec![0.0; n_el * stride];
-    for (g, group) in groups.iter().enumerate() {
-        for e in 0..n_el {
-            let (s, o) = (group.start[e], group.old[e]);
-            for c in 0..3 {
-                b[e * stride + 3 * g + c] = s[c];
-                // Bit-equal values have nothing to pass on (D = 0 exactly, not a rounding).
-                if s[c].to_bits() != o[c].to_bits() {
-                    u[e * stride + 3 * g + c] = s[c] - o[c];
+    b.par_chunks_mut(stride)
+        .zip(u.par_chunks_mut(stride))
+        .enumerate()
+        .for_each(|(e, (b, u))| {
+            for (g, group) in groups.iter().enumerate() {
+                let (s, o) = (group.start[e], group.old[e]);
+                for c in 0..3 {
+                    b[3 * g + c] = s[c];
+                    // Bit-equal values have nothing to pass on (D = 0 exactly, not a rounding).
+                    if s[c].to_bits() != o[c].to_bits() {
+                        u[3 * g + c] = s[c] - o[c];
+                    }
                 }
             }
-        }
-    }
+        });
     // Luminance power A·|v|_Y of every element and group (`k` per element), in parallel; each
     // value is computed on its own, so the result does not depend on the thread count.
     let powers = |v: &[f64]| -> Vec<f64> {
