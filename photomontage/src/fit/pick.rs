@@ -11,11 +11,11 @@
 //! vertices have no coordinates yet are skipped. The picker is rebuilt when the site changes
 //! (the caller decides when); no subpixel snapping to polygon edges.
 
-use nalgebra::Point2;
+use nalgebra::{Point2, Point3};
 
 use super::natural_scene::natural_scene;
 use crate::bvh::BuildQuality;
-use crate::scene::{MaterialLibrary, SceneTracer};
+use crate::scene::{MaterialLibrary, SceneHit, SceneTracer};
 use crate::site::{Site, stored_camera};
 
 /// What can go wrong picking a polygon on a photo.
@@ -108,33 +108,63 @@ impl PolygonPicker {
         photo: &str,
         pixel_px: [f64; 2],
     ) -> Result<PolygonHit, PickError> {
-        let camera = stored_camera(site, photo).ok_or_else(|| PickError::NotSolved {
-            photo: photo.to_owned(),
-        })?;
-        let centre = camera.pose.camera_center_in_world;
-        let dir = camera.ray_dir_in_world(Point2::new(pixel_px[0], pixel_px[1]));
-        let ray = self
-            .tracer
-            .ray_from_world(&centre, &dir, 0.0, f32::INFINITY);
         let no_polygon = || PickError::NoPolygon {
             photo: photo.to_owned(),
             x_px: pixel_px[0],
             y_px: pixel_px[1],
         };
-        let hit = self.tracer.closest_hit(&ray).ok_or_else(no_polygon)?;
+        let hit = cast_pixel(&self.tracer, site, photo, pixel_px)
+            .ok_or_else(|| PickError::NotSolved {
+                photo: photo.to_owned(),
+            })?
+            .ok_or_else(no_polygon)?;
         let (polygon, material) = self
             .polygon_of_triangle
-            .get(hit.hit.triangle_id as usize)
+            .get(hit.hit.hit.triangle_id as usize)
             .and_then(|i| self.polygons.get(*i))
             .ok_or_else(no_polygon)?;
-        let point = self.tracer.hit_point_in_world_m(&ray, hit.hit.t);
         Ok(PolygonHit {
             polygon: polygon.clone(),
             material: material.clone(),
-            point_in_world_m: point.into(),
-            distance_m: (point - centre).norm(),
+            point_in_world_m: hit.point_in_world_m.into(),
+            distance_m: hit.distance_m,
         })
     }
+}
+
+/// What the ray through a pixel of a solved photo meets first.
+#[derive(Debug, Clone, Copy)]
+pub struct PixelHit {
+    /// The tracer's hit (triangle, material, object, distance along the ray).
+    pub hit: SceneHit,
+    /// The point hit, world frame, metres.
+    pub point_in_world_m: Point3<f64>,
+    /// Distance from the camera centre, metres.
+    pub distance_m: f64,
+}
+
+/// Casts the ray of `pixel_px` of photo `photo` of `site` into `tracer`'s scene: `None` when
+/// the photo has no solved camera, `Some(None)` when the ray meets nothing (sky). One cast for
+/// every picker (polygons here, materials in `site::material_pick`).
+#[must_use]
+pub fn cast_pixel(
+    tracer: &SceneTracer,
+    site: &Site,
+    photo: &str,
+    pixel_px: [f64; 2],
+) -> Option<Option<PixelHit>> {
+    let camera = stored_camera(site, photo)?;
+    let centre = camera.pose.camera_center_in_world;
+    let dir = camera.ray_dir_in_world(Point2::new(pixel_px[0], pixel_px[1]));
+    let ray = tracer.ray_from_world(&centre, &dir, 0.0, f32::INFINITY);
+    Some(tracer.closest_hit(&ray).map(|hit| {
+        let point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+        PixelHit {
+            hit,
+            point_in_world_m: point,
+            distance_m: (point - centre).norm(),
+        }
+    }))
 }
 
 #[cfg(test)]

@@ -12,11 +12,10 @@
 //! models, polygons or materials change. Glass and mirrors are hit like any surface (the
 //! material shown through them is not followed).
 
-use nalgebra::Point2;
-
+use super::Site;
 use super::site_scene::{ObjectSource, SiteScene};
-use super::{Site, stored_camera};
 use crate::bvh::BuildQuality;
+use crate::fit::pick::cast_pixel;
 use crate::scene::{SceneError, SceneTracer};
 
 /// What can go wrong picking a material on a photo.
@@ -87,18 +86,14 @@ impl MaterialPicker {
         photo: &str,
         pixel_px: [f64; 2],
     ) -> Result<Option<MaterialHit>, MaterialPickError> {
-        let camera = stored_camera(site, photo).ok_or_else(|| MaterialPickError::NotSolved {
-            photo: photo.to_owned(),
-        })?;
-        let centre = camera.pose.camera_center_in_world;
-        let dir = camera.ray_dir_in_world(Point2::new(pixel_px[0], pixel_px[1]));
-        let ray = self
-            .tracer
-            .ray_from_world(&centre, &dir, 0.0, f32::INFINITY);
-        let Some(hit) = self.tracer.closest_hit(&ray) else {
+        let Some(hit) = cast_pixel(&self.tracer, site, photo, pixel_px).ok_or_else(|| {
+            MaterialPickError::NotSolved {
+                photo: photo.to_owned(),
+            }
+        })?
+        else {
             return Ok(None);
         };
-        let point = self.tracer.hit_point_in_world_m(&ray, hit.hit.t);
         let name = |names: &[String], i: u32| {
             names
                 .get(i as usize)
@@ -106,10 +101,10 @@ impl MaterialPicker {
                 .unwrap_or_else(|| format!("#{i}"))
         };
         Ok(Some(MaterialHit {
-            material: name(&self.materials, hit.material.0),
-            object: name(&self.objects, hit.object.0),
-            point_in_world_m: point.into(),
-            distance_m: (point - centre).norm(),
+            material: name(&self.materials, hit.hit.material.0),
+            object: name(&self.objects, hit.hit.object.0),
+            point_in_world_m: hit.point_in_world_m.into(),
+            distance_m: hit.distance_m,
         }))
     }
 }
@@ -118,6 +113,7 @@ impl MaterialPicker {
 mod tests {
     use super::*;
     use crate::site::render::site_scene;
+    use crate::site::stored_camera;
     use nalgebra::Point3;
 
     /// The hit point is computed in f32 relative to a local origin (coordinates ≲ 20 m here,
