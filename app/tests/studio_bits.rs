@@ -31,6 +31,22 @@ fn has(h: &H, text: &str) -> bool {
     h.query_all_by_label_contains(text).next().is_some()
 }
 
+/// Steps until the Materials tab says "elevation ready", failing on "elevation failed" or
+/// after `limit_s` seconds.
+fn wait_for_elevation(h: &mut H, limit_s: u64) {
+    let start = std::time::Instant::now();
+    while !has(h, "elevation ready") {
+        assert!(!has(h, "elevation failed"), "the elevation failed");
+        assert!(
+            start.elapsed().as_secs() < limit_s,
+            "the elevation did not finish"
+        );
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    h.run();
+}
+
 fn site_of(h: &H) -> photomontage::site::Site {
     h.state().document().unwrap().site.clone()
 }
@@ -294,17 +310,7 @@ fn the_unfolded_elevation_is_drawn_on_the_worker_and_exported_as_the_cli_writes_
     click(&mut h, "Materials tab");
     click(&mut h, "Unfolded elevation");
     click(&mut h, "Draw elevation");
-    let start = std::time::Instant::now();
-    while !has(&h, "elevation ready") {
-        assert!(!has(&h, "elevation failed"), "the elevation failed");
-        assert!(
-            start.elapsed().as_secs() < 120,
-            "the elevation did not finish"
-        );
-        h.step();
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    h.run();
+    wait_for_elevation(&mut h, 120);
     assert!(h.query_by_label("unfolded elevation image").is_some());
     let out = dir.path().join("box-elevation.png");
     set_text(&mut h, "elevation PNG path", out.to_str().unwrap());
@@ -462,17 +468,7 @@ fn the_irradiance_elevation_takes_the_clis_solve_options() {
     h.get_by_label("elevation seed").set_value_accesskit(3.0);
     h.run();
     click(&mut h, "Draw elevation");
-    let start = std::time::Instant::now();
-    while !has(&h, "elevation ready") {
-        assert!(!has(&h, "elevation failed"), "the elevation failed");
-        assert!(
-            start.elapsed().as_secs() < 300,
-            "the elevation did not finish"
-        );
-        h.step();
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    h.run();
+    wait_for_elevation(&mut h, 300);
     let out = dir.path().join("box-irradiance.png");
     set_text(&mut h, "elevation PNG path", out.to_str().unwrap());
     click(&mut h, "Export elevation PNG");

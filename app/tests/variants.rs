@@ -177,12 +177,7 @@ fn variants_edited_rendered_compared_and_exported() {
     assert_eq!(variant_names(&h), ["Red box", "No box"]);
 
     // Render both on the worker.
-    {
-        let q = &mut h.state_mut().variants_panel_mut().quality;
-        q.spp_min = SPP;
-        q.spp_max = SPP;
-        q.seed = SEED;
-    }
+    set_quality(&mut h);
     // The spinner repaints while it runs: step, not run.
     h.get_by_label("Render all variants").click();
     h.step();
@@ -353,16 +348,19 @@ fn set_colour_text(h: &mut Harness<'static, Studio>, material: &str, text: &str)
 const TWO_VARIANTS: &str = "\n[[variants]]\nname = \"With box\"\nvisible_models = [\"box\"]\n\n[[variants]]\nname = \"No box\"\nvisible_models = []\n";
 
 /// Renders every variant of the solved sample at [`SPP`] and waits for them.
+/// The variant renders' quality of these tests ([`SPP`] rays, seed [`SEED`]).
+fn set_quality(h: &mut Harness<'static, Studio>) {
+    let q = &mut h.state_mut().variants_panel_mut().quality;
+    q.spp_min = SPP;
+    q.spp_max = SPP;
+    q.seed = SEED;
+}
+
 fn render_variants(h: &mut Harness<'static, Studio>) {
     h.get_by_label("Solve").click();
     step_until(h, "solve", |s| s.solution().is_some() && s.is_idle());
     click(h, "Variants tab");
-    {
-        let q = &mut h.state_mut().variants_panel_mut().quality;
-        q.spp_min = SPP;
-        q.spp_max = SPP;
-        q.seed = SEED;
-    }
+    set_quality(h);
     h.get_by_label("Render all variants").click();
     h.step();
     step_until(h, "variant renders", |s| {
