@@ -76,43 +76,53 @@ fn timed(f: &mut dyn FnMut(usize)) -> (f64, f64) {
     (median(&mut wall), median(&mut cpu))
 }
 
-/// The studio's transfers for `scene` lit by `lighting`; prints the build.
-fn studio_transfers(
-    pool: &rayon::ThreadPool,
-    scene: &Scene,
-    lighting: &TransferLighting,
-    params: &TransferParams,
-) -> SiteTransfers {
-    let t0 = Instant::now();
-    let transfers = pool.install(|| {
-        SiteTransfers::build_for(scene, lighting, params, &AtomicBool::new(false)).unwrap()
-    });
-    println!(
-        "relight latency: {} + {} elements (with / without the planned building), built in \
-         {:.1} s on {THREADS} threads",
-        transfers.with_artificial().mesh.elements.len(),
-        transfers.without_artificial().mesh.elements.len(),
-        t0.elapsed().as_secs_f64()
-    );
-    transfers
+/// The studio's two transfers and what relights them.
+struct StudioTransfers<'a> {
+    pool: &'a rayon::ThreadPool,
+    params: &'a TransferParams,
+    transfers: SiteTransfers,
 }
 
-/// One studio step, as the live preview makes it: relight both transfers to `scene` and
-/// `lighting` (never a build).
-fn step(
-    pool: &rayon::ThreadPool,
-    transfers: &mut SiteTransfers,
-    params: &TransferParams,
-    scene: &Scene,
-    lighting: &TransferLighting,
-) {
-    let update = pool.install(|| transfers.relight_for(scene, lighting, params).unwrap());
-    // Never a build: a step is a relight (or nothing, when it goes back to where it is).
-    assert!(matches!(
-        update,
-        Some(TransferUpdate::Relit | TransferUpdate::Unchanged)
-    ));
-    drop(transfers.light());
+impl<'a> StudioTransfers<'a> {
+    /// The transfers for `scene` lit by `lighting`; prints the build.
+    fn build(
+        pool: &'a rayon::ThreadPool,
+        params: &'a TransferParams,
+        scene: &Scene,
+        lighting: &TransferLighting,
+    ) -> Self {
+        let t0 = Instant::now();
+        let transfers = pool.install(|| {
+            SiteTransfers::build_for(scene, lighting, params, &AtomicBool::new(false)).unwrap()
+        });
+        println!(
+            "relight latency: {} + {} elements (with / without the planned building), built in \
+             {:.1} s on {THREADS} threads",
+            transfers.with_artificial().mesh.elements.len(),
+            transfers.without_artificial().mesh.elements.len(),
+            t0.elapsed().as_secs_f64()
+        );
+        Self {
+            pool,
+            params,
+            transfers,
+        }
+    }
+
+    /// One studio step, as the live preview makes it: relight both transfers to `scene` and
+    /// `lighting` (never a build).
+    fn step(&mut self, scene: &Scene, lighting: &TransferLighting) {
+        let (transfers, params) = (&mut self.transfers, self.params);
+        let update = self
+            .pool
+            .install(|| transfers.relight_for(scene, lighting, params).unwrap());
+        // Never a build: a step is a relight (or nothing, when it goes back to where it is).
+        assert!(matches!(
+            update,
+            Some(TransferUpdate::Relit | TransferUpdate::Unchanged)
+        ));
+        drop(transfers.light());
+    }
 }
 
 fn bench_relight_latency(c: &mut Criterion) {
@@ -125,7 +135,7 @@ fn bench_relight_latency(c: &mut Criterion) {
         city_block(1, [RENDER_ALBEDO; 3]).unwrap(),
         city_block(1, RENDER_COLOUR).unwrap(),
     ];
-    let mut transfers = studio_transfers(&pool, &scenes[0], &city_block_lighting(), &params);
+    let mut studio = StudioTransfers::build(&pool, &params, &scenes[0], &city_block_lighting());
     let mut group = c.benchmark_group("studio_relight_50k");
     group.sample_size(10);
     group.warm_up_time(std::time::Duration::from_millis(500));
@@ -134,111 +144,51 @@ fn bench_relight_latency(c: &mut Criterion) {
     group.bench_function("sun_slider_step", |b| {
         b.iter(|| {
             flip = !flip;
-            step(
-                &pool,
-                &mut transfers,
-                &params,
-                &scenes[0],
-                &sun_lighting(flip),
-            );
+            studio.step(&scenes[0], &sun_lighting(flip));
         });
     });
     // Back to the base sun, then colour steps.
-    step(
-        &pool,
-        &mut transfers,
-        &params,
-        &scenes[0],
-        &sun_lighting(false),
-    );
+    studio.step(&scenes[0], &sun_lighting(false));
     let mut k = 0;
     group.bench_function("material_colour_step", |b| {
         b.iter(|| {
             k = 1 - k;
-            step(
-                &pool,
-                &mut transfers,
-                &params,
-                &scenes[k],
-                &sun_lighting(false),
-            );
+            studio.step(&scenes[k], &sun_lighting(false));
         });
     });
     if k == 1 {
-        step(
-            &pool,
-            &mut transfers,
-            &params,
-            &scenes[0],
-            &sun_lighting(false),
-        );
+        studio.step(&scenes[0], &sun_lighting(false));
     }
     let load_before = load_average();
     let (sun_ms, sun_cpu_ms) = timed(&mut |i| {
-        step(
-            &pool,
-            &mut transfers,
-            &params,
-            &scenes[0],
-            &sun_lighting(i % 2 == 0),
-        );
+        studio.step(&scenes[0], &sun_lighting(i % 2 == 0));
     });
-    step(
-        &pool,
-        &mut transfers,
-        &params,
-        &scenes[0],
-        &sun_lighting(false),
-    );
+    studio.step(&scenes[0], &sun_lighting(false));
     let (colour_ms, colour_cpu_ms) = timed(&mut |i| {
-        step(
-            &pool,
-            &mut transfers,
-            &params,
-            &scenes[(i + 1) % 2],
-            &sun_lighting(false),
-        );
+        studio.step(&scenes[(i + 1) % 2], &sun_lighting(false));
     });
-    drop(transfers);
+    drop(studio);
     // The planned building in its own material.
     let proposal: [Scene; 2] = [
         city_block_with_proposal([RENDER_ALBEDO; 3], [RENDER_ALBEDO; 3]).unwrap(),
         city_block_with_proposal([RENDER_ALBEDO; 3], PROPOSAL_COLOUR).unwrap(),
     ];
-    let mut transfers = studio_transfers(&pool, &proposal[0], &city_block_lighting(), &params);
+    let mut studio = StudioTransfers::build(&pool, &params, &proposal[0], &city_block_lighting());
     let mut k = 0;
     group.bench_function("proposal_colour_step", |b| {
         b.iter(|| {
             k = 1 - k;
-            step(
-                &pool,
-                &mut transfers,
-                &params,
-                &proposal[k],
-                &sun_lighting(false),
-            );
+            studio.step(&proposal[k], &sun_lighting(false));
         });
     });
     group.finish();
     if k == 1 {
-        step(
-            &pool,
-            &mut transfers,
-            &params,
-            &proposal[0],
-            &sun_lighting(false),
-        );
+        studio.step(&proposal[0], &sun_lighting(false));
     }
     let (proposal_ms, proposal_cpu_ms) = timed(&mut |i| {
-        step(
-            &pool,
-            &mut transfers,
-            &params,
-            &proposal[(i + 1) % 2],
-            &sun_lighting(false),
-        );
+        studio.step(&proposal[(i + 1) % 2], &sun_lighting(false));
     });
-    drop(transfers);
+    drop(studio);
     // The sun step again under a CIE clear sky (type 12), which follows the sun: its clusters
     // are re-made and re-traced at every step (report only, no criterion group).
     let clear = |flip: bool| {
@@ -248,16 +198,10 @@ fn bench_relight_latency(c: &mut Criterion) {
         }
         l
     };
-    let mut transfers = studio_transfers(&pool, &scenes[0], &clear(false), &params);
-    step(&pool, &mut transfers, &params, &scenes[0], &clear(true));
+    let mut studio = StudioTransfers::build(&pool, &params, &scenes[0], &clear(false));
+    studio.step(&scenes[0], &clear(true));
     let (clear_ms, clear_cpu_ms) = timed(&mut |i| {
-        step(
-            &pool,
-            &mut transfers,
-            &params,
-            &scenes[0],
-            &clear(i % 2 == 1),
-        );
+        studio.step(&scenes[0], &clear(i % 2 == 1));
     });
     println!("\n== studio relight ({THREADS} threads, median of 8 steps, wall / CPU) ==");
     println!("sun slider step (1° azimuth): {sun_ms:.1} ms / {sun_cpu_ms:.1} ms CPU");

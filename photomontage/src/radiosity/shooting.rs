@@ -186,21 +186,18 @@ pub(super) fn shoot(
     // Leaves: B and the unshot part, `stride` values per element (group-major within).
     let mut b = vec![0.0; n_el * stride];
     let mut u = vec![0.0; n_el * stride];
-    b.par_chunks_mut(stride)
-        .zip(u.par_chunks_mut(stride))
-        .enumerate()
-        .for_each(|(e, (b, u))| {
-            for (g, group) in groups.iter().enumerate() {
-                let (s, o) = (group.start[e], group.old[e]);
-                for c in 0..3 {
-                    b[3 * g + c] = s[c];
-                    // Bit-equal values have nothing to pass on (D = 0 exactly, not a rounding).
-                    if s[c].to_bits() != o[c].to_bits() {
-                        u[3 * g + c] = s[c] - o[c];
-                    }
+    for (g, group) in groups.iter().enumerate() {
+        for e in 0..n_el {
+            let (s, o) = (group.start[e], group.old[e]);
+            for c in 0..3 {
+                b[e * stride + 3 * g + c] = s[c];
+                // Bit-equal values have nothing to pass on (D = 0 exactly, not a rounding).
+                if s[c].to_bits() != o[c].to_bits() {
+                    u[e * stride + 3 * g + c] = s[c] - o[c];
                 }
             }
-        });
+        }
+    }
     // Luminance power A·|v|_Y of every element and group (`k` per element), in parallel; each
     // value is computed on its own, so the result does not depend on the thread count.
     let powers = |v: &[f64]| -> Vec<f64> {
