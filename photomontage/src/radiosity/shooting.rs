@@ -12,10 +12,16 @@
 //! whose source carries unshot radiosity are read, and all light groups travel together on one
 //! read of each link.
 //!
-//! Each round shoots the patches with the most unshot power (A·|ΔB| in luminance, relative to
-//! each group's total) until what is left is at most half the stop rule's residual; a group
-//! stops when its unshot power over its total power is below the residual (a bound on what one
-//! more round would add) and its mean brightness changed by less than the stop rule's mean
+//! Each round chooses the patches it shoots by their unshot power (A·|ΔB| in luminance, relative
+//! to each group's total) per link read, best first (Southwell's greedy order, priced by what a
+//! shot costs here). A round that cannot be the last stops when what is left is at most 5 % of
+//! what it started with (or half the stop rule's residual): the weakest patches wait, and the
+//! next round's bounce usually makes them worth shooting or unnecessary. When one round can be
+//! the last (every group's unshot power, times what the previous round sent back per unit shot
+//! with a 25 % margin, is under 0.9 × the residual), it shoots just enough of each group's power
+//! to leave it there. A group stops when its unshot power over its total power is below the
+//! residual (a bound on what one more round would add) and its mean brightness changed by less
+//! than the stop rule's mean
 //! change. Rounds are sequential. Within a round the links are read in parallel, split by a
 //! fixed set of receiver-node ranges ([`RECEIVER_RANGES`], balanced by links received): the links
 //! are stored range by range, and within a range source by source ([`SourceRows`]), so each range
@@ -23,11 +29,12 @@
 //! sum runs over the shot nodes in node order and each run in receiver order, exactly as one
 //! thread would, so the result is the same bit for bit on
 //! any number of threads. A round's convergence row counts the links it read (`interactions`), the same in every
-//! group's row; its residual is the group's unshot power over its total.
+//! group's row; its residual is the group's unshot power over its total. The patches' powers
+//! are summed in the same parallel pass that pushes a round's gathers down, and the buffers are
+//! kept by the transfer between relights ([`ShootScratch`]), so a relight makes no fresh pages.
 
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
 use super::hierarchical::Link;
-use super::mesh::Mesh;
 use super::topology::Topology;
 use super::{Rgb, luminance};
 use rayon::prelude::*;
@@ -53,9 +60,6 @@ fn simd_token() -> Option<Simd> {
 fn simd_token() -> Option<Simd> {
     None
 }
-
-/// Elements per parallel task of the per-element power sums.
-const POWER_CHUNK: usize = 4096;
 
 /// The links as compressed rows per **source** node (receiver and factor), stored per receiver
 /// range: range r holds, source by source, the links whose receiver lies in
@@ -164,104 +168,156 @@ pub(super) struct ShotGroup<'a> {
     pub start: Vec<Rgb>,
 }
 
+/// The buffers of [`shoot`], kept by the transfer between relights so that a relight neither
+/// allocates nor touches a fresh page. `acc` is all zeros between calls; the others are
+/// overwritten before they are read. A clone starts empty (the buffers are refilled on use).
+#[derive(Default)]
+pub(super) struct ShootScratch {
+    /// Per element, B (`stride` values).
+    b: Vec<f64>,
+    /// Per element, the unshot part.
+    u: Vec<f64>,
+    /// Per node, the unshot values of shot nodes.
+    un: Vec<f64>,
+    /// Per node, what it gathered in the round.
+    acc: Vec<f64>,
+}
+
+impl Clone for ShootScratch {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl std::fmt::Debug for ShootScratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShootScratch")
+            .field(
+                "values",
+                &(self.b.len() + self.u.len() + self.un.len() + self.acc.len()),
+            )
+            .finish()
+    }
+}
+
+/// Per patch and group (`k` values per patch): the luminance power A·|v|_Y of its elements' B
+/// and of their unshot part.
+struct PatchPowers {
+    total: Vec<f64>,
+    unshot: Vec<f64>,
+}
+
+/// Sums, into `total` and `unshot` (`k` each), the power of one patch's elements in `b` and `u`
+/// (the patch's own slices, `stride` = 3k values per element).
+fn patch_powers(areas: &[f64], b: &[f64], u: &[f64], total: &mut [f64], unshot: &mut [f64]) {
+    let stride = 3 * total.len();
+    let power = |v: &[f64]| luminance(&[v[0].abs(), v[1].abs(), v[2].abs()]);
+    total.fill(0.0);
+    unshot.fill(0.0);
+    for ((&area, b), u) in areas
+        .iter()
+        .zip(b.chunks_exact(stride))
+        .zip(u.chunks_exact(stride))
+    {
+        for (((t, s), b), u) in total
+            .iter_mut()
+            .zip(unshot.iter_mut())
+            .zip(b.chunks_exact(3))
+            .zip(u.chunks_exact(3))
+        {
+            *t += power(b) * area;
+            *s += power(u) * area;
+        }
+    }
+}
+
+/// Per group, the sum over patches in patch order (so the same on any number of threads).
+fn group_sums(per_patch: &[f64], k: usize) -> Vec<f64> {
+    let mut out = vec![0.0; k];
+    for chunk in per_patch.chunks_exact(k) {
+        for (o, v) in out.iter_mut().zip(chunk) {
+            *o += v;
+        }
+    }
+    out
+}
+
 /// Shoots D = start − old of every group (module doc) with reflectance `rho` (per element).
 /// Returns each group's radiosity per element and its convergence rows.
 #[allow(clippy::too_many_lines)]
 pub(super) fn shoot(
-    mesh: &Mesh,
     topology: &Topology,
     rows: &SourceRows,
     rho: &[Rgb],
     groups: Vec<ShotGroup<'_>>,
     stop: &StopRule,
+    scratch: &mut ShootScratch,
 ) -> Vec<(Vec<Rgb>, Vec<ConvergenceRow>)> {
     let k = groups.len();
     let stride = 3 * k;
     let simd = simd_token();
-    let n_el = mesh.elements.len();
-    let n_nodes = mesh.nodes.len();
+    let n_el = topology.areas.len();
+    let n_nodes = topology.element.len();
     let node_element = |n: usize| topology.element[n];
     let areas = &topology.areas;
     let area_sum: f64 = areas.iter().sum();
-    // Leaves: B and the unshot part, `stride` values per element (group-major within).
-    let mut b = vec![0.0; n_el * stride];
-    let mut u = vec![0.0; n_el * stride];
-    for (g, group) in groups.iter().enumerate() {
-        for e in 0..n_el {
-            let (s, o) = (group.start[e], group.old[e]);
-            for c in 0..3 {
-                b[e * stride + 3 * g + c] = s[c];
-                // Bit-equal values have nothing to pass on (D = 0 exactly, not a rounding).
-                if s[c].to_bits() != o[c].to_bits() {
-                    u[e * stride + 3 * g + c] = s[c] - o[c];
+    let patches = &topology.patch_ranges;
+    let ShootScratch { b, u, un, acc } = scratch;
+    b.resize(n_el * stride, 0.0);
+    u.resize(n_el * stride, 0.0);
+    un.resize(n_nodes * stride, 0.0);
+    acc.resize(n_nodes * stride, 0.0);
+    // Leaves: B and the unshot part, `stride` values per element (group-major within), and the
+    // patches' powers; patch by patch in parallel.
+    let mut powers = PatchPowers {
+        total: vec![0.0; patches.len() * k],
+        unshot: vec![0.0; patches.len() * k],
+    };
+    patch_elements3(topology, stride, b, u)
+        .into_par_iter()
+        .zip(powers.total.par_chunks_mut(k))
+        .zip(powers.unshot.par_chunks_mut(k))
+        .for_each(|(((p, b, u), total), unshot)| {
+            let (elo, ehi) = topology.patch_elements[p];
+            for (i, e) in (elo..ehi).enumerate() {
+                for (g, group) in groups.iter().enumerate() {
+                    let (s, o) = (group.start[e], group.old[e]);
+                    for c in 0..3 {
+                        let j = i * stride + 3 * g + c;
+                        b[j] = s[c];
+                        // Bit-equal values have nothing to pass on (D = 0 exactly, not a
+                        // rounding).
+                        u[j] = if s[c].to_bits() == o[c].to_bits() {
+                            0.0
+                        } else {
+                            s[c] - o[c]
+                        };
+                    }
                 }
             }
-        }
-    }
-    // Luminance power A·|v|_Y of every element and group (`k` per element), in parallel; each
-    // value is computed on its own, so the result does not depend on the thread count.
-    let powers = |v: &[f64]| -> Vec<f64> {
-        let mut out = vec![0.0; n_el * k];
-        out.par_chunks_mut(k * POWER_CHUNK)
-            .enumerate()
-            .for_each(|(chunk, out)| {
-                for (i, o) in out.iter_mut().enumerate() {
-                    let (e, g) = (chunk * POWER_CHUNK + i / k, i % k);
-                    let j = e * stride + 3 * g;
-                    *o = luminance(&[v[j].abs(), v[j + 1].abs(), v[j + 2].abs()]) * areas[e];
-                }
-            });
-        out
-    };
-    let totals = |pw: &[f64]| -> Vec<f64> {
-        (0..k)
-            .map(|g| (0..n_el).map(|e| pw[e * k + g]).sum())
-            .collect()
-    };
+            patch_powers(&areas[elo..ehi], b, u, total, unshot);
+        });
     let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
-    let mut total = totals(&powers(&b));
+    let mut total = group_sums(&powers.total, k);
     let mut previous_mean: Vec<f64> = total.iter().map(|t| t / area_sum).collect();
-    let mut unshot_power = powers(&u);
-    let mut un = vec![0.0; n_nodes * stride];
-    let mut acc = vec![0.0; n_nodes * stride];
-    let patches = &topology.patch_ranges;
+    // Links read when a patch is shot (all its nodes carry unshot radiosity then).
+    let patch_links: Vec<u64> = patches
+        .iter()
+        .map(|&(lo, hi)| (lo..hi).map(|n| rows.row_len(n)).sum())
+        .collect();
+    // Per group, the unshot power a round sends back as unshot power per unit shot (measured
+    // after each round; 1 until then, so the first round is never taken for the last).
+    let mut bounce = vec![1.0; k];
     for pass in 1..=stop.max_passes {
-        // Unshot power per patch, relative to each group's total.
-        let scale: Vec<f64> = total
-            .iter()
-            .map(|&t| if t > 0.0 { 1.0 / t } else { 0.0 })
-            .collect();
-        let score: Vec<f64> = patches
-            .par_iter()
-            .map(|&(lo, hi)| {
-                (lo..hi)
-                    .filter_map(node_element)
-                    .map(|e| {
-                        (0..k)
-                            .map(|g| unshot_power[e as usize * k + g] * scale[g])
-                            .sum::<f64>()
-                    })
-                    .sum()
-            })
-            .collect();
-        let unshot: f64 = score.iter().sum();
-        if unshot <= 0.0 {
+        let unshot = group_sums(&powers.unshot, k);
+        if unshot.iter().all(|&v| v <= 0.0) {
             break;
         }
-        let mut order: Vec<usize> = (0..patches.len()).filter(|&p| score[p] > 0.0).collect();
-        order.sort_by(|&a, &c| score[c].total_cmp(&score[a]).then(a.cmp(&c)));
-        let mut left = unshot;
-        let mut shot_now = vec![false; patches.len()];
-        for &p in &order {
-            if left <= 0.5 * stop.residual {
-                break;
-            }
-            left -= score[p];
-            shot_now[p] = true;
-        }
+        let shot_now = choose_patches(&powers.unshot, &unshot, &total, &bounce, &patch_links, stop);
+        let before = powers.unshot.clone();
         // Node values of the unshot part of every shot patch (leaves up), then clear its leaves;
         // patch by patch in parallel (each writes only its own nodes and elements).
-        let active_per_patch: Vec<Vec<usize>> = patch_slices(topology, stride, &mut un, &mut u)
+        let active_per_patch: Vec<Vec<usize>> = patch_slices(topology, stride, un, u)
             .into_par_iter()
             .map(|(p, un, u)| {
                 if !shot_now[p] {
@@ -296,14 +352,15 @@ pub(super) fn shoot(
                     .collect()
             })
             .collect();
-        let mut active: Vec<usize> = active_per_patch.into_iter().flatten().collect();
-        // Gathered in node order, so that each range task walks its arrays forwards.
-        active.sort_unstable();
+        // Patches follow one another in node order, so the active nodes come out sorted: each
+        // range task walks its arrays forwards.
+        let active: Vec<usize> = active_per_patch.into_iter().flatten().collect();
+        debug_assert!(active.is_sorted());
         let interactions: u64 = active.iter().map(|&n| rows.row_len(n)).sum();
         // Each receiver range gathers on its own task; a receiver's sum runs over the shot
         // nodes in node order and each run in receiver order, as one thread would.
         let mut ranges: Vec<(usize, &mut [f64])> = Vec::with_capacity(RECEIVER_RANGES);
-        let mut rest: &mut [f64] = &mut acc;
+        let mut rest: &mut [f64] = acc;
         for r in 0..RECEIVER_RANGES {
             let (lo, hi) = (rows.bounds[r] as usize, rows.bounds[r + 1] as usize);
             let (chunk, tail) = std::mem::take(&mut rest).split_at_mut((hi - lo) * stride);
@@ -311,19 +368,23 @@ pub(super) fn shoot(
             rest = tail;
         }
         let t = simd;
+        let un: &[f64] = un;
         ranges.into_par_iter().for_each(|(r, chunk)| match stride {
-            3 => gather_range::<3>(rows, r, &active, &un, chunk, t),
-            6 => gather_range::<6>(rows, r, &active, &un, chunk, t),
-            9 => gather_range::<9>(rows, r, &active, &un, chunk, t),
-            12 => gather_range::<12>(rows, r, &active, &un, chunk, t),
-            _ => gather_range_dyn(rows, r, &active, &un, chunk, stride),
+            3 => gather_range::<3>(rows, r, &active, un, chunk, t),
+            6 => gather_range::<6>(rows, r, &active, un, chunk, t),
+            9 => gather_range::<9>(rows, r, &active, un, chunk, t),
+            12 => gather_range::<12>(rows, r, &active, un, chunk, t),
+            _ => gather_range_dyn(rows, r, &active, un, chunk, stride),
         });
-        // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot; patch
-        // by patch in parallel (each writes only its own nodes and elements).
-        patch_slices3(topology, stride, &mut acc, &mut b, &mut u)
+        // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot; then
+        // clear the patch's gathers and sum its powers. Patch by patch in parallel (each writes
+        // only its own nodes, elements and powers).
+        patch_slices3(topology, stride, acc, b, u)
             .into_par_iter()
-            .for_each(|(p, acc, b, u)| {
-                let ((lo, hi), (elo, _)) = (patches[p], topology.patch_elements[p]);
+            .zip(powers.total.par_chunks_mut(k))
+            .zip(powers.unshot.par_chunks_mut(k))
+            .for_each(|(((p, acc, b, u), total), unshot)| {
+                let ((lo, hi), (elo, ehi)) = (patches[p], topology.patch_elements[p]);
                 for n in lo..hi {
                     if n > lo {
                         let parent = topology.parent[n] as usize - lo;
@@ -344,19 +405,31 @@ pub(super) fn shoot(
                         }
                     }
                 }
+                acc.fill(0.0);
+                patch_powers(&areas[elo..ehi], b, u, total, unshot);
             });
-        acc.fill(0.0);
-        total = totals(&powers(&b));
-        unshot_power = powers(&u);
+        total = group_sums(&powers.total, k);
+        let unshot_after = group_sums(&powers.unshot, k);
         let mut all_met = true;
         for g in 0..k {
-            let unshot_g: f64 = (0..n_el).map(|e| unshot_power[e * k + g]).sum();
+            // What the round sent back, per unit it shot (the estimate for the next round).
+            let (mut shot, mut left) = (0.0, 0.0);
+            for (p, &now) in shot_now.iter().enumerate() {
+                if now {
+                    shot += before[p * k + g];
+                } else {
+                    left += before[p * k + g];
+                }
+            }
+            if shot > 0.0 {
+                bounce[g] = ((unshot_after[g] - left) / shot).clamp(0.0, 1.0);
+            }
             let mean = total[g] / area_sum;
             let row = ConvergenceRow {
                 group: groups[g].name.to_owned(),
                 pass,
                 residual: if total[g] > 0.0 {
-                    unshot_g / total[g]
+                    unshot_after[g] / total[g]
                 } else {
                     0.0
                 },
@@ -382,6 +455,103 @@ pub(super) fn shoot(
             (values, rows)
         })
         .collect()
+}
+
+/// Safety factor on a group's measured bounce when a round is planned as the last.
+const BOUNCE_MARGIN: f64 = 1.25;
+/// What a round that is not the last may leave unshot, as a fraction of what it started with.
+const EARLY_LEFT: f64 = 0.05;
+/// What a last round aims to leave unshot, as a fraction of the stop rule's residual.
+const LAST_ROUND_TARGET: f64 = 0.9;
+
+/// The patches a round shoots (module doc). `patch_unshot`: unshot power per patch and group;
+/// `unshot`, `total`: per group; `bounce`: per group, unshot power a round sends back per unit
+/// it shoots; `patch_links`: links read per patch.
+///
+/// When one round can leave every group below the residual (its unshot power times its bounce,
+/// with [`BOUNCE_MARGIN`], under [`LAST_ROUND_TARGET`] × residual), the round shoots the patches
+/// with the most of each group's still needed power per link read, until every group's need is
+/// met. Otherwise it shoots the patches with the most unshot power (relative to each group's
+/// total) per link read until what is left is at most [`EARLY_LEFT`] of what there was, or half
+/// the residual.
+fn choose_patches(
+    patch_unshot: &[f64],
+    unshot: &[f64],
+    total: &[f64],
+    bounce: &[f64],
+    patch_links: &[u64],
+    stop: &StopRule,
+) -> Vec<bool> {
+    let k = unshot.len();
+    let n = patch_links.len();
+    let scale: Vec<f64> = total
+        .iter()
+        .map(|&t| if t > 0.0 { 1.0 / t } else { 0.0 })
+        .collect();
+    let target = LAST_ROUND_TARGET * stop.residual;
+    let back: Vec<f64> = bounce
+        .iter()
+        .map(|b| (b * BOUNCE_MARGIN).min(1.0))
+        .collect();
+    let last = (0..k).all(|g| back[g] * unshot[g] * scale[g] <= target);
+    let mut shot = vec![false; n];
+    if last {
+        // Power still to shoot per group: u − s + b·s ≤ target.
+        let mut need: Vec<f64> = (0..k)
+            .map(|g| {
+                let u = unshot[g] * scale[g];
+                if u <= target {
+                    0.0
+                } else {
+                    (u - target) / (1.0 - back[g])
+                }
+            })
+            .collect();
+        let weight: Vec<f64> = need
+            .iter()
+            .map(|&v| if v > 0.0 { 1.0 / v } else { 0.0 })
+            .collect();
+        #[allow(clippy::cast_precision_loss)] // link counts far below 2^52
+        let worth: Vec<f64> = (0..n)
+            .map(|p| {
+                let gain: f64 = (0..k)
+                    .map(|g| weight[g] * patch_unshot[p * k + g] * scale[g])
+                    .sum();
+                gain / patch_links[p].max(1) as f64
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..n).filter(|&p| worth[p] > 0.0).collect();
+        order.sort_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
+        for p in order {
+            if need.iter().all(|&v| v <= 0.0) {
+                break;
+            }
+            shot[p] = true;
+            for g in 0..k {
+                need[g] -= patch_unshot[p * k + g] * scale[g];
+            }
+        }
+        return shot;
+    }
+    let score: Vec<f64> = (0..n)
+        .map(|p| (0..k).map(|g| patch_unshot[p * k + g] * scale[g]).sum())
+        .collect();
+    let mut left: f64 = score.iter().sum();
+    let keep = (EARLY_LEFT * left).max(0.5 * stop.residual);
+    #[allow(clippy::cast_precision_loss)] // link counts far below 2^52
+    let worth: Vec<f64> = (0..n)
+        .map(|p| score[p] / patch_links[p].max(1) as f64)
+        .collect();
+    let mut order: Vec<usize> = (0..n).filter(|&p| score[p] > 0.0).collect();
+    order.sort_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
+    for p in order {
+        if left <= keep {
+            break;
+        }
+        left -= score[p];
+        shot[p] = true;
+    }
+    shot
 }
 
 /// Per patch p: `(p, its nodes' values in `nodes`, its elements' values in `elements`)`, `stride`
@@ -410,6 +580,29 @@ fn patch_slices<'a>(
         out.push((p, mine, el));
     }
     out
+}
+
+/// Per patch p: `(p, its values in `a`, its values in `b`)`, two element arrays of `stride`
+/// values per element.
+fn patch_elements3<'a>(
+    topology: &Topology,
+    stride: usize,
+    a: &'a mut [f64],
+    b: &'a mut [f64],
+) -> Vec<(usize, &'a mut [f64], &'a mut [f64])> {
+    let (mut a_rest, mut b_rest) = (a, b);
+    topology
+        .patch_elements
+        .iter()
+        .enumerate()
+        .map(|(p, &(elo, ehi))| {
+            let (a, rest) = std::mem::take(&mut a_rest).split_at_mut((ehi - elo) * stride);
+            a_rest = rest;
+            let (b, rest) = std::mem::take(&mut b_rest).split_at_mut((ehi - elo) * stride);
+            b_rest = rest;
+            (p, a, b)
+        })
+        .collect()
 }
 
 /// A patch's index, its node values and its values in two element arrays.

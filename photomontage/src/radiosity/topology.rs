@@ -71,6 +71,15 @@ impl Topology {
                 }
             }
         }
+        assert_eq!(
+            patch_elements.last().map_or(0, |r| r.1),
+            mesh.elements.len(),
+            "every element lies in a patch"
+        );
+        assert!(
+            patch_ranges.windows(2).all(|w| w[0].1 <= w[1].0),
+            "patches follow one another in node order"
+        );
         let areas = (0..mesh.elements.len())
             .map(|e| mesh.element_node(e).area_m2)
             .collect();

@@ -50,7 +50,7 @@ use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_cha
 use super::form_factor::FormFactorEngine;
 use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
-use super::shooting::{ShotGroup, SourceRows, shoot};
+use super::shooting::{ShootScratch, ShotGroup, SourceRows, shoot};
 use super::solve::{GroundTerm, group_direct, initial_exitance};
 use super::sources::{self, DirectSamples, LightWarning, PointSource};
 use super::topology::Topology;
@@ -244,6 +244,8 @@ pub struct Transfer {
     rows: LinkRows,
     /// The same links by source, for [`Sweep::Shooting`].
     source_rows: SourceRows,
+    /// The shooting's buffers, kept between relights.
+    scratch: ShootScratch,
     topology: Topology,
     ground: Option<GroundTerm>,
     dome: IcosahedralDome,
@@ -481,6 +483,7 @@ impl Transfer {
             params: params.clone(),
             rows,
             source_rows,
+            scratch: ShootScratch::default(),
             topology,
             ground,
             dome,
@@ -768,7 +771,6 @@ impl Transfer {
             pending.push((g, b0_new, start));
         }
         if self.params.sweep == Sweep::Shooting && !pending.is_empty() {
-            let mesh = &self.solution.mesh;
             let shot: Vec<ShotGroup<'_>> = pending
                 .iter_mut()
                 .map(|(g, _, start)| ShotGroup {
@@ -778,12 +780,12 @@ impl Transfer {
                 })
                 .collect();
             let results = shoot(
-                mesh,
                 &self.topology,
                 &self.source_rows,
                 &new_rho,
                 shot,
                 &self.params.solve.stop,
+                &mut self.scratch,
             );
             for ((g, b0_new, _), (radiosity, rows)) in pending.into_iter().zip(results) {
                 let group = &mut self.solution.groups[g];

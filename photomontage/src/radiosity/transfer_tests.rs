@@ -308,8 +308,9 @@ fn relight_on_the_same_links_is_the_cold_solve_with(sweep: Sweep) {
 
 #[test]
 fn shooting_a_material_change_reads_only_that_materials_links_first() {
-    // Only the block is `render`: the first shooting round reads exactly the links whose source
-    // node lies on the block, far fewer than a sweep over all links.
+    // Only the block is `render`: the first shooting round reads only links whose source node
+    // lies on the block (most of them: it leaves at most 5 % of the unshot power, the patches
+    // with the least of it per link read), far fewer than a sweep over all links.
     let scene = yard([0.6; 3]);
     let mut t = build(
         &scene,
@@ -327,7 +328,12 @@ fn shooting_a_material_change_reads_only_that_materials_links_first() {
     let block_links = t.links_from_object("block");
     for g in &relit.groups {
         let first = &g.convergence[0];
-        assert_eq!(first.interactions, block_links, "{}", g.name);
+        assert!(
+            first.interactions <= block_links && 2 * first.interactions >= block_links,
+            "{}: {} of the block's {block_links}",
+            g.name,
+            first.interactions
+        );
         assert!(
             first.interactions < links / 2,
             "{} of {links}",
