@@ -189,8 +189,9 @@ fn bench_relight_latency(c: &mut Criterion) {
         studio.step(&proposal[(i + 1) % 2], &sun_lighting(false));
     });
     drop(studio);
-    // The sun step again under a CIE clear sky (type 12), which follows the sun: its clusters
-    // are re-made and re-traced at every step (report only, no criterion group).
+    // The sun step again under a CIE clear sky (type 12), which follows the sun: its direct
+    // light is summed again from the sky transfer's facets at every step (report only, no
+    // criterion group).
     let clear = |flip: bool| {
         let mut l = sun_lighting(flip);
         if let Some(sky) = l.sky.as_mut() {
@@ -214,7 +215,7 @@ fn bench_relight_latency(c: &mut Criterion) {
          {proposal_cpu_ms:.1} ms CPU"
     );
     println!(
-        "sun slider step under a CIE clear sky (type 12, re-clustered with the sun): \
+        "sun slider step under a CIE clear sky (type 12, which follows the sun): \
          {clear_ms:.1} ms / {clear_cpu_ms:.1} ms CPU"
     );
     println!(

@@ -48,10 +48,14 @@ pub mod mesh;
 pub mod progressive;
 pub mod query;
 mod shooting;
+mod sky_transfer;
 mod solve;
+mod source_rows;
 pub mod sources;
+mod sweeps;
 mod topology;
 pub mod transfer;
+pub mod transfer_lighting;
 
 #[cfg(test)]
 mod form_factor_tests;
@@ -71,7 +75,7 @@ pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning};
 pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
 pub use solve::{
-    GroupSolution, LightGroup, RadiosityDifference, Solution, SolveParams, Solver, solve,
+    GroupSolution, LightGroup, RadiosityDifference, SkyLight, Solution, SolveParams, Solver, solve,
     solve_on_mesh,
 };
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};

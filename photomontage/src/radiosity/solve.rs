@@ -10,10 +10,12 @@ use super::form_factor::{FormFactorEngine, FormFactorParams};
 use super::hierarchical::{HierarchicalParams, Hierarchy};
 use super::mesh::{Mesh, MeshParams};
 use super::progressive::RowCache;
+use super::sky_transfer::SkyTransfer;
 use super::sources::{self, DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 use super::{RadiosityError, Rgb, direct, progressive};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
+use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
 /// The interreflection solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,6 +71,21 @@ pub struct LightGroup {
     pub points: Vec<PointSource>,
     /// Whether the materials' emission belongs to this group.
     pub emission: bool,
+    /// The sky these `sources` cluster, when known: the elements' direct light then comes from
+    /// the sky transfer of this sky (module `sky_transfer`) instead of tracing the clusters,
+    /// which still light the ground below the horizon and point queries.
+    pub sky: Option<SkyLight>,
+}
+
+/// A sky as a transfer relights it: its model, the sun it follows and its weight.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkyLight {
+    /// The luminance model.
+    pub model: crate::sky::SkyModel,
+    /// Unit vector towards the sun, world frame (z up).
+    pub sun_dir_in_world: nalgebra::Vector3<f64>,
+    /// Unobstructed horizontal irradiance, per channel.
+    pub horizontal_irradiance_rgb: Rgb,
 }
 
 impl LightGroup {
@@ -83,6 +100,7 @@ impl LightGroup {
             }],
             points: Vec::new(),
             emission: false,
+            sky: None,
         }
     }
 
@@ -94,6 +112,7 @@ impl LightGroup {
             sources,
             points: Vec::new(),
             emission: false,
+            sky: None,
         }
     }
 
@@ -105,6 +124,7 @@ impl LightGroup {
             sources: Vec::new(),
             points: Vec::new(),
             emission: true,
+            sky: None,
         }
     }
 
@@ -116,6 +136,7 @@ impl LightGroup {
             sources: Vec::new(),
             points: vec![source],
             emission: false,
+            sky: None,
         }
     }
 }
@@ -333,7 +354,7 @@ pub fn solve_on_mesh(
             &group.points,
             &mesh.object_names,
         ));
-        let direct = group_direct(&engine, group, g as u64, ground.as_ref(), None)?;
+        let direct = group_direct(&engine, group, g as u64, ground.as_ref(), None, None)?;
         b0s.push(initial_exitance(&mesh, &direct, group.emission));
         directs.push(direct);
     }
@@ -470,19 +491,47 @@ const GROUND_DOME_FREQUENCIES: [u32; 2] = [4, 2];
 
 /// A group's direct irradiance per element: its distant sources (and the ground they light),
 /// its point sources. `group_index` selects the random streams; `samples`, when given, are that
-/// group's direct-light sample points drawn before (a transfer keeps them).
+/// group's direct-light sample points drawn before (a transfer keeps them). A group that knows its
+/// sky ([`LightGroup::sky`]) takes the elements' light from `sky_transfer` (a transfer keeps one),
+/// else from one traced here from the same points.
 pub(crate) fn group_direct(
     engine: &FormFactorEngine<'_>,
     group: &LightGroup,
     group_index: u64,
     ground: Option<&GroundTerm>,
     samples: Option<&sources::DirectSamples>,
+    sky_transfer: Option<&SkyTransfer>,
 ) -> Result<Vec<Rgb>, RadiosityError> {
     sources::validate(&group.name, &group.sources)?;
     sources::validate_points(&group.name, &group.points)?;
-    let mut direct = match samples {
-        Some(samples) => sources::direct_irradiance_at(engine, samples, &group.sources),
-        None => sources::direct_irradiance(engine, &group.sources, group_index),
+    let mut direct = match (&group.sky, samples) {
+        (Some(sky), _) if !group.sources.is_empty() => {
+            let owned;
+            let transfer = if let Some(t) = sky_transfer {
+                t
+            } else {
+                let drawn;
+                let samples = if let Some(s) = samples {
+                    s
+                } else {
+                    drawn = sources::DirectSamples::new(engine, group_index);
+                    &drawn
+                };
+                owned = SkyTransfer::new(
+                    engine,
+                    samples,
+                    &IcosahedralDome::new(&IcosahedralParams::tonn_donath())?,
+                );
+                &owned
+            };
+            transfer.direct(
+                &sky.model,
+                &sky.sun_dir_in_world,
+                sky.horizontal_irradiance_rgb,
+            )?
+        }
+        (_, Some(samples)) => sources::direct_irradiance_at(engine, samples, &group.sources),
+        (_, None) => sources::direct_irradiance(engine, &group.sources, group_index),
     };
     if let Some(ground) = ground {
         ground.add(&group.sources, &mut direct);

@@ -388,6 +388,7 @@ fn bad_input_and_cancel() {
         }],
         points: Vec::new(),
         emission: false,
+        sky: None,
     }];
     let err = solve(
         &scene,

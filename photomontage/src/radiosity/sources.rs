@@ -44,7 +44,7 @@ use crate::sky_dome::icosahedral::IcosahedralDome;
 pub const DIRECT_RAY_OFFSET_M: f64 = 1e-4;
 
 /// Rays toward distant sources stop here, metres (beyond any site).
-const DIRECT_RAY_LENGTH_M: f32 = 1e7;
+pub(super) const DIRECT_RAY_LENGTH_M: f32 = 1e7;
 
 /// Random stream family of direct lighting, kept apart from the form-factor pairs' streams.
 const DIRECT_SEED_SALT: u64 = 0x5EED_D1EC_7000_0000;
@@ -136,6 +136,18 @@ impl DirectSamples {
     #[must_use]
     pub fn fits(&self, elements: usize, per_element: usize) -> bool {
         self.per_element == per_element && self.points.len() == elements * per_element
+    }
+
+    /// Points per element.
+    #[must_use]
+    pub fn per_element(&self) -> usize {
+        self.per_element
+    }
+
+    /// Element `e`'s points.
+    #[must_use]
+    pub fn of_element(&self, e: usize) -> &[Point3<f64>] {
+        &self.points[e * self.per_element..(e + 1) * self.per_element]
     }
 }
 
@@ -242,6 +254,28 @@ pub fn sky_sources(
             "sky weight {horizontal_irradiance_rgb:?} must be finite and ≥ 0"
         )));
     }
+    let (flux, horizontal) = sky_leaf_flux(model, sun_dir_in_world, dome)?;
+    let (clusters, _bound) = dome.cluster(&flux, tolerance)?;
+    Ok(clusters
+        .into_iter()
+        .map(|c| DistantSource {
+            dir_in_world: c.dir_in_world,
+            normal_irradiance_rgb: horizontal_irradiance_rgb
+                .map(|k| k * c.integrated_luminance / horizontal),
+        })
+        .collect())
+}
+
+/// Each leaf's ∫L dω of the sky `model` (sun in `sun_dir_in_world`) in relative units, and the
+/// unobstructed horizontal irradiance Σ Φ_i·max(0, d_z) they give.
+///
+/// # Errors
+/// [`RadiosityError::InvalidSource`] when the model gives no light above the horizon.
+pub fn sky_leaf_flux(
+    model: &SkyModel,
+    sun_dir_in_world: &Vector3<f64>,
+    dome: &IcosahedralDome,
+) -> Result<(Vec<f64>, f64), RadiosityError> {
     let flux: Vec<f64> = dome
         .leaves
         .iter()
@@ -256,19 +290,14 @@ pub fn sky_sources(
         .map(|(f, phi)| phi * f.centre_dir_in_world.z.max(0.0))
         .sum();
     if !(horizontal.is_finite() && horizontal > 0.0) {
-        return Err(bad(format!(
-            "the sky model gives horizontal irradiance {horizontal} above the horizon"
-        )));
+        return Err(RadiosityError::InvalidSource {
+            group: "sky".into(),
+            reason: format!(
+                "the sky model gives horizontal irradiance {horizontal} above the horizon"
+            ),
+        });
     }
-    let (clusters, _bound) = dome.cluster(&flux, tolerance)?;
-    Ok(clusters
-        .into_iter()
-        .map(|c| DistantSource {
-            dir_in_world: c.dir_in_world,
-            normal_irradiance_rgb: horizontal_irradiance_rgb
-                .map(|k| k * c.integrated_luminance / horizontal),
-        })
-        .collect())
+    Ok((flux, horizontal))
 }
 
 /// The lower hemisphere as a uniform ground of the given albedo (module doc).

@@ -16,8 +16,11 @@
 //!   streams as [`super::solve`], so the direct term is the re-solve's bit for bit; the points
 //!   of the sun and sky groups are drawn once at build and kept) and then
 //!   iterates the sun group on the stored links; a sky whose luminance follows the sun (CIE
-//!   general skies, Perez) is re-clustered and re-traced as well.
-//! - **A sky type change** re-clusters the dome and re-traces the sky group's direct light.
+//!   general skies, Perez) changes as well.
+//! - **A sky change** (type, or one that follows the sun) traces nothing: the build keeps each
+//!   element's visibility of every dome facet (≈ 9°, module `sky_transfer`), so the sky's direct
+//!   light is a sum over facets per element; the dome is re-clustered (under a millisecond) for
+//!   the ground below the horizon and for point queries.
 //! - **A material's reflectance** changes ρ on its elements; every group is iterated again.
 //!
 //! Iterations start warm: B_start = B₀′ + (ρ′/ρ)·(B − B₀) per element, i.e. the previous
@@ -37,26 +40,28 @@
 //! The links keep the refinement made for the build's lighting: a sun moved far from where it
 //! was is solved on links refined for the old shadows (BF refinement is not redone; a full
 //! [`super::solve`] would refine differently, within the BF tolerance). Emission and geometry
-//! cannot change (a new scene needs a new transfer). A sky change re-traces every sky cluster
-//! (it is not an interactive-speed change for many clusters).
+//! cannot change (a new scene needs a new transfer). The sky's visibility is resolved per
+//! facet, not per cluster of the current sky (module `sky_transfer`).
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_change};
+use super::convergence::ConvergenceRow;
 use super::form_factor::FormFactorEngine;
 use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
-use super::shooting::{ShootScratch, ShotGroup, SourceRows, shoot};
+use super::shooting::{ShootScratch, ShotGroup, shoot};
+use super::sky_transfer::SkyTransfer;
 use super::solve::{GroundTerm, group_direct, initial_exitance};
-use super::sources::{self, DirectSamples, LightWarning, PointSource};
+use super::source_rows::SourceRows;
+use super::sources::{self, DirectSamples, LightWarning};
+use super::sweeps::{LinkRows, iterate};
 use super::topology::Topology;
-use super::{
-    GroupSolution, LightGroup, RadiosityError, Rgb, Solution, SolveParams, Solver, luminance,
-};
+use super::transfer_lighting::check_rgb;
+pub use super::transfer_lighting::{LightingChange, NamedLuminaire, Sky, Sun, TransferLighting};
+use super::{GroupSolution, LightGroup, RadiosityError, Rgb, Solution, SolveParams, Solver};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
 use crate::sky::SkyModel;
@@ -70,61 +75,6 @@ use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 pub const RELIGHT_L1_REL_TOL: f64 = 0.02;
 /// The mean brightness of a relit solution against a fresh solve: within the stop rule's 1 %.
 pub const RELIGHT_MEAN_REL_TOL: f64 = 0.01;
-
-/// The sun as a distant source.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sun {
-    /// Unit vector towards the sun, world frame (z up).
-    pub dir_in_world: Vector3<f64>,
-    /// Irradiance on a plane facing the sun, per channel.
-    pub normal_irradiance_rgb: Rgb,
-}
-
-/// The sky: a luminance model scaled to a horizontal irradiance.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sky {
-    /// Any sky model of [`crate::sky`] (uniform, CIE overcast, CIE general 1–15, Perez).
-    pub model: SkyModel,
-    /// Unobstructed horizontal irradiance of the sky, per channel (the site's `sky_weight`).
-    pub horizontal_irradiance_rgb: Rgb,
-}
-
-/// A luminaire (or isotropic point light) with its dimming factor.
-#[derive(Debug, Clone, PartialEq)]
-pub struct NamedLuminaire {
-    /// Group name (`luminaire:ID` in the CLI).
-    pub name: String,
-    /// The source at full output.
-    pub source: PointSource,
-    /// Output factor, ≥ 0 (1 = full).
-    pub dimming: f64,
-}
-
-/// The lighting a transfer is built for and relit to.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TransferLighting {
-    /// The sun, `None` when there is none.
-    pub sun: Option<Sun>,
-    /// The sky, `None` when there is none.
-    pub sky: Option<Sky>,
-    /// Luminaires, one light group each.
-    pub luminaires: Vec<NamedLuminaire>,
-    /// Whether the emitting materials form a group.
-    pub emitters: bool,
-}
-
-/// What [`Transfer::relight`] changes; `None`/empty fields keep the current value.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LightingChange {
-    /// A new sun (`Some(None)` switches it off).
-    pub sun: Option<Option<Sun>>,
-    /// A new sky (`Some(None)` switches it off).
-    pub sky: Option<Option<Sky>>,
-    /// New dimming factors by luminaire name.
-    pub luminaire_dimming: Vec<(String, f64)>,
-    /// New diffuse reflectance (RGB, each in [0, 1]) by material name.
-    pub material_reflectance: Vec<(String, Rgb)>,
-}
 
 /// How a relight re-solves (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -191,51 +141,6 @@ enum Action {
     Retrace,
 }
 
-/// The links as compressed rows per receiver node.
-#[derive(Debug, Clone)]
-struct LinkRows {
-    /// Row of node n: `start[n]..start[n + 1]`.
-    start: Vec<u32>,
-    source: Vec<u32>,
-    form_factor: Vec<f32>,
-}
-
-impl LinkRows {
-    #[allow(clippy::cast_possible_truncation)] // at most `max_links` (5·10⁶) links
-    fn new(nodes: usize, hierarchy: &Hierarchy) -> Self {
-        let mut start = vec![0u32; nodes + 1];
-        for l in &hierarchy.links {
-            start[l.receiver as usize + 1] += 1;
-        }
-        for n in 0..nodes {
-            start[n + 1] += start[n];
-        }
-        // Links are sorted by receiver (stable): rows keep the hierarchy's order.
-        Self {
-            start,
-            source: hierarchy.links.iter().map(|l| l.source).collect(),
-            form_factor: hierarchy
-                .links
-                .iter()
-                .map(|l| l.form_factor as f32)
-                .collect(),
-        }
-    }
-
-    fn gather(&self, n: usize, b: &[Rgb]) -> Rgb {
-        let mut g = [0.0; 3];
-        let (lo, hi) = (self.start[n] as usize, self.start[n + 1] as usize);
-        for (s, f) in self.source[lo..hi].iter().zip(&self.form_factor[lo..hi]) {
-            let bs = &b[*s as usize];
-            let f = f64::from(*f);
-            for c in 0..3 {
-                g[c] += f * bs[c];
-            }
-        }
-        g
-    }
-}
-
 /// The geometry-dependent part of a radiosity solution, and the current lighting on it.
 #[derive(Debug, Clone)]
 pub struct Transfer {
@@ -261,6 +166,8 @@ pub struct Transfer {
     /// Per group whose distant sources a relight re-traces (sun, sky), its direct-light sample
     /// points, drawn once.
     direct_samples: Vec<Option<Arc<DirectSamples>>>,
+    /// The sky's visibility per element and dome facet: a sky change is a sum, not a trace.
+    sky_transfer: SkyTransfer,
     solution: Solution,
 }
 
@@ -279,111 +186,6 @@ fn ratio(new: Rgb, old: Rgb) -> Option<Rgb> {
         }
     }
     Some(k)
-}
-
-fn check_rgb(name: &str, what: &str, rgb: Rgb, max: f64) -> Result<(), RadiosityError> {
-    if rgb.iter().all(|v| v.is_finite() && *v >= 0.0 && *v <= max) {
-        Ok(())
-    } else {
-        Err(RadiosityError::InvalidSource {
-            group: name.to_owned(),
-            reason: format!("{what} {rgb:?} must be finite and in [0, {max}]"),
-        })
-    }
-}
-
-impl TransferLighting {
-    /// The light groups in transfer order: sun, sky, each luminaire, emitters (sun and sky are
-    /// always present, empty when off), with the warnings of the sun's position.
-    ///
-    /// # Errors
-    /// Invalid sources, sky models without light.
-    pub fn light_groups(
-        &self,
-        dome: &IcosahedralDome,
-        sky_tolerance: f64,
-    ) -> Result<(Vec<LightGroup>, Vec<LightWarning>), RadiosityError> {
-        let mut warnings = Vec::new();
-        let sun_group = self.sun_group(&mut warnings)?;
-        let mut groups = vec![sun_group, self.sky_group(dome, sky_tolerance)?];
-        for l in &self.luminaires {
-            groups.push(luminaire_group(l)?);
-        }
-        if self.emitters {
-            groups.push(LightGroup::emitters());
-        }
-        Ok((groups, warnings))
-    }
-
-    fn sun_group(&self, warnings: &mut Vec<LightWarning>) -> Result<LightGroup, RadiosityError> {
-        let mut group = LightGroup::sun(Vector3::z(), [0.0; 3]);
-        group.sources.clear();
-        if let Some(sun) = &self.sun {
-            check_rgb(
-                "sun",
-                "normal irradiance",
-                sun.normal_irradiance_rgb,
-                f64::MAX,
-            )?;
-            let norm = sun.dir_in_world.norm();
-            if !(norm.is_finite() && (norm - 1.0).abs() < 1e-6) {
-                return Err(RadiosityError::InvalidSource {
-                    group: "sun".into(),
-                    reason: format!("direction {:?} is not a unit vector", sun.dir_in_world),
-                });
-            }
-            if sun.dir_in_world.z <= 0.0 {
-                warnings.push(LightWarning::SunBelowHorizon {
-                    elevation_deg: sun.dir_in_world.z.clamp(-1.0, 1.0).asin().to_degrees(),
-                });
-            } else {
-                group = LightGroup::sun(sun.dir_in_world, sun.normal_irradiance_rgb);
-            }
-        }
-        Ok(group)
-    }
-
-    fn sky_group(
-        &self,
-        dome: &IcosahedralDome,
-        tolerance: f64,
-    ) -> Result<LightGroup, RadiosityError> {
-        let Some(sky) = &self.sky else {
-            return Ok(LightGroup::sky(Vec::new()));
-        };
-        check_rgb(
-            "sky",
-            "horizontal irradiance",
-            sky.horizontal_irradiance_rgb,
-            f64::MAX,
-        )?;
-        if sky.horizontal_irradiance_rgb.iter().all(|&v| v == 0.0) {
-            return Ok(LightGroup::sky(Vec::new()));
-        }
-        let sun_dir = self
-            .sun
-            .as_ref()
-            .map_or_else(Vector3::z, |s| s.dir_in_world);
-        Ok(LightGroup::sky(sources::sky_sources(
-            &sky.model,
-            &sun_dir,
-            sky.horizontal_irradiance_rgb,
-            dome,
-            tolerance,
-        )?))
-    }
-}
-
-fn luminaire_group(l: &NamedLuminaire) -> Result<LightGroup, RadiosityError> {
-    if !(l.dimming.is_finite() && l.dimming >= 0.0) {
-        return Err(RadiosityError::InvalidSource {
-            group: l.name.clone(),
-            reason: format!("dimming {} must be finite and ≥ 0", l.dimming),
-        });
-    }
-    let mut source = l.source.clone();
-    source.intensity_rgb = source.intensity_rgb.map(|v| v * l.dimming);
-    Ok(LightGroup::luminaire(&l.name, source))
 }
 
 impl Transfer {
@@ -425,6 +227,14 @@ impl Transfer {
         let direct_samples: Vec<Option<Arc<DirectSamples>>> = (0..groups.len())
             .map(|g| (g < 2).then(|| Arc::new(DirectSamples::new(&engine, g as u64))))
             .collect();
+        // Group 1's sample points (the sky's) are where the sky transfer looks from.
+        let sky_transfer = SkyTransfer::new(
+            &engine,
+            direct_samples[1]
+                .as_deref()
+                .unwrap_or_else(|| unreachable!("the sky group has sample points")),
+            &dome,
+        );
         for (g, group) in groups.iter().enumerate() {
             warnings.extend(sources::check_point_sources(
                 &tracer,
@@ -438,6 +248,7 @@ impl Transfer {
                 g as u64,
                 ground.as_ref(),
                 direct_samples[g].as_deref(),
+                Some(&sky_transfer),
             )?;
             b0s.push(initial_exitance(&mesh, &direct, group.emission));
             directs.push(direct);
@@ -494,6 +305,7 @@ impl Transfer {
             groups,
             b0s,
             direct_samples,
+            sky_transfer,
             solution: Solution {
                 mesh: Arc::new(mesh),
                 groups: solved,
@@ -682,6 +494,7 @@ impl Transfer {
                         g as u64,
                         self.ground.as_ref(),
                         self.direct_samples.get(g).and_then(Option::as_deref),
+                        Some(&self.sky_transfer),
                     )?);
                 }
             }
@@ -836,136 +649,5 @@ impl Transfer {
             .iter()
             .map(|&s| surfaces[s as usize].reflectance_rgb)
             .collect()
-    }
-}
-
-/// Iterates B = B₀ + ρ·F·B on the stored links from `start` (per element) until the stop rule
-/// holds (its mean change measured from the start). Returns the leaves and the rows.
-#[allow(clippy::too_many_arguments)]
-fn iterate(
-    mesh: &Mesh,
-    rows: &LinkRows,
-    topology: &Topology,
-    rho: &[Rgb],
-    b0: &[Rgb],
-    start: &[Rgb],
-    group: &str,
-    stop: &StopRule,
-    sweep: Sweep,
-) -> (Vec<Rgb>, Vec<ConvergenceRow>) {
-    /// Receivers gathered per parallel task of a Jacobi sweep (fixed, so the split does not
-    /// depend on the thread count).
-    const JACOBI_CHUNK: usize = 4096;
-    let areas = &topology.areas;
-    let mut previous_mean = Some(mean_brightness(start, areas));
-    let mut b = vec![[0.0; 3]; mesh.nodes.len()];
-    for (e, &node) in mesh.elements.iter().enumerate() {
-        b[node as usize] = start[e];
-    }
-    pull_all(mesh, topology, &mut b);
-    let mut out_rows = Vec::new();
-    let mut acc = vec![[0.0; 3]; mesh.nodes.len()];
-    let leaves = |b: &[Rgb]| -> Vec<Rgb> { mesh.elements.iter().map(|&n| b[n as usize]).collect() };
-    for pass in 1..=stop.max_passes {
-        let update = match sweep {
-            // (Shooting relights do not come here; a full sweep is its fallback.)
-            Sweep::GaussSeidel | Sweep::Shooting => {
-                let mut update = 0.0;
-                for &(lo, hi) in &topology.patch_ranges {
-                    for (n, a) in acc.iter_mut().enumerate().take(hi).skip(lo) {
-                        *a = rows.gather(n, &b);
-                    }
-                    update += push_pull(topology, rho, b0, &mut acc, &mut b, lo, hi);
-                }
-                update
-            }
-            Sweep::Jacobi => {
-                acc.par_chunks_mut(JACOBI_CHUNK)
-                    .enumerate()
-                    .for_each(|(chunk, out)| {
-                        for (i, a) in out.iter_mut().enumerate() {
-                            *a = rows.gather(chunk * JACOBI_CHUNK + i, &b);
-                        }
-                    });
-                let mut update = 0.0;
-                for &(lo, hi) in &topology.patch_ranges {
-                    update += push_pull(topology, rho, b0, &mut acc, &mut b, lo, hi);
-                }
-                update
-            }
-        };
-        let now = leaves(&b);
-        let mean = mean_brightness(&now, areas);
-        let total: f64 = now.iter().zip(areas).map(|(v, a)| luminance(v) * a).sum();
-        let row = ConvergenceRow {
-            group: group.to_owned(),
-            pass,
-            residual: if total > 0.0 { update / total } else { 0.0 },
-            mean_change: relative_change(previous_mean, mean),
-            mean_brightness: mean,
-            interactions: rows.source.len() as u64,
-        };
-        previous_mean = Some(mean);
-        let done = stop.met(&row) || mean <= 0.0;
-        out_rows.push(row);
-        if done {
-            return (now, out_rows);
-        }
-    }
-    (leaves(&b), out_rows)
-}
-
-/// Push (gathered values down to the leaves, B = B₀ + ρ·G) and pull (area-weighted means up)
-/// over the subtree in nodes `lo..hi` (pre-order); `acc` holds each node's own gather on entry.
-/// Returns Σ A·|ΔB|_Y over its leaves.
-fn push_pull(
-    topology: &Topology,
-    rho: &[Rgb],
-    b0: &[Rgb],
-    acc: &mut [Rgb],
-    b: &mut [Rgb],
-    lo: usize,
-    hi: usize,
-) -> f64 {
-    let mut update = 0.0;
-    for n in lo..hi {
-        if n > lo {
-            let down = acc[topology.parent[n] as usize];
-            for c in 0..3 {
-                acc[n][c] += down[c];
-            }
-        }
-        if let Some(e) = topology.element[n] {
-            let e = e as usize;
-            let v: Rgb = std::array::from_fn(|c| b0[e][c] + rho[e][c] * acc[n][c]);
-            let diff: Rgb = std::array::from_fn(|c| (v[c] - b[n][c]).abs());
-            update += luminance(&diff) * topology.areas[e];
-            b[n] = v;
-        }
-    }
-    for n in (lo..hi).rev() {
-        pull_node(topology, n, b);
-    }
-    update
-}
-
-/// An inner node takes the area-weighted mean of its children.
-fn pull_node(topology: &Topology, n: usize, b: &mut [Rgb]) {
-    if let Some(kids) = topology.children[n] {
-        let mut sum = [0.0; 3];
-        for k in kids {
-            let w = topology.weight[k as usize];
-            for c in 0..3 {
-                sum[c] += w * b[k as usize][c];
-            }
-        }
-        b[n] = sum;
-    }
-}
-
-/// Inner nodes take the area-weighted mean of their children (leaves already set).
-fn pull_all(mesh: &Mesh, topology: &Topology, b: &mut [Rgb]) {
-    for n in (0..mesh.nodes.len()).rev() {
-        pull_node(topology, n, b);
     }
 }

@@ -1,0 +1,304 @@
+//! The links stored by source for ΔB shooting ([`super::shooting`]), and the gather that reads
+//! them: the links are split at a fixed set of receiver-node ranges ([`RECEIVER_RANGES`],
+//! balanced by links received) and stored range by range, and within a range source by source,
+//! so each range is one task that walks its own arrays forwards and writes only its own
+//! receivers. A receiver's sum runs over the shot nodes in node order and each run in receiver
+//! order, exactly as one thread would, so the result is the same bit for bit on any number of
+//! threads. With AVX2 the same sums run in the vector kernel of [`super::gather_avx2`].
+
+use super::hierarchical::Link;
+/// Receiver ranges of a shooting round: the links of every source row are split at the same
+/// receiver-node boundaries, and each range is accumulated by one task. Fixed, so the result
+/// does not depend on the thread count.
+pub(super) const RECEIVER_RANGES: usize = 16;
+
+/// The vector kernel's token where the CPU has one.
+#[cfg(target_arch = "x86_64")]
+pub(super) type Simd = super::gather_avx2::Token;
+/// No vector kernel off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+pub(super) type Simd = ();
+
+#[cfg(target_arch = "x86_64")]
+pub(super) fn simd_token() -> Option<Simd> {
+    Simd::new()
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+pub(super) fn simd_token() -> Option<Simd> {
+    None
+}
+
+/// The links as compressed rows per **source** node (receiver and factor), stored per receiver
+/// range: range r holds, source by source, the links whose receiver lies in
+/// `bounds[r]..bounds[r + 1]`, each source's run sorted by receiver. A range's task so reads its
+/// own contiguous arrays in source order, with no cut of a long row to look up per source.
+#[derive(Debug, Clone)]
+pub(super) struct SourceRows {
+    nodes: usize,
+    /// Run of source n in range r: `start[r·(nodes+1) + n]..start[r·(nodes+1) + n + 1]`.
+    start: Vec<u32>,
+    receiver: Vec<u32>,
+    form_factor: Vec<f32>,
+    /// Receiver node ranges: range r is `bounds[r]..bounds[r + 1]` (balanced by links).
+    pub(super) bounds: Vec<u32>,
+    /// Links per source node, all ranges.
+    row_len: Vec<u32>,
+}
+
+impl SourceRows {
+    /// Transposes `links` (any order; each source's run is sorted by receiver, stably).
+    #[allow(clippy::cast_possible_truncation)] // at most `max_links` links, node ids are u32
+    pub(super) fn new(nodes: usize, links: &[Link]) -> Self {
+        let mut into = vec![0u64; nodes];
+        for l in links {
+            into[l.receiver as usize] += 1;
+        }
+        // Range boundaries at equal shares of the links received.
+        let total: u64 = into.iter().sum();
+        let mut bounds = vec![0u32; RECEIVER_RANGES + 1];
+        let mut seen = 0u64;
+        let mut r = 1;
+        for (n, &k) in into.iter().enumerate() {
+            while r < RECEIVER_RANGES && seen * RECEIVER_RANGES as u64 >= r as u64 * total {
+                bounds[r] = n as u32;
+                r += 1;
+            }
+            seen += k;
+        }
+        for b in &mut bounds[r..] {
+            *b = nodes as u32;
+        }
+        let range_of = |receiver: u32| bounds[1..].partition_point(|&b| b <= receiver);
+        let width = nodes + 1;
+        let mut start = vec![0u32; RECEIVER_RANGES * width];
+        for l in links {
+            start[range_of(l.receiver) * width + l.source as usize + 1] += 1;
+        }
+        // One prefix sum over range-major (range, source) runs.
+        let mut acc = 0u32;
+        for r in 0..RECEIVER_RANGES {
+            let row = &mut start[r * width..(r + 1) * width];
+            row[0] = acc;
+            for n in 0..nodes {
+                acc += row[n + 1];
+                row[n + 1] = acc;
+            }
+        }
+        let mut next: Vec<u32> = (0..RECEIVER_RANGES * width).map(|i| start[i]).collect();
+        let mut pairs = vec![(0u32, 0f32); links.len()];
+        for l in links {
+            let at = range_of(l.receiver) * width + l.source as usize;
+            let i = next[at] as usize;
+            next[at] += 1;
+            pairs[i] = (l.receiver, l.form_factor as f32);
+        }
+        for r in 0..RECEIVER_RANGES {
+            for n in 0..nodes {
+                let (a, z) = (
+                    start[r * width + n] as usize,
+                    start[r * width + n + 1] as usize,
+                );
+                pairs[a..z].sort_by_key(|&(rcv, _)| rcv);
+            }
+        }
+        let (receiver, form_factor) = pairs.into_iter().unzip();
+        let mut row_len = vec![0u32; nodes];
+        for l in links {
+            row_len[l.source as usize] += 1;
+        }
+        Self {
+            nodes,
+            start,
+            receiver,
+            form_factor,
+            bounds,
+            row_len,
+        }
+    }
+
+    /// The links of node `n`'s row into receiver range `r`.
+    fn cut(&self, n: usize, r: usize) -> std::ops::Range<usize> {
+        let i = r * (self.nodes + 1) + n;
+        self.start[i] as usize..self.start[i + 1] as usize
+    }
+
+    /// Links whose source is node `n`.
+    pub(super) fn row_len(&self, n: usize) -> u64 {
+        u64::from(self.row_len[n])
+    }
+}
+
+/// Receiver range `r` gathers the unshot values `un` (`S` per node) of the `active` nodes
+/// through their links into `acc` (the range's nodes, `S` per node): a receiver's sum runs over
+/// `active` in order and each row in receiver order. With an AVX2 `token` the same sums run in
+/// the vector kernel (bit for bit the same).
+pub(super) fn gather_range<const S: usize>(
+    rows: &SourceRows,
+    r: usize,
+    active: &[usize],
+    un: &[f64],
+    acc: &mut [f64],
+    token: Option<Simd>,
+) {
+    let base = rows.bounds[r] as usize;
+    for &n in active {
+        let src: &[f64; S] = un[n * S..(n + 1) * S]
+            .try_into()
+            .unwrap_or_else(|_| unreachable!("S values per node"));
+        let links = rows.cut(n, r);
+        let (receivers, factors) = (&rows.receiver[links.clone()], &rows.form_factor[links]);
+        #[cfg(target_arch = "x86_64")]
+        if let Some(token) = token {
+            token.gather_run::<S>(src, receivers, factors, base, acc);
+            continue;
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = token;
+        for (rcv, f) in receivers.iter().zip(factors) {
+            let f = f64::from(*f);
+            let at = (*rcv as usize - base) * S;
+            let dst: &mut [f64; S] = (&mut acc[at..at + S])
+                .try_into()
+                .unwrap_or_else(|_| unreachable!("S values per node"));
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d += f * s;
+            }
+        }
+    }
+}
+
+/// [`gather_range`] for any number of values per node.
+pub(super) fn gather_range_dyn(
+    rows: &SourceRows,
+    r: usize,
+    active: &[usize],
+    un: &[f64],
+    acc: &mut [f64],
+    stride: usize,
+) {
+    let base = rows.bounds[r] as usize;
+    for &n in active {
+        let src = &un[n * stride..(n + 1) * stride];
+        let links = rows.cut(n, r);
+        for (rcv, f) in rows.receiver[links.clone()]
+            .iter()
+            .zip(&rows.form_factor[links])
+        {
+            let f = f64::from(*f);
+            let at = (*rcv as usize - base) * stride;
+            for (d, s) in acc[at..at + stride].iter_mut().zip(src) {
+                *d += f * s;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every link lands in exactly one receiver range, the one holding its receiver; each
+    /// source's links in a range are sorted by receiver; a source's runs over all ranges are its
+    /// links; the ranges tile the nodes and the runs tile the arrays in (range, source) order.
+    #[test]
+    fn receiver_ranges_partition_every_row() {
+        let nodes = 997;
+        let mut state = 12_345u64;
+        let mut next = |m: u64| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) % m
+        };
+        #[allow(clippy::cast_possible_truncation)]
+        let links: Vec<Link> = (0..20_000)
+            .map(|_| Link {
+                receiver: next(nodes) as u32,
+                source: next(nodes) as u32,
+                form_factor: 0.001,
+            })
+            .collect();
+        let rows = SourceRows::new(nodes as usize, &links);
+        assert_eq!(rows.bounds[0], 0);
+        assert_eq!(rows.bounds[RECEIVER_RANGES] as usize, nodes as usize);
+        assert!(rows.bounds.windows(2).all(|w| w[0] <= w[1]));
+        let mut at = 0;
+        for r in 0..RECEIVER_RANGES {
+            for n in 0..nodes as usize {
+                let cut = rows.cut(n, r);
+                assert_eq!(
+                    cut.start, at,
+                    "runs tile the arrays in (range, source) order"
+                );
+                at = cut.end;
+            }
+        }
+        assert_eq!(at, links.len());
+        for n in 0..nodes as usize {
+            let mut expected: Vec<u32> = links
+                .iter()
+                .filter(|l| l.source as usize == n)
+                .map(|l| l.receiver)
+                .collect();
+            expected.sort_unstable();
+            let mut got = Vec::new();
+            for r in 0..RECEIVER_RANGES {
+                let run = &rows.receiver[rows.cut(n, r)];
+                assert!(run.windows(2).all(|w| w[0] <= w[1]));
+                let (lo, hi) = (rows.bounds[r], rows.bounds[r + 1]);
+                assert!(run.iter().all(|&x| lo <= x && x < hi));
+                got.extend_from_slice(run);
+            }
+            assert_eq!(got, expected, "row of node {n}");
+            assert_eq!(rows.row_len(n), expected.len() as u64);
+        }
+        // Balanced: no range holds more than twice its share of the links.
+        let share = links.len() / RECEIVER_RANGES;
+        for r in 0..RECEIVER_RANGES {
+            let k: usize = (0..nodes as usize).map(|n| rows.cut(n, r).len()).sum();
+            assert!(k <= 2 * share, "range {r} holds {k} links, share {share}");
+        }
+    }
+
+    /// The AVX2 kernel gives the portable loop's sums bit for bit, for every stride the
+    /// shooting uses.
+    #[test]
+    fn vector_gather_equals_the_portable_loop() {
+        fn check<const S: usize>(rows: &SourceRows, nodes: usize, token: Simd) {
+            #[allow(clippy::cast_precision_loss)]
+            let un: Vec<f64> = (0..nodes * S)
+                .map(|i| ((i * 7919 % 1000) as f64 - 500.0) * 1.37e-3)
+                .collect();
+            let active: Vec<usize> = (0..nodes).filter(|n| n % 3 != 1).collect();
+            for r in 0..RECEIVER_RANGES {
+                let width = (rows.bounds[r + 1] - rows.bounds[r]) as usize * S;
+                let (mut a, mut b) = (vec![0.25; width], vec![0.25; width]);
+                gather_range::<S>(rows, r, &active, &un, &mut a, None);
+                gather_range::<S>(rows, r, &active, &un, &mut b, Some(token));
+                assert!(
+                    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "S = {S}, range {r}"
+                );
+            }
+        }
+        let Some(token) = simd_token() else {
+            eprintln!("notice: this CPU has no vector kernel; nothing to compare");
+            return;
+        };
+        let nodes = 301;
+        #[allow(clippy::cast_possible_truncation)]
+        let links: Vec<Link> = (0..6000u64)
+            .map(|i| Link {
+                receiver: (i * 2_654_435_761 % nodes) as u32,
+                source: (i * 40_503 % nodes) as u32,
+                form_factor: 1e-4 * (1 + i % 97) as f64,
+            })
+            .collect();
+        let rows = SourceRows::new(nodes as usize, &links);
+        check::<3>(&rows, nodes as usize, token);
+        check::<6>(&rows, nodes as usize, token);
+        check::<9>(&rows, nodes as usize, token);
+        check::<12>(&rows, nodes as usize, token);
+    }
+}
