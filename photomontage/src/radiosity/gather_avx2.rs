@@ -1,18 +1,18 @@
 //! AVX2 kernel of the shooting gather ([`super::shooting`]) for x86-64, selected at run time
 //! (`is_x86_feature_detected!`): per link, the `S` unshot values of the source (kept in
-//! registers for the source's whole run) times the factor, added to the receiver's `S`
-//! accumulators four (then two, then one) at a time. Each lane does the same separate multiply
+//! registers for the source's whole run) times the factor, added to the receiver's `S` `f32`
+//! accumulators eight (then four, then one) at a time. Each lane does the same separate multiply
 //! and add as the portable loop (no FMA), so the sums are the same bit for bit; the kernel only
 //! does fewer instructions per link.
 //!
 //! # Known limitations
-//! x86-64 only (other targets take the portable loop); no gain for `S` < 4 beyond the paired
-//! lanes.
+//! x86-64 only (other targets take the portable loop); no gain for `S` < 4; at most 12 values
+//! stay in registers (the shooting's strides are 3, 6, 9 and 12).
 #![allow(unsafe_code)] // std::arch loads and stores, and the call of a `target_feature` function.
 
 use std::arch::x86_64::{
-    __m256d, _mm_add_pd, _mm_loadu_pd, _mm_mul_pd, _mm_set1_pd, _mm_storeu_pd, _mm256_add_pd,
-    _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+    _mm_add_ps, _mm_loadu_ps, _mm_mul_ps, _mm_set1_ps, _mm_storeu_ps, _mm256_add_ps,
+    _mm256_loadu_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps,
 };
 
 /// Proof that this CPU has AVX2: only [`Token::new`] makes one, after checking.
@@ -30,59 +30,53 @@ impl Token {
     #[inline]
     pub fn gather_run<const S: usize>(
         self,
-        src: &[f64; S],
+        src: &[f32; S],
         receivers: &[u32],
         factors: &[f32],
         base: usize,
-        acc: &mut [f64],
+        acc: &mut [f32],
     ) {
         // SAFETY: a `Token` exists only if the CPU has AVX2 (`Token::new`).
         unsafe { gather_run_impl::<S>(src, receivers, factors, base, acc) }
     }
 }
 
-/// Vectors of four source values kept in registers (at most three, S ≤ 12).
-const MAX_QUADS: usize = 3;
-
 #[target_feature(enable = "avx2")]
 fn gather_run_impl<const S: usize>(
-    src: &[f64; S],
+    src: &[f32; S],
     receivers: &[u32],
     factors: &[f32],
     base: usize,
-    acc: &mut [f64],
+    acc: &mut [f32],
 ) {
-    let quads = (S / 4).min(MAX_QUADS);
-    let mut s4 = [_mm256_setzero_pd(); MAX_QUADS];
-    for (q, v) in s4.iter_mut().enumerate().take(quads) {
-        // SAFETY: 4q + 4 ≤ S values of `src` are read.
-        *v = unsafe { _mm256_loadu_pd(src.as_ptr().add(4 * q)) };
-    }
-    let pair = 4 * quads + 2 <= S;
-    // SAFETY (pair): 4·quads + 2 ≤ S values of `src` are read.
-    let s2 = pair.then(|| unsafe { _mm_loadu_pd(src.as_ptr().add(4 * quads)) });
-    let single = 4 * quads + if pair { 2 } else { 0 };
-    for (rcv, f) in receivers.iter().zip(factors) {
-        let f = f64::from(*f);
+    // Eight source values in one register where S ≥ 8, then four, then one at a time.
+    // SAFETY (both loads): 8 ≤ S, and quad_at + 4 ≤ S, values of `src` are read.
+    let s8 = (S >= 8).then(|| unsafe { _mm256_loadu_ps(src.as_ptr()) });
+    let quad_at = if S >= 8 { 8 } else { 0 };
+    let s4 = (quad_at + 4 <= S).then(|| unsafe { _mm_loadu_ps(src.as_ptr().add(quad_at)) });
+    let single = quad_at + if s4.is_some() { 4 } else { 0 };
+    for (rcv, &f) in receivers.iter().zip(factors) {
         let at = (*rcv as usize - base) * S;
-        let dst: &mut [f64; S] = (&mut acc[at..at + S])
+        let dst: &mut [f32; S] = (&mut acc[at..at + S])
             .try_into()
             .unwrap_or_else(|_| unreachable!("S values per node"));
-        let f4: __m256d = _mm256_set1_pd(f);
-        for (q, v) in s4.iter().enumerate().take(quads) {
-            // SAFETY: `dst` holds S ≥ 4q + 4 values; loads and stores are unaligned.
+        if let Some(v) = s8 {
+            // SAFETY: `dst` holds S ≥ 8 values; loads and stores are unaligned.
             unsafe {
-                let p = dst.as_mut_ptr().add(4 * q);
-                _mm256_storeu_pd(p, _mm256_add_pd(_mm256_loadu_pd(p), _mm256_mul_pd(f4, *v)));
+                let p = dst.as_mut_ptr();
+                _mm256_storeu_ps(
+                    p,
+                    _mm256_add_ps(_mm256_loadu_ps(p), _mm256_mul_ps(_mm256_set1_ps(f), v)),
+                );
             }
         }
-        if let Some(v) = s2 {
-            // SAFETY: `dst` holds S ≥ 4·quads + 2 values.
+        if let Some(v) = s4 {
+            // SAFETY: `dst` holds S ≥ quad_at + 4 values.
             unsafe {
-                let p = dst.as_mut_ptr().add(4 * quads);
-                _mm_storeu_pd(
+                let p = dst.as_mut_ptr().add(quad_at);
+                _mm_storeu_ps(
                     p,
-                    _mm_add_pd(_mm_loadu_pd(p), _mm_mul_pd(_mm_set1_pd(f), v)),
+                    _mm_add_ps(_mm_loadu_ps(p), _mm_mul_ps(_mm_set1_ps(f), v)),
                 );
             }
         }

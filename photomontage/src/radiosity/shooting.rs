@@ -32,6 +32,8 @@
 //! group's row; its residual is the group's unshot power over its total. The patches' powers
 //! are summed in the same parallel pass that pushes a round's gathers down, and the buffers are
 //! kept by the transfer between relights ([`ShootScratch`]), so a relight makes no fresh pages.
+//! The shot node values and the gathers are `f32` (a round's increment needs ~1e-6 relative, the
+//! factors are `f32` already); B and the unshot leaves stay `f64`.
 
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
 use super::source_rows::{RECEIVER_RANGES, SourceRows, gather_range, gather_range_dyn, simd_token};
@@ -56,9 +58,9 @@ pub(super) struct ShootScratch {
     /// Per element, the unshot part.
     u: Vec<f64>,
     /// Per node, the unshot values of shot nodes.
-    un: Vec<f64>,
+    un: Vec<f32>,
     /// Per node, what it gathered in the round.
-    acc: Vec<f64>,
+    acc: Vec<f32>,
 }
 
 impl Clone for ShootScratch {
@@ -207,13 +209,19 @@ pub(super) fn shoot(
                     let own = &mut head[(n - lo) * stride..];
                     if let Some(e) = node_element(n) {
                         let e = e as usize - elo;
-                        own.copy_from_slice(&u[e * stride..(e + 1) * stride]);
+                        for (o, v) in own.iter_mut().zip(&u[e * stride..(e + 1) * stride]) {
+                            #[allow(clippy::cast_possible_truncation)]
+                            {
+                                *o = *v as f32;
+                            }
+                        }
                         u[e * stride..(e + 1) * stride].fill(0.0);
                     } else {
                         own.fill(0.0);
                         for kid in topology.children[n].into_iter().flatten() {
                             let kid = kid as usize;
-                            let w = topology.weight[kid];
+                            #[allow(clippy::cast_possible_truncation)]
+                            let w = topology.weight[kid] as f32;
                             let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
                             for (o, v) in own.iter_mut().zip(kid_vals) {
                                 *o += w * v;
@@ -237,8 +245,8 @@ pub(super) fn shoot(
         let interactions: u64 = active.iter().map(|&n| rows.row_len(n)).sum();
         // Each receiver range gathers on its own task; a receiver's sum runs over the shot
         // nodes in node order and each run in receiver order, as one thread would.
-        let mut ranges: Vec<(usize, &mut [f64])> = Vec::with_capacity(RECEIVER_RANGES);
-        let mut rest: &mut [f64] = acc;
+        let mut ranges: Vec<(usize, &mut [f32])> = Vec::with_capacity(RECEIVER_RANGES);
+        let mut rest: &mut [f32] = acc;
         for r in 0..RECEIVER_RANGES {
             let (lo, hi) = (rows.bounds[r] as usize, rows.bounds[r + 1] as usize);
             let (chunk, tail) = std::mem::take(&mut rest).split_at_mut((hi - lo) * stride);
@@ -246,7 +254,7 @@ pub(super) fn shoot(
             rest = tail;
         }
         let t = simd;
-        let un: &[f64] = un;
+        let un: &[f32] = un;
         ranges.into_par_iter().for_each(|(r, chunk)| match stride {
             3 => gather_range::<3>(rows, r, &active, un, chunk, t),
             6 => gather_range::<6>(rows, r, &active, un, chunk, t),
@@ -277,7 +285,7 @@ pub(super) fn shoot(
                     if let Some(e) = node_element(n) {
                         let (e, el) = (e as usize, e as usize - elo);
                         for j in 0..stride {
-                            let db = rho[e][j % 3] * acc[(n - lo) * stride + j];
+                            let db = rho[e][j % 3] * f64::from(acc[(n - lo) * stride + j]);
                             b[el * stride + j] += db;
                             u[el * stride + j] += db;
                         }
@@ -434,12 +442,12 @@ fn choose_patches(
 
 /// Per patch p: `(p, its nodes' values in `nodes`, its elements' values in `elements`)`, `stride`
 /// values per node and per element (nodes between patches, above them, are skipped).
-fn patch_slices<'a>(
+fn patch_slices<'a, N, E>(
     topology: &Topology,
     stride: usize,
-    nodes: &'a mut [f64],
-    elements: &'a mut [f64],
-) -> Vec<(usize, &'a mut [f64], &'a mut [f64])> {
+    nodes: &'a mut [N],
+    elements: &'a mut [E],
+) -> Vec<(usize, &'a mut [N], &'a mut [E])> {
     let mut out = Vec::with_capacity(topology.patch_ranges.len());
     let (mut node_rest, mut node_at) = (nodes, 0);
     let mut element_rest = elements;
@@ -484,13 +492,13 @@ fn patch_elements3<'a>(
 }
 
 /// A patch's index, its node values and its values in two element arrays.
-type PatchSlices3<'a> = (usize, &'a mut [f64], &'a mut [f64], &'a mut [f64]);
+type PatchSlices3<'a> = (usize, &'a mut [f32], &'a mut [f64], &'a mut [f64]);
 
 /// [`patch_slices`] with two element arrays.
 fn patch_slices3<'a>(
     topology: &Topology,
     stride: usize,
-    nodes: &'a mut [f64],
+    nodes: &'a mut [f32],
     a: &'a mut [f64],
     b: &'a mut [f64],
 ) -> Vec<PatchSlices3<'a>> {

@@ -137,13 +137,13 @@ pub(super) fn gather_range<const S: usize>(
     rows: &SourceRows,
     r: usize,
     active: &[usize],
-    un: &[f64],
-    acc: &mut [f64],
+    un: &[f32],
+    acc: &mut [f32],
     token: Option<Simd>,
 ) {
     let base = rows.bounds[r] as usize;
     for &n in active {
-        let src: &[f64; S] = un[n * S..(n + 1) * S]
+        let src: &[f32; S] = un[n * S..(n + 1) * S]
             .try_into()
             .unwrap_or_else(|_| unreachable!("S values per node"));
         let links = rows.cut(n, r);
@@ -155,10 +155,9 @@ pub(super) fn gather_range<const S: usize>(
         }
         #[cfg(not(target_arch = "x86_64"))]
         let _ = token;
-        for (rcv, f) in receivers.iter().zip(factors) {
-            let f = f64::from(*f);
+        for (rcv, &f) in receivers.iter().zip(factors) {
             let at = (*rcv as usize - base) * S;
-            let dst: &mut [f64; S] = (&mut acc[at..at + S])
+            let dst: &mut [f32; S] = (&mut acc[at..at + S])
                 .try_into()
                 .unwrap_or_else(|_| unreachable!("S values per node"));
             for (d, s) in dst.iter_mut().zip(src) {
@@ -173,8 +172,8 @@ pub(super) fn gather_range_dyn(
     rows: &SourceRows,
     r: usize,
     active: &[usize],
-    un: &[f64],
-    acc: &mut [f64],
+    un: &[f32],
+    acc: &mut [f32],
     stride: usize,
 ) {
     let base = rows.bounds[r] as usize;
@@ -185,7 +184,7 @@ pub(super) fn gather_range_dyn(
             .iter()
             .zip(&rows.form_factor[links])
         {
-            let f = f64::from(*f);
+            let f = *f;
             let at = (*rcv as usize - base) * stride;
             for (d, s) in acc[at..at + stride].iter_mut().zip(src) {
                 *d += f * s;
@@ -267,13 +266,13 @@ mod tests {
     fn vector_gather_equals_the_portable_loop() {
         fn check<const S: usize>(rows: &SourceRows, nodes: usize, token: Simd) {
             #[allow(clippy::cast_precision_loss)]
-            let un: Vec<f64> = (0..nodes * S)
-                .map(|i| ((i * 7919 % 1000) as f64 - 500.0) * 1.37e-3)
+            let un: Vec<f32> = (0..nodes * S)
+                .map(|i| ((i * 7919 % 1000) as f32 - 500.0) * 1.37e-3)
                 .collect();
             let active: Vec<usize> = (0..nodes).filter(|n| n % 3 != 1).collect();
             for r in 0..RECEIVER_RANGES {
                 let width = (rows.bounds[r + 1] - rows.bounds[r]) as usize * S;
-                let (mut a, mut b) = (vec![0.25; width], vec![0.25; width]);
+                let (mut a, mut b) = (vec![0.25_f32; width], vec![0.25_f32; width]);
                 gather_range::<S>(rows, r, &active, &un, &mut a, None);
                 gather_range::<S>(rows, r, &active, &un, &mut b, Some(token));
                 assert!(
