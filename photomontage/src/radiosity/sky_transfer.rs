@@ -279,7 +279,8 @@ mod tests {
         }
     }
 
-    fn yard() -> Scene {
+    /// A 6 m square of open ground.
+    fn ground() -> Scene {
         let mut scene = Scene::new();
         add(
             &mut scene,
@@ -292,6 +293,12 @@ mod tests {
             ),
             grey("asphalt", 0.3),
         );
+        scene
+    }
+
+    /// The ground with a block and a wall on it.
+    fn yard() -> Scene {
+        let mut scene = ground();
         add(
             &mut scene,
             "block",
@@ -309,18 +316,7 @@ mod tests {
 
     #[test]
     fn open_ground_gets_the_horizontal_irradiance() {
-        let mut scene = Scene::new();
-        add(
-            &mut scene,
-            "ground",
-            quad(
-                p(-3., -3., 0.),
-                p(3., -3., 0.),
-                p(3., 3., 0.),
-                p(-3., 3., 0.),
-            ),
-            grey("asphalt", 0.3),
-        );
+        let scene = ground();
         let s = Setup::new(&scene);
         let engine = s.engine();
         let dome = dome();
