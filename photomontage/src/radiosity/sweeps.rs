@@ -1,4 +1,4 @@
-//! Gathering sweeps of a relight on the stored links ([`super::transfer::Sweep`]): Gauss–Seidel
+//! Gathering sweeps of a relight on the stored links ([`Sweep`]): Gauss–Seidel
 //! patch by patch (sequential) or Jacobi (parallel, fixed chunks), each followed by the push
 //! (gathered values down to the leaves) and the pull (area-weighted means up). ΔB shooting, the
 //! default, lives in [`super::shooting`].
@@ -9,8 +9,20 @@ use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_cha
 use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
 use super::topology::Topology;
-use super::transfer::Sweep;
 use super::{Rgb, luminance};
+
+/// The sweep of a relight iteration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sweep {
+    /// Patch by patch, each gathering the newest values (sequential).
+    GaussSeidel,
+    /// All receivers from the previous sweep's values (parallel).
+    Jacobi,
+    /// Only the change is passed on: the difference from the old solution is shot through the
+    /// links by source, from the elements where it is not zero, all groups at once
+    /// (progressive refinement on ΔB; module `radiosity::shooting`).
+    Shooting,
+}
 
 /// The links as compressed rows per receiver node.
 #[derive(Debug, Clone)]

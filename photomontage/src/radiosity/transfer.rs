@@ -57,6 +57,7 @@ use super::sky_transfer::SkyTransfer;
 use super::solve::{GroundTerm, group_direct, initial_exitance};
 use super::source_rows::SourceRows;
 use super::sources::{self, DirectSamples, LightWarning};
+pub use super::sweeps::Sweep;
 use super::sweeps::{LinkRows, iterate};
 use super::topology::Topology;
 use super::transfer_lighting::check_rgb;
@@ -83,19 +84,6 @@ pub enum RelightStrategy {
     WarmGaussSeidel,
     /// Scalings are exact multiplications; only re-traced groups and material changes iterate.
     LinearResponses,
-}
-
-/// The sweep of a relight iteration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sweep {
-    /// Patch by patch, each gathering the newest values (sequential).
-    GaussSeidel,
-    /// All receivers from the previous sweep's values (parallel).
-    Jacobi,
-    /// Only the change is passed on: the difference from the old solution is shot through the
-    /// links by source, from the elements where it is not zero, all groups at once
-    /// (progressive refinement on ΔB; module `radiosity::shooting`).
-    Shooting,
 }
 
 /// Transfer tunables.
