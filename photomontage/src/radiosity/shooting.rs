@@ -122,7 +122,8 @@ fn group_sums(per_patch: &[f64], k: usize) -> Vec<f64> {
     out
 }
 
-/// Shoots D = start − old of every group (module doc) with reflectance `rho` (per element).
+/// Shoots D = start − old of every group (module doc) with reflectance `rho` (per element);
+/// `patch_links` are the links read when a patch is shot ([`SourceRows::patch_links`]).
 /// Returns each group's radiosity per element and its convergence rows.
 #[allow(clippy::too_many_lines)]
 pub(super) fn shoot(
@@ -131,6 +132,7 @@ pub(super) fn shoot(
     rho: &[Rgb],
     groups: Vec<ShotGroup<'_>>,
     stop: &StopRule,
+    patch_links: &[u64],
     scratch: &mut ShootScratch,
 ) -> Vec<(Vec<Rgb>, Vec<ConvergenceRow>)> {
     let k = groups.len();
@@ -180,11 +182,6 @@ pub(super) fn shoot(
     let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
     let mut total = group_sums(&powers.total, k);
     let mut previous_mean: Vec<f64> = total.iter().map(|t| t / area_sum).collect();
-    // Links read when a patch is shot (all its nodes carry unshot radiosity then).
-    let patch_links: Vec<u64> = patches
-        .iter()
-        .map(|&(lo, hi)| (lo..hi).map(|n| rows.row_len(n)).sum())
-        .collect();
     // Per group, the unshot power a round sends back as unshot power per unit shot (measured
     // after each round; 1 until then, so the first round is never taken for the last).
     let mut bounce = vec![1.0; k];
@@ -193,7 +190,7 @@ pub(super) fn shoot(
         if unshot.iter().all(|&v| v <= 0.0) {
             break;
         }
-        let shot_now = choose_patches(&powers.unshot, &unshot, &total, &bounce, &patch_links, stop);
+        let shot_now = choose_patches(&powers.unshot, &unshot, &total, &bounce, patch_links, stop);
         let before = powers.unshot.clone();
         // Node values of the unshot part of every shot patch (leaves up), then clear its leaves;
         // patch by patch in parallel (each writes only its own nodes and elements).

@@ -149,6 +149,11 @@ impl SkyTransfer {
         }
     }
 
+    /// The dome whose leaves a sky is evaluated on (the transfer clusters the sky on it too).
+    pub(crate) fn dome(&self) -> &IcosahedralDome {
+        &self.dome
+    }
+
     /// Number of facets.
     #[cfg(test)]
     pub(crate) fn facets(&self) -> usize {
@@ -230,6 +235,9 @@ mod tests {
 
     /// The open ground gets the horizontal irradiance to the rounding of the f32 facet sum.
     const EXACT_REL_TOL: f64 = 1e-6;
+    /// A lone wall under the clear sky against the all-leaves sum: what docs/methodology.md
+    /// states (< 1 %); measured 0.46 %. The facets' own bound is checked as well.
+    const LONE_WALL_REL_TOL: f64 = 0.01;
     /// Facets against the traced clusters (τ = 0.1) on an occluded yard, area-weighted L1 over
     /// the sum: the two differ in where visibility is sampled (≈ 9° facets against clusters, one
     /// ray per element each) and in the facets' cut error; measured 0.13 %.
@@ -379,11 +387,11 @@ mod tests {
         for e in &direct {
             let got = e[0] / WEIGHT[0] * horizontal;
             assert!(
-                got <= leaf_sum + 1e-12 && leaf_sum - got <= bound,
+                got <= leaf_sum * (1.0 + EXACT_REL_TOL) && leaf_sum - got <= bound,
                 "{got} against the leaves' {leaf_sum}, bound {bound}"
             );
             assert!(
-                (leaf_sum - got) / leaf_sum < 0.01,
+                (leaf_sum - got) / leaf_sum < LONE_WALL_REL_TOL,
                 "{got} against {leaf_sum}"
             );
         }

@@ -127,6 +127,15 @@ impl SourceRows {
     pub(super) fn row_len(&self, n: usize) -> u64 {
         u64::from(self.row_len[n])
     }
+
+    /// Per patch (node range), the links read when it is shot: all its nodes carry unshot
+    /// radiosity then. Geometry only, so a transfer computes it once.
+    pub(super) fn patch_links(&self, patch_ranges: &[(usize, usize)]) -> Vec<u64> {
+        patch_ranges
+            .iter()
+            .map(|&(lo, hi)| (lo..hi).map(|n| self.row_len(n)).sum())
+            .collect()
+    }
 }
 
 /// Receiver range `r` gathers the unshot values `un` (`S` per node) of the `active` nodes

@@ -137,11 +137,12 @@ pub struct Transfer {
     rows: LinkRows,
     /// The same links by source, for [`Sweep::Shooting`].
     source_rows: SourceRows,
+    /// Per patch, the links a shot of it reads ([`SourceRows::patch_links`]).
+    patch_links: Vec<u64>,
     /// The shooting's buffers, kept between relights.
     scratch: ShootScratch,
     topology: Topology,
     ground: Option<GroundTerm>,
-    dome: IcosahedralDome,
     /// Material index per mesh surface, and the material names.
     surface_material: Vec<usize>,
     material_names: Vec<String>,
@@ -277,15 +278,16 @@ impl Transfer {
         let rows = LinkRows::new(mesh.nodes.len(), &hierarchy);
         let source_rows = SourceRows::new(mesh.nodes.len(), &hierarchy.links);
         let topology = Topology::new(&mesh);
+        let patch_links = source_rows.patch_links(&topology.patch_ranges);
         Ok(Self {
             tracer,
             params: params.clone(),
             rows,
             source_rows,
+            patch_links,
             scratch: ShootScratch::default(),
             topology,
             ground,
-            dome,
             surface_material,
             material_names,
             lighting: lighting.clone(),
@@ -464,7 +466,7 @@ impl Transfer {
     pub fn relight_in_place(&mut self, change: &LightingChange) -> Result<(), RadiosityError> {
         let (lighting, reflectance) = self.apply_to_lighting(change)?;
         let (new_groups, warnings) =
-            lighting.light_groups(&self.dome, self.params.sky_tolerance)?;
+            lighting.light_groups(self.sky_transfer.dome(), self.params.sky_tolerance)?;
         let actions = self.actions(&lighting);
         // Re-trace what needs it (only the changed groups' rays; never a form factor).
         let mut retraced: Vec<Option<Vec<Rgb>>> = vec![None; actions.len()];
@@ -586,6 +588,7 @@ impl Transfer {
                 &new_rho,
                 shot,
                 &self.params.solve.stop,
+                &self.patch_links,
                 &mut self.scratch,
             );
             for ((g, b0_new, _), (radiosity, rows)) in pending.into_iter().zip(results) {
