@@ -1,7 +1,7 @@
 //! Montage helpers for the `street` sample site (Mitsuba photos and truth): box-filtered
 //! downscaling, rendering a solved view into its downscaled photo, and the error measures against
-//! the truth render (building pixels, shadow pixels, whole image). Shared by `street_render.rs`
-//! and `street_fit.rs`.
+//! the truth render (building pixels, shadow pixels, whole image). Shared by `street_render.rs`,
+//! `street_render_radiosity.rs` and `street_fit.rs`.
 //!
 //! Photos and truth are 8-bit sRGB PNGs at 256 spp; both are box-filtered `scale` × `scale` (the
 //! solved camera's focal length and principal point scaled to match) to keep the tests within
@@ -14,6 +14,7 @@ use image::Rgb32FImage;
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
+use photomontage::site::render_radiosity::site_radiosity_arc;
 
 use crate::sample_site;
 
@@ -127,9 +128,29 @@ pub struct StreetView {
 /// # Panics
 /// When the view cannot be prepared or rendered (a test helper).
 #[must_use]
-#[allow(clippy::unwrap_used)]
 pub fn render_street_view(doc: &SiteDocument, id: &str, scale: u32) -> StreetView {
+    render_street_view_in(doc, id, scale, false)
+}
+
+/// [`render_street_view`], in the radiosity lighting mode when `radiosity` is set (the site's
+/// solutions with and without the building, as `render --radiosity` solves them).
+///
+/// # Panics
+/// When the view cannot be prepared, solved or rendered (a test helper).
+#[must_use]
+#[allow(clippy::unwrap_used)]
+pub fn render_street_view_in(
+    doc: &SiteDocument,
+    id: &str,
+    scale: u32,
+    radiosity: bool,
+) -> StreetView {
     let mut job = prepare_view(doc, id).unwrap();
+    if radiosity {
+        let (light, _report) =
+            site_radiosity_arc(doc, &job.scene.scene, id, &AtomicBool::new(false)).unwrap();
+        job.lighting.radiosity = Some(light);
+    }
     let photo = downscale(&job.photo_linear, scale);
     let truth_full = load_linear(&sample_site("street").join(format!("truth/{id}.png")));
     let truth = downscale(&truth_full, scale);

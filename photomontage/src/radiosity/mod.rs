@@ -52,10 +52,12 @@ mod sky_transfer;
 mod solve;
 mod source_rows;
 pub mod sources;
+mod surface_point;
 mod sweeps;
 mod topology;
 pub mod transfer;
 pub mod transfer_lighting;
+pub mod vertex_gather;
 
 #[cfg(test)]
 mod form_factor_tests;
@@ -83,6 +85,7 @@ pub use transfer::{
     LightingChange, NamedLuminaire, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, RelightStrategy, Sky,
     Sun, Sweep, Transfer, TransferLighting, TransferParams,
 };
+pub use vertex_gather::VertexGather;
 
 /// RGB triple (linear).
 pub type Rgb = [f64; 3];

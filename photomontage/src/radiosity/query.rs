@@ -29,6 +29,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::sources::{DIRECT_RAY_OFFSET_M, DistantSource};
+use super::surface_point::{barycentric, cosine_direction, vertex_key};
+use super::vertex_gather::VertexGather;
 use super::{RadiosityError, Rgb, Solution, Transfer};
 
 /// A query point lies on an element when it is within this distance of its plane, metres
@@ -101,19 +103,6 @@ fn cell_of(p: &Point3<f64>, cell_m: f64) -> [i64; 3] {
         (p.x / cell_m).floor() as i64,
         (p.y / cell_m).floor() as i64,
         (p.z / cell_m).floor() as i64,
-    ]
-}
-
-#[allow(clippy::cast_possible_truncation)]
-fn vertex_key(p: &Point3<f64>, n: &Vector3<f64>) -> [i64; 6] {
-    let q = |v: f64, s: f64| (v * s).round() as i64;
-    [
-        q(p.x, 1e5),
-        q(p.y, 1e5),
-        q(p.z, 1e5),
-        q(n.x, 1e3),
-        q(n.y, 1e3),
-        q(n.z, 1e3),
     ]
 }
 
@@ -236,20 +225,6 @@ impl ElementLocator {
     }
 }
 
-/// Barycentric weights of the projection of `p` on triangle `a b c` with normal `n`.
-fn barycentric(
-    p: &Point3<f64>,
-    a: &Point3<f64>,
-    b: &Point3<f64>,
-    c: &Point3<f64>,
-    n: &Vector3<f64>,
-) -> [f64; 3] {
-    let area2 = (b - a).cross(&(c - a)).dot(n);
-    let wa = (b - p).cross(&(c - p)).dot(n) / area2;
-    let wb = (c - p).cross(&(a - p)).dot(n) / area2;
-    [wa, wb, 1.0 - wa - wb]
-}
-
 impl Solution {
     fn locator(&self) -> &ElementLocator {
         self.locator.get_or_init(|| ElementLocator::new(self))
@@ -284,18 +259,41 @@ impl Solution {
     }
 }
 
-/// Cosine-distributed direction about `n` from two uniform numbers (Malley's method).
-fn cosine_direction(n: &Vector3<f64>, u1: f64, u2: f64) -> Vector3<f64> {
-    let r = u1.sqrt();
-    let phi = std::f64::consts::TAU * u2;
-    let t = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let a = n.cross(&t).normalize();
-    let b = n.cross(&a);
-    a * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()
+impl Solution {
+    /// Irradiance at a point as [`Solution::irradiance_at`], with the interreflected part taken
+    /// from the vertex gathers `gather` of this solution's mesh for the exitances
+    /// `radiosity_rgb` (per element) instead of the elements' own values
+    /// ([`super::vertex_gather`]); the direct part stays interpolated. `None` where the point
+    /// lies on no element, or when `gather` belongs to another mesh.
+    #[must_use]
+    pub fn irradiance_gathered_at(
+        &self,
+        point_in_world_m: &Point3<f64>,
+        normal_in_world: &Vector3<f64>,
+        gather: &VertexGather,
+        radiosity_rgb: &[Rgb],
+    ) -> Option<IrradianceSample> {
+        if !std::sync::Arc::ptr_eq(gather.mesh(), &self.mesh)
+            || radiosity_rgb.len() != self.mesh.elements.len()
+        {
+            return None;
+        }
+        let locator = self.locator();
+        let (e, w) = locator.locate(self, point_in_world_m, normal_in_world)?;
+        let mut direct = [0.0; 3];
+        for (k, (_, d)) in locator.vertex_values[e].iter().enumerate() {
+            for c in 0..3 {
+                direct[c] += w[k] * d[c];
+            }
+        }
+        let indirect = gather.indirect_rgb(e, w, radiosity_rgb);
+        Some(IrradianceSample {
+            direct_rgb: direct,
+            indirect_rgb: indirect,
+            total_rgb: std::array::from_fn(|c| direct[c] + indirect[c]),
+            element: Some(e),
+        })
+    }
 }
 
 impl Transfer {

@@ -175,11 +175,9 @@ fn fixture() -> Fixture {
             ambient_radiance_rgb: [0.0; 3],
             sky: sky_facets(),
         },
-        radiosity: Some(Arc::new(RadiosityLight::new(
-            &with,
-            &without,
-            &RadiosityLight::traced_exactly,
-        ))),
+        radiosity: Some(Arc::new(
+            RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly).unwrap(),
+        )),
         ..Lighting::default()
     };
     #[allow(clippy::cast_possible_truncation)]

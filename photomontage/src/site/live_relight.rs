@@ -331,11 +331,14 @@ impl SiteTransfers {
         };
         let with_artificial = build(0)?;
         let without_artificial = build(1)?;
-        let light = Arc::new(RadiosityLight::new(
-            with_artificial.transfer.solution(),
-            without_artificial.transfer.solution(),
-            &RadiosityLight::traced_exactly,
-        ));
+        let light = Arc::new(
+            RadiosityLight::new(
+                with_artificial.transfer.solution(),
+                without_artificial.transfer.solution(),
+                &RadiosityLight::traced_exactly,
+            )
+            .map_err(|e| radiosity_error(&e))?,
+        );
         let report = RadiosityReport {
             element_edge_m,
             elements: [
@@ -473,11 +476,15 @@ impl SiteTransfers {
         let [t0, t1] = targets.try_into().unwrap_or_else(|_| unreachable!());
         self.with_artificial.materials = t0;
         self.without_artificial.materials = t1;
-        self.light = Arc::new(RadiosityLight::new(
-            self.with_artificial.transfer.solution(),
-            self.without_artificial.transfer.solution(),
-            &RadiosityLight::traced_exactly,
-        ));
+        self.light = Arc::new(
+            self.light
+                .relit(
+                    self.with_artificial.transfer.solution(),
+                    self.without_artificial.transfer.solution(),
+                    &RadiosityLight::traced_exactly,
+                )
+                .map_err(|e| radiosity_error(&e))?,
+        );
         Ok(Some(TransferUpdate::Relit))
     }
 }

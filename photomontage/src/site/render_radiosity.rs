@@ -149,7 +149,8 @@ pub fn site_radiosity_light(
         seconds: start.elapsed().as_secs_f64(),
         notes,
     };
-    let light = RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly);
+    let light = RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly)
+        .map_err(|e| radiosity_error(&e))?;
     Ok((light, report))
 }
 

@@ -16,21 +16,29 @@
 //!   blocked by an artificial object, an artificial light reaches it, or |ΔE_rad| exceeds
 //!   [`RadiosityLight::change_fraction`] of E_nat in some channel ([`DEFAULT_CHANGE_FRACTION`]).
 //!
+//! In both solutions the sky's direct light (and the ground below the horizon) is interpolated
+//! on the elements (nodal averaging), and the interreflected light is a **final gather** at the
+//! element vertices ([`crate::radiosity::vertex_gather`]): the exitances of the elements the
+//! vertex sees, not the element's own value, which a hierarchical solution only knows as a mean
+//! over a coarse receiver node. The gathers trace their rays once per vertex the renderer
+//! reaches and are kept across relights of the same meshes ([`RadiosityLight::relit`]).
+//!
 //! Where a point lies on no element of a solution (a back face, geometry the mesh skipped), the
 //! facet path of the ordinary mode is used for that ray.
 //!
 //! # Known limitations
-//! The solution is interpolated on its elements (nodal averaging): a change of sky or bounce
-//! light across an element is blurred over it, so coarse elements near the building blur the
-//! sky it blocks (no final gather in this mode yet). The threshold hides changes below it
-//! (by design: they leave the photo untouched). RGB mode only: the spectral passes ignore the
-//! solutions and use the facets.
+//! The sky's direct light is interpolated on the elements: a change across an element is
+//! blurred over it, so coarse elements near the building blur the sky it blocks. The gathered
+//! light is a Monte Carlo estimate (1024 stratified rays per vertex). The threshold hides changes
+//! below it (by design: they leave the photo untouched). RGB mode only: the spectral passes
+//! ignore the solutions and use the facets.
 
 use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
 
-use crate::radiosity::Solution;
+use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
+use crate::radiosity::{RadiosityError, Solution, VertexGather};
 use crate::render::illumination::Rgb;
 
 /// A radiosity change below this fraction of the natural irradiance, in every channel, leaves a
@@ -47,22 +55,79 @@ pub struct RadiosityLight {
     pub without_artificial: Arc<Solution>,
     /// The change threshold (module doc).
     pub change_fraction: f64,
+    /// Vertex gathers of the two meshes (with, without).
+    gathers: [Arc<VertexGather>; 2],
+    /// Exitance per element of the two solutions as solved (every group's direct light in),
+    /// which the gathers sum.
+    radiosity_rgb: [Vec<Rgb>; 2],
 }
 
 impl RadiosityLight {
     /// From solutions of the scene with and without the artificial objects, taking out the direct
     /// light of the groups `traced_exactly` names (the sun and the luminaires, which the
     /// renderer traces itself).
-    #[must_use]
+    ///
+    /// # Errors
+    /// A tracer error while setting up the vertex gathers (not reachable for solved meshes).
     pub fn new(
         with_artificial: &Solution,
         without_artificial: &Solution,
         traced_exactly: &dyn Fn(&str) -> bool,
+    ) -> Result<Self, RadiosityError> {
+        let gather = |s: &Solution| {
+            VertexGather::new(Arc::clone(&s.mesh), DEFAULT_RAYS_PER_AXIS).map(Arc::new)
+        };
+        let gathers = [gather(with_artificial)?, gather(without_artificial)?];
+        Ok(Self::with_gathers(
+            with_artificial,
+            without_artificial,
+            traced_exactly,
+            gathers,
+        ))
+    }
+
+    /// The same for relit solutions: the vertex gathers (the rays they traced) are kept where a
+    /// solution's mesh is the one this light was built on, and set up anew where it is not.
+    ///
+    /// # Errors
+    /// As [`RadiosityLight::new`].
+    pub fn relit(
+        &self,
+        with_artificial: &Solution,
+        without_artificial: &Solution,
+        traced_exactly: &dyn Fn(&str) -> bool,
+    ) -> Result<Self, RadiosityError> {
+        let keep = |k: usize, s: &Solution| {
+            if Arc::ptr_eq(self.gathers[k].mesh(), &s.mesh) {
+                Ok(Arc::clone(&self.gathers[k]))
+            } else {
+                VertexGather::new(Arc::clone(&s.mesh), DEFAULT_RAYS_PER_AXIS).map(Arc::new)
+            }
+        };
+        let gathers = [keep(0, with_artificial)?, keep(1, without_artificial)?];
+        Ok(Self::with_gathers(
+            with_artificial,
+            without_artificial,
+            traced_exactly,
+            gathers,
+        ))
+    }
+
+    fn with_gathers(
+        with_artificial: &Solution,
+        without_artificial: &Solution,
+        traced_exactly: &dyn Fn(&str) -> bool,
+        gathers: [Arc<VertexGather>; 2],
     ) -> Self {
         Self {
             with_artificial: Arc::new(with_artificial.without_direct_of(traced_exactly)),
             without_artificial: Arc::new(without_artificial.without_direct_of(traced_exactly)),
             change_fraction: DEFAULT_CHANGE_FRACTION,
+            gathers,
+            radiosity_rgb: [
+                with_artificial.total_radiosity_rgb(),
+                without_artificial.total_radiosity_rgb(),
+            ],
         }
     }
 
@@ -76,7 +141,7 @@ impl RadiosityLight {
     #[must_use]
     pub fn with_at(&self, point: &Point3<f64>, normal: &Vector3<f64>) -> Option<Rgb> {
         self.with_artificial
-            .irradiance_at(point, normal)
+            .irradiance_gathered_at(point, normal, &self.gathers[0], &self.radiosity_rgb[0])
             .map(|s| s.total_rgb)
     }
 
@@ -84,7 +149,7 @@ impl RadiosityLight {
     #[must_use]
     pub fn without_at(&self, point: &Point3<f64>, normal: &Vector3<f64>) -> Option<Rgb> {
         self.without_artificial
-            .irradiance_at(point, normal)
+            .irradiance_gathered_at(point, normal, &self.gathers[1], &self.radiosity_rgb[1])
             .map(|s| s.total_rgb)
     }
 
