@@ -24,7 +24,8 @@
 //! [`transfer::Transfer`] keeps the geometry-dependent part (mesh, links, ground transfer) and
 //! relights it (sun, sky, dimming, reflectance) without recomputing form factors;
 //! [`query`] interpolates irradiance at any surface point, with a final gather where the mesh
-//! is coarse.
+//! is coarse; [`vertex_gather`] gathers the interreflected light at element vertices for the
+//! renderer's radiosity mode (hit lists traced once, re-summed for any exitances).
 //!
 //! # Known limitations
 //! Surfaces are one-sided (front = counter-clockwise normal) and Lambertian: specular, glass and

@@ -36,6 +36,7 @@
 use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
 use crate::radiosity::{RadiosityError, Solution, VertexGather};
@@ -45,6 +46,23 @@ use crate::render::illumination::Rgb;
 /// natural point unchanged: 1 %, about one 8-bit sRGB step at mid-grey, and above the difference
 /// two solves of the same unchanged surroundings leave between them far from the building.
 pub const DEFAULT_CHANGE_FRACTION: f64 = 0.01;
+
+/// Σ over groups of the exitance per element (as [`Solution::total_radiosity_rgb`], the same sum
+/// in the same order), element-parallel: it runs on every relight of the studio.
+fn total_radiosity(solution: &Solution) -> Vec<Rgb> {
+    (0..solution.mesh.elements.len())
+        .into_par_iter()
+        .map(|e| {
+            let mut sum = [0.0; 3];
+            for g in &solution.groups {
+                for c in 0..3 {
+                    sum[c] += g.radiosity_rgb[e][c];
+                }
+            }
+            sum
+        })
+        .collect()
+}
 
 /// The two solutions the radiosity mode reads (module doc).
 #[derive(Debug, Clone)]
@@ -125,8 +143,8 @@ impl RadiosityLight {
             change_fraction: DEFAULT_CHANGE_FRACTION,
             gathers,
             radiosity_rgb: [
-                with_artificial.total_radiosity_rgb(),
-                without_artificial.total_radiosity_rgb(),
+                total_radiosity(with_artificial),
+                total_radiosity(without_artificial),
             ],
         }
     }
