@@ -6,25 +6,69 @@
 //! and the photo-bounce gathers.
 //!
 //! The site's 1 km ground takes the element size to 7.1 m under the element budget
-//! (`render_radiosity::ELEMENT_BUDGET`), so the sky the building blocks is interpolated over
-//! 7 m elements: that blur is what is left in the shadows of V1 and V2.
+//! (`render_radiosity::ELEMENT_BUDGET`); elements that a sun shadow edge crosses are split to
+//! 1 m. Besides the shadow mask of `street_render.rs` the test measures its **interior** (shadow
+//! pixels whose four neighbours are shadow pixels too): in V1 and V2 the shadow is a strip a few
+//! pixels tall at this scale, and most of its error sits in the rows along its edges, where the
+//! solved camera (0.3 px click noise, 1 cm survey noise) puts the edge a fraction of a pixel away
+//! from the truth's. That is registration, not light; the interior shows the light.
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 use photomontage::site::{SiteDocument, apply_solution, solve_site};
 use photomontage_tests::sample_site;
-use photomontage_tests::street::render_street_view_in;
+use photomontage_tests::street::{SHADOW_DARKENING, StreetView, render_street_view_in};
+
+/// Mean relative error over the interior of the shadow mask (module doc) and its size.
+fn interior_shadow_error(view: &StreetView) -> (f64, usize) {
+    let (w, h) = view.truth.dimensions();
+    let lum = |v: [f32; 3]| v.iter().map(|&c| f64::from(c)).sum::<f64>();
+    let in_mask = |x: u32, y: u32| {
+        let o = view.out.rgba[(y * w + x) as usize];
+        o[3] <= 0.0
+            && lum(view.truth.get_pixel(x, y).0)
+                < SHADOW_DARKENING * lum(view.photo.get_pixel(x, y).0)
+    };
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            if in_mask(x, y)
+                && in_mask(x - 1, y)
+                && in_mask(x + 1, y)
+                && in_mask(x, y - 1)
+                && in_mask(x, y + 1)
+            {
+                let o = view.out.rgba[(y * w + x) as usize];
+                let t = view.truth.get_pixel(x, y).0;
+                sum += (0..3)
+                    .map(|k| (f64::from(o[k]) - f64::from(t[k])).abs() / f64::from(t[k]).max(1e-3))
+                    .sum::<f64>()
+                    / 3.0;
+                n += 1;
+            }
+        }
+    }
+    #[allow(clippy::cast_precision_loss)]
+    (sum / n.max(1) as f64, n)
+}
 
 /// Box-filter factor, as `street_render.rs`.
 const SCALE: u32 = 4;
 
-/// Building pixels, mean relative error per view (V1, V2, V3). Measured 2026-11-25: 2.05 %,
-/// 1.92 %, 2.72 % (the facet mode, `street_render.rs`: 1.6 %, 2.1 %, 3.9 %). Bounds: the
-/// measurement plus 0.5 %; V1 is NOT at or below the facet mode yet.
-const BUILDING_MEAN_REL_TOL: [f64; 3] = [0.026, 0.025, 0.033];
-/// Shadow pixels, mean relative error per view. Measured 2026-11-25: 5.74 %, 5.34 %, 3.72 %
-/// (facet mode 9.8–10.1 %, 9.2–9.4 %, 5.2 %). Bounds: the measurement plus 0.5 %; the issue's
-/// 5 % holds in V3 only.
-const SHADOW_MEAN_REL_TOL: [f64; 3] = [0.063, 0.059, 0.043];
+/// Building pixels, mean relative error per view (V1, V2, V3). Measured 2026-11-25: 1.54 %,
+/// 1.53 %, 2.26 % (the facet mode, `street_render.rs`: 1.6 %, 2.1 %, 3.9 %; this mode before the
+/// shadow-edge refinement 2.05 %, 1.92 %, 2.72 %, and before the vertex gathers worse again).
+/// Bounds: the measurement plus 0.5 %.
+const BUILDING_MEAN_REL_TOL: [f64; 3] = [0.021, 0.021, 0.028];
+/// Shadow pixels, mean relative error per view. Measured 2026-11-25: 5.90 %, 5.05 %, 3.30 %
+/// (facet mode 9.8 %, 9.2 %, 5.2 %). Bounds: the measurement plus 0.5 %. The issue's 5 % holds in
+/// V3 and not quite in V1 and V2, whose masks are mostly edge rows (module doc).
+const SHADOW_MEAN_REL_TOL: [f64; 3] = [0.064, 0.056, 0.038];
+/// Interior shadow pixels (module doc), mean relative error per view. Measured 2026-11-25:
+/// 2.23 %, 2.13 %, 2.44 % (154, 328 and 4 751 pixels); the facet mode gives 4.2 %, 4.0 %, 3.6 %
+/// there. Bound: the issue's 3 %.
+const SHADOW_INTERIOR_MEAN_REL_TOL: f64 = 0.03;
+/// Interior masks smaller than this are not measured (pixels at 1/4 scale).
+const MIN_INTERIOR_PX: usize = 100;
 /// A view is only measured where its masks are big enough to mean something (pixels at 1/4
 /// scale).
 const MIN_MASK_PX: usize = 300;
@@ -42,9 +86,11 @@ fn street_montage_in_radiosity_mode_matches_mitsuba_truth() {
     for id in &ids {
         let view = render_street_view_in(&doc, id, SCALE, true);
         let m = view.measured;
+        let (interior, interior_px) = interior_shadow_error(&view);
         println!(
             "street radiosity {id}: building {} px mean rel err {:.4}; shadow {} px mean rel err \
-             {:.4}; RMSE {:.5} (photo vs truth {:.5}); changed px {}",
+             {:.4}, interior {interior_px} px {interior:.4}; RMSE {:.5} (photo vs truth {:.5}); \
+             changed px {}",
             m.building_px,
             m.building_mre,
             m.shadow_px,
@@ -53,10 +99,18 @@ fn street_montage_in_radiosity_mode_matches_mitsuba_truth() {
             m.rmse_photo,
             view.out.changed_pixels
         );
-        results.push((id.clone(), m));
+        results.push((id.clone(), m, interior, interior_px));
     }
     // All views are measured and printed before any assertion.
-    for (k, (id, m)) in results.iter().enumerate() {
+    for (k, (id, m, interior, interior_px)) in results.iter().enumerate() {
+        assert!(
+            *interior_px >= MIN_INTERIOR_PX,
+            "{id}: interior {interior_px} px"
+        );
+        assert!(
+            *interior <= SHADOW_INTERIOR_MEAN_REL_TOL,
+            "{id}: shadow interior {interior}"
+        );
         assert!(
             m.building_px >= MIN_MASK_PX && m.shadow_px >= MIN_MASK_PX,
             "{id}: masks {} building, {} shadow",

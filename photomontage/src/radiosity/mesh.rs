@@ -14,16 +14,26 @@
 //! [`Mesh::ply`] writes the elements as binary-free ASCII PLY with their radiosity as vertex-free
 //! face colours, for inspection in MeshLab or Blender.
 //!
+//! **Refinement** ([`Mesh::build_refined`]): below the element level a node is split further,
+//! down to [`Refinement::min_element_edge_m`], where a predicate asks for it. With
+//! [`MeshParams::shadow_edge_element_m`] set, [`Mesh::build_lit`] (used by the solve and the
+//! transfer, so both mesh alike) splits where a sun shadow edge crosses the node
+//! ([`super::shadow_refinement`]), so that a shadow narrower than the element size (a garden
+//! wall's) is not averaged into the light around it. Splits stay depth-first, so a patch's
+//! elements keep their order; elements of different sizes meet in T-junctions.
+//!
 //! # Known limitations
-//! Uniform subdivision only (no refinement along shadow boundaries); a long thin triangle
-//! keeps its aspect ratio in its children. Surfaces are one-sided.
+//! Refinement only by the predicate given (no a-posteriori refinement on the solution's
+//! gradients); a long thin triangle keeps its aspect ratio in its children. Surfaces are
+//! one-sided.
 
 use std::collections::BTreeMap;
 
 use nalgebra::{Point3, Vector3};
 
 use super::{RadiosityError, Rgb, check_positive};
-use crate::scene::{ObjectId, Scene};
+use crate::bvh::BuildQuality;
+use crate::scene::{ObjectId, Scene, SceneTracer};
 
 /// Triangles with area below this fraction of their longest edge squared are degenerate
 /// (a sliver whose normal is not defined to better than ~1e-9 rad in `f64`).
@@ -40,16 +50,20 @@ pub struct MeshParams {
     pub object_element_edge_m: BTreeMap<String, f64>,
     /// Refuse to mesh beyond this many elements.
     pub max_elements: usize,
+    /// Split elements that a sun shadow edge crosses down to this edge, metres, when the mesh
+    /// is built for a lighting with a sun ([`Mesh::build_lit`]); `None` meshes uniformly.
+    pub shadow_edge_element_m: Option<f64>,
 }
 
 impl Default for MeshParams {
-    /// 4 m patches, 1 m elements, at most 200 000 elements.
+    /// 4 m patches, 1 m elements, at most 200 000 elements, no shadow-edge refinement.
     fn default() -> Self {
         Self {
             max_patch_edge_m: 4.0,
             max_element_edge_m: 1.0,
             object_element_edge_m: BTreeMap::new(),
             max_elements: 200_000,
+            shadow_edge_element_m: None,
         }
     }
 }
@@ -177,6 +191,28 @@ fn levels_for(longest_m: f64, max_edge_m: f64) -> u32 {
     levels
 }
 
+/// Whether the node with these vertices (world metres) and unit normal is to be split.
+pub type SplitTest<'a> = dyn Fn(&[Point3<f64>; 3], &Vector3<f64>) -> bool + Sync + 'a;
+
+/// Splits elements further where [`Refinement::split`] asks (module doc).
+pub struct Refinement<'a> {
+    /// No element is split below this edge, metres.
+    pub min_element_edge_m: f64,
+    /// Whether the node with these vertices and unit normal is to be split.
+    pub split: &'a SplitTest<'a>,
+}
+
+impl std::fmt::Debug for Refinement<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Refinement")
+            .field("min_element_edge_m", &self.min_element_edge_m)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Deepest level a refinement may reach (edges 2⁻²⁴ of the scene triangle's).
+const MAX_LEVEL: u32 = 24;
+
 impl Mesh {
     /// Meshes every triangle of `scene` (see the module doc).
     ///
@@ -186,6 +222,60 @@ impl Mesh {
     /// [`RadiosityError::TooManyElements`] past the budget, [`RadiosityError::NoPatches`] when
     /// nothing (non-degenerate) remains.
     pub fn build(scene: &Scene, params: &MeshParams) -> Result<Self, RadiosityError> {
+        Self::build_refined(scene, params, None)
+    }
+
+    /// [`Mesh::build`] for a lighting whose suns shine from `dirs_to_sun` (unit vectors toward
+    /// them): with [`MeshParams::shadow_edge_element_m`] set, elements that a shadow edge of
+    /// theirs crosses are split down to that size
+    /// ([`super::shadow_refinement::crosses_shadow_edge`]). The shadows are those `occluders`
+    /// casts, or `scene`'s own when `None`.
+    ///
+    /// # Errors
+    /// As [`Mesh::build_refined`]; a tracer error for the scene.
+    pub fn build_lit(
+        scene: &Scene,
+        params: &MeshParams,
+        dirs_to_sun: &[Vector3<f64>],
+        occluders: Option<&SceneTracer>,
+    ) -> Result<Self, RadiosityError> {
+        let Some(min_element_edge_m) = params
+            .shadow_edge_element_m
+            .filter(|_| !dirs_to_sun.is_empty())
+        else {
+            return Self::build(scene, params);
+        };
+        let own;
+        let tracer = if let Some(t) = occluders {
+            t
+        } else {
+            own = SceneTracer::new(scene, BuildQuality::Medium)?;
+            &own
+        };
+        let split = |v: &[Point3<f64>; 3], n: &Vector3<f64>| {
+            super::shadow_refinement::crosses_shadow_edge(tracer, dirs_to_sun, v, n)
+        };
+        let refinement = Refinement {
+            min_element_edge_m,
+            split: &split,
+        };
+        Self::build_refined(scene, params, Some(&refinement))
+    }
+
+    /// [`Mesh::build`], splitting elements further where `refinement` asks (module doc).
+    ///
+    /// # Errors
+    /// As [`Mesh::build`]; [`RadiosityError::InvalidParameter`] for a non-positive
+    /// `min_element_edge_m`; [`RadiosityError::TooManyElements`] when the refined mesh passes
+    /// the budget.
+    pub fn build_refined(
+        scene: &Scene,
+        params: &MeshParams,
+        refinement: Option<&Refinement<'_>>,
+    ) -> Result<Self, RadiosityError> {
+        if let Some(r) = refinement {
+            check_positive("min_element_edge_m", r.min_element_edge_m)?;
+        }
         check_positive("max_patch_edge_m", params.max_patch_edge_m)?;
         check_positive("max_element_edge_m", params.max_element_edge_m)?;
         let object_names: Vec<String> = scene.objects().iter().map(|o| o.name.clone()).collect();
@@ -283,9 +373,15 @@ impl Mesh {
                 cross / (2.0 * area_m2),
                 surface,
                 0,
-                patch_levels,
-                element_levels,
+                [patch_levels, element_levels],
+                refinement,
             );
+            if mesh.elements.len() > params.max_elements {
+                return Err(RadiosityError::TooManyElements {
+                    limit: params.max_elements,
+                    object: name_of(tri.object),
+                });
+            }
         }
         if mesh.elements.is_empty() {
             let reason = if scene.triangles().is_empty() {
@@ -306,8 +402,8 @@ impl Mesh {
         normal_in_world: Vector3<f64>,
         surface: u32,
         level: u32,
-        patch_level: u32,
-        element_level: u32,
+        [patch_level, element_level]: [u32; 2],
+        refinement: Option<&Refinement<'_>>,
     ) -> u32 {
         let id = self.nodes.len() as u32;
         let area_m2 = 0.5 * (v[1] - v[0]).cross(&(v[2] - v[0])).norm();
@@ -323,10 +419,16 @@ impl Mesh {
         if level == patch_level {
             self.patches.push(id);
         }
-        if level == element_level {
-            self.nodes[id as usize].element = Some(self.elements.len() as u32);
-            self.elements.push(id);
-            return id;
+        if level >= element_level {
+            let split = level < MAX_LEVEL
+                && refinement.is_some_and(|r| {
+                    longest_edge_m(&v) > r.min_element_edge_m && (r.split)(&v, &normal_in_world)
+                });
+            if !split {
+                self.nodes[id as usize].element = Some(self.elements.len() as u32);
+                self.elements.push(id);
+                return id;
+            }
         }
         let mid = |a: &Point3<f64>, b: &Point3<f64>| Point3::from((a.coords + b.coords) * 0.5);
         let [a, b, c] = v;
@@ -337,8 +439,8 @@ impl Mesh {
                 normal_in_world,
                 surface,
                 level + 1,
-                patch_level,
-                element_level,
+                [patch_level, element_level],
+                refinement,
             )
         });
         self.nodes[id as usize].children = Some(children);

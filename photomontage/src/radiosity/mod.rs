@@ -48,6 +48,7 @@ pub mod hierarchical;
 pub mod mesh;
 pub mod progressive;
 pub mod query;
+pub mod shadow_refinement;
 mod shooting;
 mod sky_transfer;
 mod solve;
@@ -67,6 +68,8 @@ mod peer_tests;
 #[cfg(test)]
 mod radiance_tests;
 #[cfg(test)]
+mod shadow_refinement_tests;
+#[cfg(test)]
 mod solver_tests;
 #[cfg(test)]
 pub(crate) mod test_scenes;
@@ -75,11 +78,11 @@ mod transfer_tests;
 
 pub use convergence::{ConvergenceRow, StopRule};
 pub use form_factor::FormFactorParams;
-pub use mesh::{Mesh, MeshParams, MeshWarning};
+pub use mesh::{Mesh, MeshParams, MeshWarning, Refinement};
 pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
 pub use solve::{
     GroupSolution, LightGroup, RadiosityDifference, SkyLight, Solution, SolveParams, Solver, solve,
-    solve_on_mesh,
+    solve_on_mesh, sun_directions,
 };
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 pub use transfer::{

@@ -309,6 +309,17 @@ impl Solution {
     }
 }
 
+/// The directions toward the distant sources of the groups named `sun` ([`LightGroup::sun`]),
+/// whose shadow edges [`Mesh::build_lit`] may refine.
+#[must_use]
+pub fn sun_directions(groups: &[LightGroup]) -> Vec<nalgebra::Vector3<f64>> {
+    groups
+        .iter()
+        .filter(|g| g.name == "sun")
+        .flat_map(|g| g.sources.iter().map(|s| s.dir_in_world))
+        .collect()
+}
+
 /// Meshes `scene`, lights it by `groups` and solves (module doc). `on_pass` sees every pass.
 ///
 /// # Errors
@@ -321,7 +332,7 @@ pub fn solve(
     on_pass: &dyn Fn(&ConvergenceRow),
 ) -> Result<Solution, RadiosityError> {
     params.stop.validate()?;
-    let mesh = Mesh::build(scene, &params.mesh)?;
+    let mesh = Mesh::build_lit(scene, &params.mesh, &sun_directions(groups), None)?;
     let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
     solve_on_mesh(mesh, &tracer, groups, params, cancel, on_pass)
 }

@@ -54,7 +54,7 @@ use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
 use super::shooting::{ShootScratch, ShotGroup, shoot};
 use super::sky_transfer::SkyTransfer;
-use super::solve::{GroundTerm, group_direct, initial_exitance};
+use super::solve::{GroundTerm, group_direct, initial_exitance, sun_directions};
 use super::source_rows::SourceRows;
 use super::sources::{self, DirectSamples, LightWarning};
 pub use super::sweeps::Sweep;
@@ -191,6 +191,25 @@ impl Transfer {
         cancel: &AtomicBool,
         on_pass: &dyn Fn(&ConvergenceRow),
     ) -> Result<Self, RadiosityError> {
+        Self::build_shadowed_by(scene, None, lighting, params, cancel, on_pass)
+    }
+
+    /// [`Transfer::build`] with the mesh refined along the sun shadow edges that `occluders`
+    /// casts instead of `scene`'s own ([`Mesh::build_lit`], when
+    /// [`super::MeshParams::shadow_edge_element_m`] is set): a site's photographed state is
+    /// meshed with the shadows of the scene with the planned objects, so that the natural
+    /// surfaces of both transfers are meshed alike.
+    ///
+    /// # Errors
+    /// As [`Transfer::build`].
+    pub fn build_shadowed_by(
+        scene: &Scene,
+        occluders: Option<&SceneTracer>,
+        lighting: &TransferLighting,
+        params: &TransferParams,
+        cancel: &AtomicBool,
+        on_pass: &dyn Fn(&ConvergenceRow),
+    ) -> Result<Self, RadiosityError> {
         params.solve.stop.validate()?;
         let Solver::Hierarchical(h) = params.solve.solver else {
             return Err(RadiosityError::InvalidParameter {
@@ -199,14 +218,20 @@ impl Transfer {
                 reason: "a transfer needs the hierarchical solver (its links are what is stored)",
             });
         };
-        let mut mesh = Mesh::build(scene, &params.solve.mesh)?;
+        let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
+        let (groups, mut warnings) = lighting.light_groups(&dome, params.sky_tolerance)?;
+        // As `solve`: refined along the shadow edges of the sun it is built with.
+        let mut mesh = Mesh::build_lit(
+            scene,
+            &params.solve.mesh,
+            &sun_directions(&groups),
+            occluders,
+        )?;
         let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
         // As `solve_on_mesh`: element parts covered by a solid standing on them do not emit.
         if params.solve.form_factors.visibility {
             super::covered::mark_covered(&mut mesh, &tracer, &params.solve.form_factors);
         }
-        let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
-        let (groups, mut warnings) = lighting.light_groups(&dome, params.sky_tolerance)?;
         let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?;
         let ground = GroundTerm::new(&engine, params.solve.ground.as_ref())?;
         let n = mesh.elements.len();

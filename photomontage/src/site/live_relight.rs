@@ -35,11 +35,12 @@ use super::SiteDocument;
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
 use super::render_radiosity::{RadiosityReport, natural_part, site_solve_params};
+use crate::bvh::BuildQuality;
 use crate::radiosity::{
     LightingChange, RadiosityError, Solution, Transfer, TransferLighting, TransferParams,
 };
 use crate::render::differential::radiosity_light::RadiosityLight;
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneTracer};
 
 /// Two luminaire outputs are the same source dimmed when their channel ratios agree within this
 /// relative difference (ratios of the same `f64` products differ by rounding only).
@@ -321,13 +322,23 @@ impl SiteTransfers {
             element_edge_m,
             notes,
         } = inputs;
+        // As `site_radiosity_light`: both meshes follow the shadows of the scene with the
+        // artificial objects.
+        let occluders = SceneTracer::new(&scenes[0], BuildQuality::Medium)?;
         let build = |k: usize| {
-            Transfer::build(&scenes[k], &lighting[k], &params, cancel, &|_| {})
-                .map(|transfer| Kept {
-                    transfer,
-                    materials: material_state(&scenes[k]),
-                })
-                .map_err(|e| radiosity_error(&e))
+            Transfer::build_shadowed_by(
+                &scenes[k],
+                Some(&occluders),
+                &lighting[k],
+                &params,
+                cancel,
+                &|_| {},
+            )
+            .map(|transfer| Kept {
+                transfer,
+                materials: material_state(&scenes[k]),
+            })
+            .map_err(|e| radiosity_error(&e))
         };
         let with_artificial = build(0)?;
         let without_artificial = build(1)?;

@@ -6,7 +6,10 @@
 //!
 //! Elements are [`ELEMENT_EDGE_M`] long, or longer where the scene's area would need more than
 //! [`ELEMENT_BUDGET`] of them (the size is then √(area / budget), stated in the report); patches
-//! are [`PATCH_PER_ELEMENT`] elements long. The hierarchical solver and the seed's stop rule of
+//! are [`PATCH_PER_ELEMENT`] elements long. Elements that a shadow edge of the view's sun crosses
+//! are split down to [`SHADOW_ELEMENT_EDGE_M`], in both meshes along the shadows of the scene
+//! with the artificial objects (the studio's transfers mesh the same way, for the sun they are
+//! built with). The hierarchical solver and the seed's stop rule of
 //! [`SolveParams::default`] are used.
 //!
 //! # Known limitations
@@ -22,15 +25,19 @@ use std::time::Instant;
 use super::SiteDocument;
 use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
 use super::render_error::SiteRenderError;
-use crate::radiosity::{MeshParams, SolveParams, solve};
+use crate::bvh::BuildQuality;
+use crate::radiosity::{Mesh, MeshParams, SolveParams, solve_on_mesh, sun_directions};
 use crate::render::differential::radiosity_light::RadiosityLight;
-use crate::scene::{ObjectKind, Scene, SceneError};
+use crate::scene::{ObjectKind, Scene, SceneError, SceneTracer};
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
 /// Longest element edge where the budget allows, metres.
 pub const ELEMENT_EDGE_M: f64 = 1.0;
 /// At most about this many elements per solve (the scene's area over the element area).
 pub const ELEMENT_BUDGET: f64 = 20_000.0;
+/// Elements that a sun shadow edge crosses are split down to this edge, metres
+/// ([`crate::radiosity::shadow_refinement`]).
+pub const SHADOW_ELEMENT_EDGE_M: f64 = 1.0;
 /// Patch edge in element edges (the hierarchy's roots).
 pub const PATCH_PER_ELEMENT: f64 = 4.0;
 /// Sky clustering tolerance of the icosahedral dome (as the `radiosity` CLI's default).
@@ -106,6 +113,7 @@ pub fn site_solve_params(
         mesh: MeshParams {
             max_patch_edge_m: PATCH_PER_ELEMENT * element_edge_m,
             max_element_edge_m: element_edge_m,
+            shadow_edge_element_m: Some(SHADOW_ELEMENT_EDGE_M.min(element_edge_m)),
             ..MeshParams::default()
         },
         ground: site_ground_below_horizon(doc, scene)?,
@@ -134,15 +142,32 @@ pub fn site_radiosity_light(
         .map_err(|e| radiosity_error(&e))?;
     let natural = natural_part(scene)?;
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
-    let with = solve(scene, &groups, &params, cancel, &|_| {}).map_err(|e| radiosity_error(&e))?;
+    // Both meshes follow the sun's shadow edges in the scene with the artificial objects (old
+    // and new shadows), so that their natural surfaces are meshed alike.
+    let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
+    let dirs_to_sun = sun_directions(&groups);
+    let mesh = |s: &Scene| {
+        Mesh::build_lit(s, &params.mesh, &dirs_to_sun, Some(&tracer))
+            .map_err(|e| radiosity_error(&e))
+    };
+    let with = solve_on_mesh(mesh(scene)?, &tracer, &groups, &params, cancel, &|_| {})
+        .map_err(|e| radiosity_error(&e))?;
     // The photographed state has none of the project's luminaires.
     let natural_groups: Vec<_> = groups
         .iter()
         .filter(|g| !g.name.starts_with("luminaire"))
         .cloned()
         .collect();
-    let without = solve(&natural, &natural_groups, &params, cancel, &|_| {})
-        .map_err(|e| radiosity_error(&e))?;
+    let natural_tracer = SceneTracer::new(&natural, BuildQuality::Medium)?;
+    let without = solve_on_mesh(
+        mesh(&natural)?,
+        &natural_tracer,
+        &natural_groups,
+        &params,
+        cancel,
+        &|_| {},
+    )
+    .map_err(|e| radiosity_error(&e))?;
     let report = RadiosityReport {
         element_edge_m,
         elements: [with.mesh.elements.len(), without.mesh.elements.len()],
