@@ -29,8 +29,9 @@
 //!
 //! # Known limitations
 //! Surfaces are one-sided (front = counter-clockwise normal) and Lambertian: specular, glass and
-//! water materials are treated by their diffuse reflectance only. Elements are a uniform
-//! subdivision (midpoint 1→4 splits to the element size); there is no discontinuity meshing, the
+//! water materials are treated by their diffuse reflectance only. Elements are midpoint 1→4
+//! splits to the element size, split further only where a sun shadow edge crosses them
+//! ([`shadow_refinement`], when asked for); there is no discontinuity meshing, and otherwise the
 //! adaptivity is the hierarchical solver's (links at coarser levels where the transfer is small).
 //! The renderer uses the solution only in its opt-in radiosity lighting mode
 //! (`render::differential::radiosity_light`). No spectral mode (RGB only). Luminaires are point
