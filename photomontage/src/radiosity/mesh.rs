@@ -171,6 +171,10 @@ pub struct Mesh {
     pub object_names: Vec<String>,
     /// Problems found while meshing.
     pub warnings: Vec<MeshWarning>,
+    /// A hash of the geometry (node vertices, the tree, the elements), set when the mesh is
+    /// built. A reflectance edit keeps it, so that what depends on geometry only (the
+    /// renderer's vertex gathers) can tell a relit mesh from a new one without comparing nodes.
+    pub geometry_hash: u64,
 }
 
 fn longest_edge_m(v: &[Point3<f64>; 3]) -> f64 {
@@ -294,6 +298,7 @@ impl Mesh {
             surfaces: Vec::new(),
             object_names,
             warnings: Vec::new(),
+            geometry_hash: 0,
         };
         let name_of = |id: ObjectId| {
             scene
@@ -391,6 +396,7 @@ impl Mesh {
             };
             return Err(RadiosityError::NoPatches { reason });
         }
+        mesh.geometry_hash = mesh.hash_geometry();
         Ok(mesh)
     }
 
@@ -445,6 +451,25 @@ impl Mesh {
         });
         self.nodes[id as usize].children = Some(children);
         id
+    }
+
+    /// [`Mesh::geometry_hash`] of the mesh as it is.
+    #[must_use]
+    pub fn hash_geometry(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for node in &self.nodes {
+            for v in &node.vertices_in_world_m {
+                for c in v.iter() {
+                    c.to_bits().hash(&mut h);
+                }
+            }
+            node.children.hash(&mut h);
+            node.element.hash(&mut h);
+            node.surface.hash(&mut h);
+        }
+        self.elements.hash(&mut h);
+        h.finish()
     }
 
     /// The node of element `e`.

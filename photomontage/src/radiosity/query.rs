@@ -264,7 +264,7 @@ impl Solution {
     /// from the vertex gathers `gather` of this solution's mesh for the exitances
     /// `radiosity_rgb` (per element) instead of the elements' own values
     /// ([`super::vertex_gather`]); the direct part stays interpolated. `None` where the point
-    /// lies on no element, or when `gather` belongs to another mesh.
+    /// lies on no element, or when `gather` belongs to another geometry.
     #[must_use]
     pub fn irradiance_gathered_at(
         &self,
@@ -273,7 +273,7 @@ impl Solution {
         gather: &VertexGather,
         radiosity_rgb: &[Rgb],
     ) -> Option<IrradianceSample> {
-        if !std::sync::Arc::ptr_eq(gather.mesh(), &self.mesh)
+        if gather.mesh().geometry_hash != self.mesh.geometry_hash
             || radiosity_rgb.len() != self.mesh.elements.len()
         {
             return None;

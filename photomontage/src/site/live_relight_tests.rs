@@ -135,6 +135,7 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
         light.without_artificial.groups,
         fresh.without_artificial.groups
     );
+    let built = light;
     let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Unchanged);
 
@@ -159,10 +160,18 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
         kept.light_groups()[0].len(),
         fresh.with_artificial.groups.len()
     );
+    // A relight keeps the vertex gathers (the rays they traced): the geometry is the same.
+    for k in 0..2 {
+        assert!(
+            Arc::ptr_eq(&built.gathers()[k], &light.gathers()[k]),
+            "gather {k}"
+        );
+    }
 
-    // Moving the model changes the geometry: a build.
+    // Moving the model changes the geometry: a build, with new gathers.
     doc.site.models[0].placement.translation[0] += 2.0;
     let scene = site_scene(&doc).unwrap().scene;
-    let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    let (moved, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Built);
+    assert!(!Arc::ptr_eq(&built.gathers()[0], &moved.gathers()[0]));
 }

@@ -105,7 +105,8 @@ impl RadiosityLight {
     }
 
     /// The same for relit solutions: the vertex gathers (the rays they traced) are kept where a
-    /// solution's mesh is the one this light was built on, and set up anew where it is not.
+    /// solution's mesh has the geometry this light was built on (a relight changes at most its
+    /// reflectances), and set up anew where it has not.
     ///
     /// # Errors
     /// As [`RadiosityLight::new`].
@@ -116,7 +117,7 @@ impl RadiosityLight {
         traced_exactly: &dyn Fn(&str) -> bool,
     ) -> Result<Self, RadiosityError> {
         let keep = |k: usize, s: &Solution| {
-            if Arc::ptr_eq(self.gathers[k].mesh(), &s.mesh) {
+            if self.gathers[k].mesh().geometry_hash == s.mesh.geometry_hash {
                 Ok(Arc::clone(&self.gathers[k]))
             } else {
                 VertexGather::new(Arc::clone(&s.mesh), DEFAULT_RAYS_PER_AXIS).map(Arc::new)
@@ -169,6 +170,12 @@ impl RadiosityLight {
         self.without_artificial
             .irradiance_gathered_at(point, normal, &self.gathers[1], &self.radiosity_rgb[1])
             .map(|s| s.total_rgb)
+    }
+
+    /// The vertex gathers of the two meshes (with, without the artificial objects).
+    #[must_use]
+    pub fn gathers(&self) -> &[Arc<VertexGather>; 2] {
+        &self.gathers
     }
 
     /// Whether a radiosity change `delta` counts against the natural irradiance `natural`.
