@@ -12,11 +12,25 @@ use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
-use photomontage::site::SiteDocument;
 use photomontage::site::render::prepare_view;
 use photomontage::site::render_radiosity::site_radiosity_arc;
+use photomontage::site::{SiteDocument, apply_solution, solve_site};
 
 use crate::sample_site;
+
+/// The `street` sample site with every photo solved (its cameras applied).
+///
+/// # Panics
+/// When the site does not load or a photo fails to solve (a test helper).
+#[must_use]
+#[allow(clippy::unwrap_used)]
+pub fn solved_street() -> SiteDocument {
+    let mut doc = SiteDocument::load(&sample_site("street").join("site.toml")).unwrap();
+    let solution = solve_site(&doc);
+    assert!(solution.failures.is_empty(), "{:?}", solution.failures);
+    apply_solution(&mut doc.site, &solution);
+    doc
+}
 
 /// A pixel is in the building's shadow when the truth is darker than the photo by this factor
 /// (summed RGB), as in `render_mitsuba.rs`.

@@ -36,9 +36,9 @@ use std::fmt::Write as _;
 
 use photomontage::fit::site::{SiteFitOptions, SiteFitReport, apply_fit, fit_site};
 use photomontage::site::FitSettings;
-use photomontage::site::{Sample, SamplePurpose, SiteDocument, apply_solution, solve_site};
+use photomontage::site::{Sample, SamplePurpose, SiteDocument};
 use photomontage_tests::sample_site;
-use photomontage_tests::street::render_street_view;
+use photomontage_tests::street::{render_street_view, solved_street};
 
 /// Box-filter factor of the montage renders (as `street_render.rs`).
 const SCALE: u32 = 4;
@@ -234,11 +234,7 @@ fn run_fit(doc: &SiteDocument, settings: FitSettings, label: &str) -> (SiteFitRe
 
 #[test]
 fn street_daylight_fit_matches_generator() {
-    let site_path = sample_site("street").join("site.toml");
-    let mut doc = SiteDocument::load(&site_path).unwrap();
-    let solution = solve_site(&doc);
-    assert!(solution.failures.is_empty(), "{:?}", solution.failures);
-    apply_solution(&mut doc.site, &solution);
+    let doc = solved_street();
 
     // (1) the joint fit on paving and plaster, with the two base albedos in a temporary copy of
     // the site's library (the other materials shade the surfaces the photos do not show).

@@ -12,9 +12,7 @@
 
 use std::path::Path;
 
-use photomontage::site::{SiteDocument, apply_solution, solve_site};
-use photomontage_tests::sample_site;
-use photomontage_tests::street::render_street_view;
+use photomontage_tests::street::{render_street_view, solved_street};
 
 /// Box-filter factor (`STREET_RENDER_SCALE` overrides it, e.g. 1 for full size).
 const DEFAULT_SCALE: u32 = 4;
@@ -46,11 +44,7 @@ fn scale() -> u32 {
 
 #[test]
 fn street_montage_matches_mitsuba_truth() {
-    let site_path = sample_site("street").join("site.toml");
-    let mut doc = SiteDocument::load(&site_path).unwrap();
-    let solution = solve_site(&doc);
-    assert!(solution.failures.is_empty(), "{:?}", solution.failures);
-    apply_solution(&mut doc.site, &solution);
+    let doc = solved_street();
     let scale = scale();
     let ids: Vec<String> = doc.site.photos.iter().map(|p| p.id.clone()).collect();
     assert!(ids.len() >= 3);

@@ -14,9 +14,9 @@
 //! from the truth's. That is registration, not light; the interior shows the light.
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
-use photomontage::site::{SiteDocument, apply_solution, solve_site};
-use photomontage_tests::sample_site;
-use photomontage_tests::street::{SHADOW_DARKENING, StreetView, render_street_view_in};
+use photomontage_tests::street::{
+    SHADOW_DARKENING, StreetView, render_street_view_in, solved_street,
+};
 
 /// Mean relative error over the interior of the shadow mask (module doc) and its size.
 fn interior_shadow_error(view: &StreetView) -> (f64, usize) {
@@ -75,11 +75,7 @@ const MIN_MASK_PX: usize = 300;
 
 #[test]
 fn street_montage_in_radiosity_mode_matches_mitsuba_truth() {
-    let site_path = sample_site("street").join("site.toml");
-    let mut doc = SiteDocument::load(&site_path).unwrap();
-    let solution = solve_site(&doc);
-    assert!(solution.failures.is_empty(), "{:?}", solution.failures);
-    apply_solution(&mut doc.site, &solution);
+    let doc = solved_street();
     let ids: Vec<String> = doc.site.photos.iter().map(|p| p.id.clone()).collect();
     assert_eq!(ids.len(), 3, "views {ids:?}");
     let mut results = Vec::new();

@@ -29,7 +29,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::sources::{DIRECT_RAY_OFFSET_M, DistantSource};
-use super::surface_point::{barycentric, cosine_direction, vertex_key};
+use super::surface_point::{barycentric, cosine_direction, point_seed, vertex_key};
 use super::vertex_gather::VertexGather;
 use super::{RadiosityError, Rgb, Solution, Transfer};
 
@@ -393,14 +393,7 @@ impl Transfer {
             }
         }
         // Interreflection: the mean exitance seen by cosine-distributed rays.
-        let seed = point
-            .coords
-            .iter()
-            .chain(normal.iter())
-            .fold(0xC0FF_EE00_u64, |h, v| {
-                (h ^ v.to_bits()).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            });
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(point_seed(0xC0FF_EE00, point, normal));
         let mut sum = [0.0; 3];
         for _ in 0..params.gather_rays {
             let dir = cosine_direction(normal, rng.random(), rng.random());

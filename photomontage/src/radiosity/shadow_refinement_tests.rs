@@ -111,24 +111,18 @@ fn the_ground_is_refined_along_a_walls_shadow_edges_only() {
     // The refined mesh resolves the strip: the ground elements whose centroid is in the
     // shadow add up to its 2 m × 10 m plus the 0.4 m × 10 m under the wall, within
     // SHADED_AREA_REL_TOL (elements of the minimum edge along its 25 m outline).
-    let shaded_area: f64 = (0..refined.elements.len())
-        .map(|e| refined.element_node(e))
-        .filter(|n| refined.surfaces[n.surface as usize].object.0 == ground)
-        .filter(|n| {
-            let p = n.centroid_in_world_m() + Vector3::z() * SURFACE_OFFSET_M;
-            tracer.any_hit(&tracer.ray_from_world(&p, &sun, 1e-3, 1e7))
-        })
-        .map(|n| n.area_m2)
-        .sum();
-    let plain_area: f64 = (0..plain.elements.len())
-        .map(|e| plain.element_node(e))
-        .filter(|n| plain.surfaces[n.surface as usize].object.0 == ground)
-        .filter(|n| {
-            let p = n.centroid_in_world_m() + Vector3::z() * SURFACE_OFFSET_M;
-            tracer.any_hit(&tracer.ray_from_world(&p, &sun, 1e-3, 1e7))
-        })
-        .map(|n| n.area_m2)
-        .sum();
+    let shaded_area_of = |mesh: &Mesh| -> f64 {
+        (0..mesh.elements.len())
+            .map(|e| mesh.element_node(e))
+            .filter(|n| mesh.surfaces[n.surface as usize].object.0 == ground)
+            .filter(|n| {
+                let p = n.centroid_in_world_m() + Vector3::z() * SURFACE_OFFSET_M;
+                tracer.any_hit(&tracer.ray_from_world(&p, &sun, 1e-3, 1e7))
+            })
+            .map(|n| n.area_m2)
+            .sum()
+    };
+    let (shaded_area, plain_area) = (shaded_area_of(&refined), shaded_area_of(&plain));
     assert!(
         (shaded_area - 24.0).abs() <= 24.0 * SHADED_AREA_REL_TOL,
         "shaded area {shaded_area} (unrefined {plain_area})"

@@ -46,3 +46,11 @@ pub(super) fn cosine_direction(n: &Vector3<f64>, u1: f64, u2: f64) -> Vector3<f6
     let b = n.cross(&a);
     a * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()
 }
+
+/// A random seed from a surface point and its normal (their bits, mixed with `salt`), so that
+/// the rays a point gathers with depend on the point alone.
+pub(super) fn point_seed(salt: u64, p: &Point3<f64>, n: &Vector3<f64>) -> u64 {
+    p.coords.iter().chain(n.iter()).fold(salt, |h, x| {
+        (h ^ x.to_bits()).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+    })
+}

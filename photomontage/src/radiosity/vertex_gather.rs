@@ -44,7 +44,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::mesh::Mesh;
 use super::sources::DIRECT_RAY_OFFSET_M;
-use super::surface_point::{barycentric, cosine_direction, vertex_key};
+use super::surface_point::{barycentric, cosine_direction, point_seed, vertex_key};
 use super::{RadiosityError, Rgb};
 use crate::bvh::BuildQuality;
 use crate::scene::{Material, ObjectKind, Scene, SceneObject, SceneTracer};
@@ -145,14 +145,7 @@ impl VertexGather {
             .map(|(v, n, centroid_sum, count)| {
                 let towards = centroid_sum / *count - v.coords;
                 let origin = v + towards * INSET_FRACTION + n * DIRECT_RAY_OFFSET_M;
-                let seed = v
-                    .coords
-                    .iter()
-                    .chain(n.iter())
-                    .fold(0x6A7E_5EED_u64, |h, x| {
-                        (h ^ x.to_bits()).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                    });
-                (origin, *n, seed)
+                (origin, *n, point_seed(0x6A7E_5EED, v, n))
             })
             .collect::<Vec<_>>();
         let hits = (0..origins.len()).map(|_| OnceLock::new()).collect();
