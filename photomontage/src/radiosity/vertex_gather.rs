@@ -344,7 +344,7 @@ mod tests {
     /// Lambert's exact point-to-polygon factor from the gather's origin: E = B·F. The error is
     /// the stratified estimate's on an indicator (the ground's outline) with 32 × 32 rays:
     /// measured at most 2.3 % and 0.59 % on average over the 81 wall vertices (16 × 16 rays gave
-    /// 8 % and about 2.5 %).
+    /// up to 8 %).
     const UNIFORM_GROUND_MAX_REL_TOL: f64 = 0.03;
     /// Mean over the wall vertices of the relative error above.
     const UNIFORM_GROUND_MEAN_REL_TOL: f64 = 0.01;
