@@ -7,7 +7,7 @@
 //!
 //! The site's 1 km ground takes the element size to 7.1 m under the element budget
 //! (`render_radiosity::ELEMENT_BUDGET`); elements that a sun shadow edge crosses are split to
-//! 1 m. Besides the shadow mask of `street_render.rs` the test measures its **interior** (shadow
+//! 1 m (along the shadows of the scene with and without the building). Besides the shadow mask of `street_render.rs` the test measures its **interior** (shadow
 //! pixels whose four neighbours are shadow pixels too): in V1 and V2 the shadow is a strip a few
 //! pixels tall at this scale, and most of its error sits in the rows along its edges, where the
 //! solved camera (0.3 px click noise, 1 cm survey noise) puts the edge a fraction of a pixel away
@@ -54,19 +54,19 @@ fn interior_shadow_error(view: &StreetView) -> (f64, usize) {
 /// Box-filter factor, as `street_render.rs`.
 const SCALE: u32 = 4;
 
-/// Building pixels, mean relative error per view (V1, V2, V3). Measured 2026-11-25: 1.54 %,
-/// 1.53 %, 2.26 % (the facet mode, `street_render.rs`: 1.6 %, 2.1 %, 3.9 %; this mode before the
+/// Building pixels, mean relative error per view (V1, V2, V3). Measured 2026-11-25: 1.55 %,
+/// 1.54 %, 2.18 % (the facet mode, `street_render.rs`: 1.6 %, 2.1 %, 3.9 %; this mode before the
 /// shadow-edge refinement 2.05 %, 1.92 %, 2.72 %, and before the vertex gathers worse again).
 /// Bounds: the measurement plus 0.5 %.
-const BUILDING_MEAN_REL_TOL: [f64; 3] = [0.021, 0.021, 0.028];
-/// Shadow pixels, mean relative error per view. Measured 2026-11-25: 5.90 %, 5.05 %, 3.30 %
+const BUILDING_MEAN_REL_TOL: [f64; 3] = [0.021, 0.021, 0.027];
+/// Shadow pixels, mean relative error per view. Measured 2026-11-25: 5.86 %, 5.71 %, 2.84 %
 /// (facet mode 9.8 %, 9.2 %, 5.2 %). Bounds: the measurement plus 0.5 %. The 5 % holds in
-/// V3 and not quite in V1 and V2, whose masks are mostly edge rows (module doc).
-const SHADOW_MEAN_REL_TOL: [f64; 3] = [0.064, 0.056, 0.038];
+/// V3 and not in V1 and V2, whose masks are mostly edge rows (module doc).
+const SHADOW_MEAN_REL_TOL: [f64; 3] = [0.064, 0.063, 0.034];
 /// Interior shadow pixels (module doc), mean relative error per view. Measured 2026-11-25:
-/// 2.23 %, 2.13 %, 2.44 % (154, 328 and 4 751 pixels); the facet mode gives 4.2 %, 4.0 %, 3.6 %
-/// there. Bound: the 3 %.
-const SHADOW_INTERIOR_MEAN_REL_TOL: f64 = 0.03;
+/// 1.85 %, 1.71 %, 1.78 % (154, 328 and 4 751 pixels); the facet mode gives 4.2 %, 4.0 %, 3.6 %
+/// there. Bound: the measurement plus 0.5 % or so, within the 3 %.
+const SHADOW_INTERIOR_MEAN_REL_TOL: f64 = 0.025;
 /// Interior masks smaller than this are not measured (pixels at 1/4 scale).
 const MIN_INTERIOR_PX: usize = 100;
 /// A view is only measured where its masks are big enough to mean something (pixels at 1/4

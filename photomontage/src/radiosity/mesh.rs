@@ -232,8 +232,8 @@ impl Mesh {
     /// [`Mesh::build`] for a lighting whose suns shine from `dirs_to_sun` (unit vectors toward
     /// them): with [`MeshParams::shadow_edge_element_m`] set, elements that a shadow edge of
     /// theirs crosses are split down to that size
-    /// ([`super::shadow_refinement::crosses_shadow_edge`]). The shadows are those `occluders`
-    /// casts, or `scene`'s own when `None`.
+    /// ([`super::shadow_refinement::crosses_shadow_edge`]). The shadows are those each of
+    /// `occluders` casts (an edge in any of them splits), or `scene`'s own when it is empty.
     ///
     /// # Errors
     /// As [`Mesh::build_refined`]; a tracer error for the scene.
@@ -241,7 +241,7 @@ impl Mesh {
         scene: &Scene,
         params: &MeshParams,
         dirs_to_sun: &[Vector3<f64>],
-        occluders: Option<&SceneTracer>,
+        occluders: &[&SceneTracer],
     ) -> Result<Self, RadiosityError> {
         let Some(min_element_edge_m) = params
             .shadow_edge_element_m
@@ -250,14 +250,16 @@ impl Mesh {
             return Self::build(scene, params);
         };
         let own;
-        let tracer = if let Some(t) = occluders {
-            t
+        let tracers: &[&SceneTracer] = if occluders.is_empty() {
+            own = [SceneTracer::new(scene, BuildQuality::Medium)?];
+            &[&own[0]]
         } else {
-            own = SceneTracer::new(scene, BuildQuality::Medium)?;
-            &own
+            occluders
         };
         let split = |v: &[Point3<f64>; 3], n: &Vector3<f64>| {
-            super::shadow_refinement::crosses_shadow_edge(tracer, dirs_to_sun, v, n)
+            tracers
+                .iter()
+                .any(|t| super::shadow_refinement::crosses_shadow_edge(t, dirs_to_sun, v, n))
         };
         let refinement = Refinement {
             min_element_edge_m,

@@ -77,7 +77,7 @@ fn the_ground_is_refined_along_a_walls_shadow_edges_only() {
             ..params.clone()
         },
         &dirs,
-        None,
+        &[],
     )
     .unwrap();
     assert_eq!(lit.nodes, refined.nodes);

@@ -332,7 +332,7 @@ pub fn solve(
     on_pass: &dyn Fn(&ConvergenceRow),
 ) -> Result<Solution, RadiosityError> {
     params.stop.validate()?;
-    let mesh = Mesh::build_lit(scene, &params.mesh, &sun_directions(groups), None)?;
+    let mesh = Mesh::build_lit(scene, &params.mesh, &sun_directions(groups), &[])?;
     let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
     solve_on_mesh(mesh, &tracer, groups, params, cancel, on_pass)
 }

@@ -191,20 +191,20 @@ impl Transfer {
         cancel: &AtomicBool,
         on_pass: &dyn Fn(&ConvergenceRow),
     ) -> Result<Self, RadiosityError> {
-        Self::build_shadowed_by(scene, None, lighting, params, cancel, on_pass)
+        Self::build_shadowed_by(scene, &[], lighting, params, cancel, on_pass)
     }
 
-    /// [`Transfer::build`] with the mesh refined along the sun shadow edges that `occluders`
-    /// casts instead of `scene`'s own ([`Mesh::build_lit`], when
-    /// [`super::MeshParams::shadow_edge_element_m`] is set): a site's photographed state is
-    /// meshed with the shadows of the scene with the planned objects, so that the natural
-    /// surfaces of both transfers are meshed alike.
+    /// [`Transfer::build`] with the mesh refined along the sun shadow edges that each of
+    /// `occluders` casts instead of `scene`'s own ([`Mesh::build_lit`], when
+    /// [`super::MeshParams::shadow_edge_element_m`] is set): a site's two transfers are both
+    /// meshed along the shadows of the scene with and without the planned objects, so that
+    /// their natural surfaces are meshed alike and each resolves its own shadows.
     ///
     /// # Errors
     /// As [`Transfer::build`].
     pub fn build_shadowed_by(
         scene: &Scene,
-        occluders: Option<&SceneTracer>,
+        occluders: &[&SceneTracer],
         lighting: &TransferLighting,
         params: &TransferParams,
         cancel: &AtomicBool,

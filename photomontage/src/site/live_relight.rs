@@ -322,13 +322,14 @@ impl SiteTransfers {
             element_edge_m,
             notes,
         } = inputs;
-        // As `site_radiosity_light`: both meshes follow the shadows of the scene with the
-        // artificial objects.
-        let occluders = SceneTracer::new(&scenes[0], BuildQuality::Medium)?;
+        // As `site_radiosity_light`: both meshes follow the shadows of the scene with and
+        // without the artificial objects.
+        let with_tracer = SceneTracer::new(&scenes[0], BuildQuality::Medium)?;
+        let natural_tracer = SceneTracer::new(&scenes[1], BuildQuality::Medium)?;
         let build = |k: usize| {
             Transfer::build_shadowed_by(
                 &scenes[k],
-                Some(&occluders),
+                &[&with_tracer, &natural_tracer],
                 &lighting[k],
                 &params,
                 cancel,

@@ -8,8 +8,8 @@
 //! [`ELEMENT_BUDGET`] of them (the size is then √(area / budget), stated in the report); patches
 //! are [`PATCH_PER_ELEMENT`] elements long. Elements that a shadow edge of the view's sun crosses
 //! are split down to [`SHADOW_ELEMENT_EDGE_M`], in both meshes along the shadows of the scene
-//! with the artificial objects (the studio's transfers mesh the same way, for the sun they are
-//! built with). The hierarchical solver and the seed's stop rule of
+//! with and without the artificial objects (the studio's transfers mesh the same way, for the
+//! sun they are built with). The hierarchical solver and the seed's stop rule of
 //! [`SolveParams::default`] are used.
 //!
 //! # Known limitations
@@ -142,12 +142,14 @@ pub fn site_radiosity_light(
         .map_err(|e| radiosity_error(&e))?;
     let natural = natural_part(scene)?;
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
-    // Both meshes follow the sun's shadow edges in the scene with the artificial objects (old
-    // and new shadows), so that their natural surfaces are meshed alike.
+    // Both meshes follow the sun's shadow edges in the scene with and without the artificial
+    // objects, so that their natural surfaces are meshed alike and each resolves its shadows
+    // (an old shadow edge inside a new shadow shows in the photographed state only).
     let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
+    let natural_tracer = SceneTracer::new(&natural, BuildQuality::Medium)?;
     let dirs_to_sun = sun_directions(&groups);
     let mesh = |s: &Scene| {
-        Mesh::build_lit(s, &params.mesh, &dirs_to_sun, Some(&tracer))
+        Mesh::build_lit(s, &params.mesh, &dirs_to_sun, &[&tracer, &natural_tracer])
             .map_err(|e| radiosity_error(&e))
     };
     let with = solve_on_mesh(mesh(scene)?, &tracer, &groups, &params, cancel, &|_| {})
@@ -158,7 +160,6 @@ pub fn site_radiosity_light(
         .filter(|g| !g.name.starts_with("luminaire"))
         .cloned()
         .collect();
-    let natural_tracer = SceneTracer::new(&natural, BuildQuality::Medium)?;
     let without = solve_on_mesh(
         mesh(&natural)?,
         &natural_tracer,
