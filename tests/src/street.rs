@@ -83,6 +83,37 @@ pub struct Measured {
     pub rmse_photo: f64,
 }
 
+impl Measured {
+    /// Asserts the checks every street montage test makes on view `id`: both masks at least
+    /// `min_mask_px`, building and shadow mean relative errors within their bounds, and the
+    /// montage closer to the truth than the photo.
+    ///
+    /// # Panics
+    /// When a check fails (a test helper).
+    pub fn assert_within(&self, id: &str, min_mask_px: usize, building_tol: f64, shadow_tol: f64) {
+        assert!(
+            self.building_px >= min_mask_px && self.shadow_px >= min_mask_px,
+            "{id}: masks {} building, {} shadow",
+            self.building_px,
+            self.shadow_px
+        );
+        assert!(
+            self.building_mre <= building_tol,
+            "{id}: building {}",
+            self.building_mre
+        );
+        assert!(
+            self.shadow_mre <= shadow_tol,
+            "{id}: shadow {}",
+            self.shadow_mre
+        );
+        assert!(
+            self.rmse < self.rmse_photo,
+            "{id}: the montage must be closer to the truth than the photo"
+        );
+    }
+}
+
 /// Measures a montage `out` against `truth`, the shadow mask taken from `truth` vs `photo`.
 #[must_use]
 pub fn measure(out: &RenderedImage, truth: &Rgb32FImage, photo: &Rgb32FImage) -> Measured {

@@ -75,25 +75,6 @@ fn street_montage_matches_mitsuba_truth() {
     }
     // All views are measured and printed before any assertion.
     for (id, m) in &results {
-        assert!(
-            m.building_px >= MIN_MASK_PX && m.shadow_px >= MIN_MASK_PX,
-            "{id}: masks {} building, {} shadow",
-            m.building_px,
-            m.shadow_px
-        );
-        assert!(
-            m.building_mre <= BUILDING_MEAN_REL_TOL,
-            "{id}: building {}",
-            m.building_mre
-        );
-        assert!(
-            m.shadow_mre <= SHADOW_MEAN_REL_TOL,
-            "{id}: shadow {}",
-            m.shadow_mre
-        );
-        assert!(
-            m.rmse < m.rmse_photo,
-            "{id}: the montage must be closer to the truth than the photo"
-        );
+        m.assert_within(id, MIN_MASK_PX, BUILDING_MEAN_REL_TOL, SHADOW_MEAN_REL_TOL);
     }
 }
