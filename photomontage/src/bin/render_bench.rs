@@ -10,8 +10,15 @@
 //! the pixels changed, and the RMSE against the 1024-spp `with_box` truth. Then the peers' render
 //! times and RMSE of the same scene read from `peers/results/{mitsuba,blender}_*.json`.
 //!
+//! `--lighting radiosity` renders in the radiosity lighting mode instead of the sky facets and
+//! photo-bounce gathers: the pair's solutions with and without the box
+//! ([`photomontage::peer_scene::radiosity::mitsuba_pair_radiosity`], as the accuracy test
+//! `render_mitsuba_radiosity.rs`) are solved at every rep and timed as the precompute, printed
+//! beside the render; each render gets a fresh renderer light, so its vertex gathers are traced
+//! within the render time, as in a first render.
+//!
 //! Usage: `render_bench [BENCH_DIR] [--reps N] [--threads 1,2] [--spp 4-4,4-8,...]
-//! [--cache on,off]`.
+//! [--cache on,off] [--lighting facets,radiosity]`.
 //! `BENCH_DIR` (or `PHOTOMONTAGE_BENCH_DATA`) is the shared bench folder holding
 //! `data/mitsuba/`; without it the program prints a notice and exits 0.
 //!
@@ -25,6 +32,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Parser;
+use photomontage::peer_scene::radiosity::mitsuba_pair_radiosity;
 use photomontage::peer_scene::{MAX_DEPTH, mitsuba_pair_scene};
 use photomontage::render::{DifferentialTracer, RenderSettings, render_view};
 use serde_json::Value;
@@ -47,6 +55,10 @@ struct Args {
     /// gathers afresh, the renderer before the cache).
     #[arg(long, default_value = "on", value_delimiter = ',')]
     cache: Vec<String>,
+    /// Lighting modes, comma-separated: `facets` (sky facets and photo-bounce gathers) and / or
+    /// `radiosity` (the radiosity solutions, precompute timed beside the render).
+    #[arg(long, default_value = "facets", value_delimiter = ',')]
+    lighting: Vec<String>,
     /// Folder with the peers' results JSON (default: BENCH_DIR/peers/results).
     #[arg(long)]
     peer_results: Option<PathBuf>,
@@ -201,10 +213,12 @@ fn main() -> Result<()> {
         )
     );
     println!(
-        "{:>5} {:>7} {:>7} {:>9} {:>10} {:>12} {:>9} {:>11} {:>9}",
+        "{:>9} {:>5} {:>7} {:>7} {:>12} {:>9} {:>10} {:>12} {:>9} {:>11} {:>9}",
+        "lighting",
         "cache",
         "threads",
         "spp",
+        "precompute s",
         "setup s",
         "render s",
         "render CPU s",
@@ -221,10 +235,20 @@ fn main() -> Result<()> {
             other => bail!("--cache {other}: on or off"),
         })
         .collect::<Result<Vec<bool>>>()?;
-    for (&threads, &cache) in args
+    let radiosity_modes = args
+        .lighting
+        .iter()
+        .map(|l| match l.trim() {
+            "facets" => Ok(false),
+            "radiosity" => Ok(true),
+            other => bail!("--lighting {other}: facets or radiosity"),
+        })
+        .collect::<Result<Vec<bool>>>()?;
+    for ((&threads, &cache), &radiosity) in args
         .threads
         .iter()
         .flat_map(|t| caches.iter().map(move |c| (t, c)))
+        .flat_map(|tc| radiosity_modes.iter().map(move |r| (tc, r)))
     {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -236,15 +260,25 @@ fn main() -> Result<()> {
                 max_depth: MAX_DEPTH,
                 ..RenderSettings::default()
             };
-            let (mut setup_s, mut render_s, mut cpu_s, mut last) =
-                (Vec::new(), Vec::new(), Vec::new(), None);
+            let (mut precompute_s, mut setup_s, mut render_s, mut cpu_s, mut last) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new(), None);
+            // Radiosity mode: a second render with the vertex gathers the first one traced (the
+            // studio's renders after a relight), wall and CPU seconds.
+            let (mut warm_s, mut warm_cpu_s) = (Vec::new(), Vec::new());
             for _ in 0..args.reps {
+                let mut lighting = peer.lighting.clone();
+                if radiosity {
+                    let t = Instant::now();
+                    let solutions = pool.install(|| mitsuba_pair_radiosity(&peer))?;
+                    precompute_s.push(t.elapsed().as_secs_f64());
+                    lighting.radiosity = Some(std::sync::Arc::new(solutions.light()?));
+                }
                 let t0 = Instant::now();
                 let mut cpu0 = None;
                 let out = pool.install(|| -> Result<_> {
                     let mut tracer = DifferentialTracer::new(
                         &peer.scene,
-                        &peer.lighting,
+                        &lighting,
                         &peer.camera,
                         &photo,
                         MAX_DEPTH,
@@ -255,12 +289,25 @@ fn main() -> Result<()> {
                     let t1 = Instant::now();
                     cpu0 = process_cpu_s();
                     let out = render_view(&tracer, &settings, &|_| {}, &AtomicBool::new(false))?;
-                    Ok((t1, out))
+                    let t1_end = Instant::now();
+                    let cpu1 = process_cpu_s();
+                    if radiosity {
+                        let warm =
+                            render_view(&tracer, &settings, &|_| {}, &AtomicBool::new(false))?;
+                        warm_s.push(t1_end.elapsed().as_secs_f64());
+                        if let (Some(a), Some(b)) = (cpu1, process_cpu_s()) {
+                            warm_cpu_s.push(b - a);
+                        }
+                        if warm.rgba != out.rgba {
+                            bail!("the warm render differs from the first");
+                        }
+                    }
+                    Ok((t1, t1_end, cpu1, out))
                 })?;
-                let (t1, image) = out;
+                let (t1, t1_end, cpu1, image) = out;
                 setup_s.push((t1 - t0).as_secs_f64());
-                render_s.push(t1.elapsed().as_secs_f64());
-                if let (Some(a), Some(b)) = (cpu0, process_cpu_s()) {
+                render_s.push((t1_end - t1).as_secs_f64());
+                if let (Some(a), Some(b)) = (cpu0, cpu1) {
                     cpu_s.push(b - a);
                 }
                 last = Some(image);
@@ -270,9 +317,15 @@ fn main() -> Result<()> {
             let rays_per_px =
                 image.primary_rays as f64 / (f64::from(size_px[0]) * f64::from(size_px[1]));
             println!(
-                "{:>5} {threads:>7} {:>7} {:>9.3} {:>10.3} {:>12} {rays_per_px:>9.2} {:>11} {:>9.5}",
+                "{:>9} {:>5} {threads:>7} {:>7} {:>12} {:>9.3} {:>10.3} {:>12} {rays_per_px:>9.2} {:>11} {:>9.5}",
+                if radiosity { "radiosity" } else { "facets" },
                 if cache { "on" } else { "off" },
                 format!("{min}-{max}"),
+                if precompute_s.is_empty() {
+                    "-".to_owned()
+                } else {
+                    format!("{:.3}", median(precompute_s))
+                },
                 median(setup_s),
                 median(render_s),
                 if cpu_s.is_empty() {
@@ -283,6 +336,22 @@ fn main() -> Result<()> {
                 image.changed_pixels,
                 rmse(&image.rgba, &truth)
             );
+            if !warm_s.is_empty() {
+                println!(
+                    "{:>9} {:>5} {threads:>7} {:>7} {:>12} {:>9} {:>10.3} {:>12} (the same render with the gathers already traced)",
+                    "  warm",
+                    "",
+                    format!("{min}-{max}"),
+                    "",
+                    "",
+                    median(warm_s),
+                    if warm_cpu_s.is_empty() {
+                        "-".to_owned()
+                    } else {
+                        format!("{:.3}", median(warm_cpu_s))
+                    },
+                );
+            }
         }
     }
     print_peers(

@@ -20,6 +20,8 @@
 //! Works on closed solids only (an open CAD shell standing on the ground is not detected);
 //! the fraction is a 16-point estimate (default n = 4), so a 1/16 sliver may be missed.
 
+use std::sync::Arc;
+
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -80,9 +82,9 @@ pub fn mark_covered(mesh: &mut Mesh, tracer: &SceneTracer, params: &FormFactorPa
             fraction
         })
         .collect();
+    let nodes = Arc::make_mut(&mut mesh.nodes);
     for (e, fraction) in open.into_iter().enumerate() {
-        let id = mesh.elements[e] as usize;
-        mesh.nodes[id].open_fraction = fraction;
+        nodes[mesh.elements[e] as usize].open_fraction = fraction;
     }
     // Parents: area-weighted means, children first (post-order from every patch).
     let patches = mesh.patches.clone();
@@ -104,6 +106,6 @@ fn aggregate(mesh: &mut Mesh, n: u32) -> f64 {
         area += a;
     }
     let fraction = if area > 0.0 { sum / area } else { 1.0 };
-    mesh.nodes[n as usize].open_fraction = fraction;
+    Arc::make_mut(&mut mesh.nodes)[n as usize].open_fraction = fraction;
     fraction
 }

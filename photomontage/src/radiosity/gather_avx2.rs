@@ -1,9 +1,15 @@
-//! AVX2 kernel of the shooting gather ([`super::shooting`]) for x86-64, selected at run time
-//! (`is_x86_feature_detected!`): per link, the `S` unshot values of the source (kept in
+//! AVX2 kernels for x86-64, selected at run time (`is_x86_feature_detected!`): the shooting
+//! gather ([`super::shooting`]) and the sky transfer's facet sum ([`super::sky_transfer`]).
+//!
+//! **Gather.** Per link, the `S` unshot values of the source (kept in
 //! registers for the source's whole run) times the factor, added to the receiver's `S` `f32`
 //! accumulators eight (then four, then one) at a time. Each lane does the same separate multiply
 //! and add as the portable loop (no FMA), so the sums are the same bit for bit; the kernel only
 //! does fewer instructions per link.
+//!
+//! **Facet sum.** Eight facets at a time: their escaped-ray counts (`u8`) widened to `f32`, times
+//! the facets' weights, added to eight lane sums; the same multiplies and adds in the same lanes
+//! as the portable loop, so again the same bits.
 //!
 //! # Known limitations
 //! x86-64 only (other targets take the portable loop); no gain for `S` < 4; at most 12 values
@@ -11,8 +17,9 @@
 #![allow(unsafe_code)] // std::arch loads and stores, and the call of a `target_feature` function.
 
 use std::arch::x86_64::{
-    _mm_add_ps, _mm_loadu_ps, _mm_mul_ps, _mm_set1_ps, _mm_storeu_ps, _mm256_add_ps,
-    _mm256_loadu_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps,
+    _mm_add_ps, _mm_loadl_epi64, _mm_loadu_ps, _mm_mul_ps, _mm_set1_ps, _mm_storeu_ps,
+    _mm256_add_ps, _mm256_cvtepi32_ps, _mm256_cvtepu8_epi32, _mm256_loadu_ps, _mm256_mul_ps,
+    _mm256_set1_ps, _mm256_setzero_ps, _mm256_storeu_ps,
 };
 
 /// Proof that this CPU has AVX2: only [`Token::new`] makes one, after checking.
@@ -39,6 +46,36 @@ impl Token {
         // SAFETY: a `Token` exists only if the CPU has AVX2 (`Token::new`).
         unsafe { gather_run_impl::<S>(src, receivers, factors, base, acc) }
     }
+
+    /// The eight lane sums of `Σ_j hits[8b + j] · weights[b][j]` over blocks `b`
+    /// (`hits.len()` = 8 · `weights.len()`).
+    #[inline]
+    pub fn escaped_lanes(self, hits: &[u8], weights: &[[f32; 8]]) -> [f32; 8] {
+        assert_eq!(
+            hits.len(),
+            8 * weights.len(),
+            "eight counts per block of weights"
+        );
+        // SAFETY: a `Token` exists only if the CPU has AVX2 (`Token::new`).
+        unsafe { escaped_lanes_impl(hits, weights) }
+    }
+}
+
+#[target_feature(enable = "avx2")]
+fn escaped_lanes_impl(hits: &[u8], weights: &[[f32; 8]]) -> [f32; 8] {
+    let mut acc = _mm256_setzero_ps();
+    for (w, h) in weights.iter().zip(hits.chunks_exact(8)) {
+        // SAFETY: `h` holds 8 bytes (one unaligned 64-bit load); `w` holds 8 values.
+        unsafe {
+            let counts =
+                _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(h.as_ptr().cast())));
+            acc = _mm256_add_ps(acc, _mm256_mul_ps(counts, _mm256_loadu_ps(w.as_ptr())));
+        }
+    }
+    let mut lanes = [0.0_f32; 8];
+    // SAFETY: `lanes` holds 8 values.
+    unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), acc) };
+    lanes
 }
 
 #[target_feature(enable = "avx2")]

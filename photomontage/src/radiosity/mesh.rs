@@ -28,6 +28,7 @@
 //! one-sided.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
 
@@ -159,8 +160,10 @@ impl MeshNode {
 /// Patches and elements of a scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mesh {
-    /// All nodes: for every scene triangle its subtree, patches and elements included.
-    pub nodes: Vec<MeshNode>,
+    /// All nodes: for every scene triangle its subtree, patches and elements included. Shared
+    /// by the mesh's clones, so that a reflectance edit (a relight clones the mesh the renderer
+    /// still reads) copies surfaces, not nodes.
+    pub nodes: Arc<Vec<MeshNode>>,
     /// Node ids of the patches (hierarchy roots of the hierarchical solver).
     pub patches: Vec<u32>,
     /// Node ids of the elements (leaves), in depth-first order per patch.
@@ -294,7 +297,7 @@ impl Mesh {
             }
         }
         let mut mesh = Self {
-            nodes: Vec::new(),
+            nodes: Arc::new(Vec::new()),
             patches: Vec::new(),
             elements: Vec::new(),
             surfaces: Vec::new(),
@@ -415,7 +418,7 @@ impl Mesh {
     ) -> u32 {
         let id = self.nodes.len() as u32;
         let area_m2 = 0.5 * (v[1] - v[0]).cross(&(v[2] - v[0])).norm();
-        self.nodes.push(MeshNode {
+        Arc::make_mut(&mut self.nodes).push(MeshNode {
             vertices_in_world_m: v,
             normal_in_world,
             area_m2,
@@ -433,7 +436,8 @@ impl Mesh {
                     longest_edge_m(&v) > r.min_element_edge_m && (r.split)(&v, &normal_in_world)
                 });
             if !split {
-                self.nodes[id as usize].element = Some(self.elements.len() as u32);
+                Arc::make_mut(&mut self.nodes)[id as usize].element =
+                    Some(self.elements.len() as u32);
                 self.elements.push(id);
                 return id;
             }
@@ -451,7 +455,7 @@ impl Mesh {
                 refinement,
             )
         });
-        self.nodes[id as usize].children = Some(children);
+        Arc::make_mut(&mut self.nodes)[id as usize].children = Some(children);
         id
     }
 
@@ -460,7 +464,7 @@ impl Mesh {
     pub fn hash_geometry(&self) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        for node in &self.nodes {
+        for node in self.nodes.iter() {
             for v in &node.vertices_in_world_m {
                 for c in v.iter() {
                     c.to_bits().hash(&mut h);

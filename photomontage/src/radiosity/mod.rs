@@ -42,6 +42,7 @@ pub mod convergence;
 pub mod convergence_plot;
 pub mod covered;
 pub mod direct;
+mod element_grid;
 pub mod form_factor;
 #[cfg(target_arch = "x86_64")]
 mod gather_avx2;

@@ -4,9 +4,9 @@
 //!
 //! **Interpolation.** Each element's irradiance (direct, and total H = (B − π·L_e)/ρ) is averaged
 //! at its vertices over the elements of the same plane that share the vertex (Cohen & Wallace,
-//! seed 002, §9.2 "nodal averaging"); a point is located on its element through a uniform grid
-//! of element bounding boxes (cells of the longest element edge) and takes the barycentric blend
-//! of the three vertex values. The lookup is built once per solution ([`std::sync::OnceLock`])
+//! seed 002, §9.2 "nodal averaging"); a point is located on its element through a hash grid of
+//! element bounding boxes, one level per power-of-two size (module `element_grid`), and takes the
+//! barycentric blend of the three vertex values. The lookup is built once per solution ([`std::sync::OnceLock`])
 //! and only read afterwards, so queries run from any number of threads.
 //!
 //! **Final gather** (Cohen & Wallace §9.3.2; the renderer's fallback): the direct term exactly
@@ -28,6 +28,7 @@ use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::element_grid::ElementGrid;
 use super::sources::{DIRECT_RAY_OFFSET_M, DistantSource};
 use super::surface_point::{barycentric, cosine_direction, point_seed, vertex_key};
 use super::vertex_gather::VertexGather;
@@ -42,6 +43,11 @@ pub const NORMAL_MATCH_COS: f64 = 0.95;
 
 /// Barycentric slack when locating a point on an element (points on shared edges).
 const BARYCENTRIC_SLACK: f64 = 1e-6;
+
+/// Padding of the element boxes in the lookup grid, metres: a located point lies within
+/// [`ON_SURFACE_TOL_M`] of the plane and about as far outside an edge, so within √2 of that
+/// of the triangle on any axis; twice the tolerance holds it.
+const GRID_PAD_M: f64 = 2.0 * ON_SURFACE_TOL_M + BARYCENTRIC_SLACK;
 
 /// Irradiance at a point, per channel, in the site's linear units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,8 +84,7 @@ impl Default for QueryParams {
 /// Element lookup grid and per-vertex irradiance of one solution.
 #[derive(Debug, Clone, Default)]
 pub struct ElementLocator {
-    cell_m: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    grid: ElementGrid,
     /// Per element and vertex: (total, direct).
     vertex_values: Vec<[(Rgb, Rgb); 3]>,
     /// Per element, total radiosity B (for gathers).
@@ -95,15 +100,6 @@ fn longest_edge(v: &[Point3<f64>; 3]) -> f64 {
         .norm()
         .max((v[2] - v[1]).norm())
         .max((v[0] - v[2]).norm())
-}
-
-#[allow(clippy::cast_possible_truncation)]
-fn cell_of(p: &Point3<f64>, cell_m: f64) -> [i64; 3] {
-    [
-        (p.x / cell_m).floor() as i64,
-        (p.y / cell_m).floor() as i64,
-        (p.z / cell_m).floor() as i64,
-    ]
 }
 
 impl ElementLocator {
@@ -148,27 +144,7 @@ impl ElementLocator {
         let longest_edge_m: Vec<f64> = (0..n)
             .map(|e| longest_edge(&mesh.element_node(e).vertices_in_world_m))
             .collect();
-        let cell_m = longest_edge_m
-            .iter()
-            .copied()
-            .fold(0.0, f64::max)
-            .max(4.0 * ON_SURFACE_TOL_M);
-        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        for e in 0..n {
-            let v = &mesh.element_node(e).vertices_in_world_m;
-            let lo = v.iter().fold(Point3::from([f64::MAX; 3]), |a, p| a.inf(p));
-            let hi = v.iter().fold(Point3::from([f64::MIN; 3]), |a, p| a.sup(p));
-            let pad = Vector3::repeat(ON_SURFACE_TOL_M);
-            let (a, b) = (cell_of(&(lo - pad), cell_m), cell_of(&(hi + pad), cell_m));
-            for x in a[0]..=b[0] {
-                for y in a[1]..=b[1] {
-                    for z in a[2]..=b[2] {
-                        #[allow(clippy::cast_possible_truncation)]
-                        cells.entry([x, y, z]).or_default().push(e as u32);
-                    }
-                }
-            }
-        }
+        let grid = ElementGrid::new(mesh, GRID_PAD_M);
         let radiosity = solution.total_radiosity_rgb();
         let reflects = (0..n)
             .map(|e| {
@@ -179,8 +155,7 @@ impl ElementLocator {
             })
             .collect();
         Self {
-            cell_m,
-            cells,
+            grid,
             vertex_values,
             radiosity,
             reflects,
@@ -196,9 +171,8 @@ impl ElementLocator {
         point: &Point3<f64>,
         normal: &Vector3<f64>,
     ) -> Option<(usize, [f64; 3])> {
-        let candidates = self.cells.get(&cell_of(point, self.cell_m))?;
         let mut best: Option<(f64, usize, [f64; 3])> = None;
-        for &e in candidates {
+        for e in self.grid.candidates(point) {
             let node = solution.mesh.element_node(e as usize);
             let n = &node.normal_in_world;
             if n.dot(normal) < NORMAL_MATCH_COS {
@@ -215,7 +189,9 @@ impl ElementLocator {
                 continue;
             }
             let score = distance + outside;
-            if best.is_none_or(|(s, _, _)| score < s) {
+            // The lowest score, and of equal scores the lowest element (candidates come level
+            // by level, so the order alone does not decide).
+            if best.is_none_or(|(s, b, _)| score.total_cmp(&s).then((e as usize).cmp(&b)).is_lt()) {
                 let clamped = w.map(|x| x.max(0.0));
                 let sum: f64 = clamped.iter().sum();
                 best = Some((score, e as usize, clamped.map(|x| x / sum)));

@@ -26,6 +26,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::form_factor::FormFactorEngine;
+use super::source_rows::{Simd, simd_token};
 use super::sources::{DIRECT_RAY_LENGTH_M, DIRECT_RAY_OFFSET_M, DirectSamples, sky_leaf_flux};
 use super::{RadiosityError, Rgb};
 use crate::sky::SkyModel;
@@ -194,27 +195,74 @@ impl SkyTransfer {
             }
         }
         let scale = horizontal_irradiance_rgb.map(|k| k / horizontal);
-        Ok(self
-            .normals
-            .par_iter()
-            .zip(self.escaped.par_chunks(blocks * LANES))
-            .map(|(n, escaped)| {
-                // LANES partial sums in a fixed order (so the loop vectorises and the result
-                // is the same on any machine and thread count), then added lane by lane.
-                #[allow(clippy::cast_possible_truncation)]
-                let [nx, ny, nz] = [n.x as f32, n.y as f32, n.z as f32];
-                let mut lanes = [0.0_f32; LANES];
-                for ([x, y, z], hits) in axes.iter().zip(escaped.chunks_exact(LANES)) {
-                    for j in 0..LANES {
-                        let cos = nx * x[j] + ny * y[j] + nz * z[j];
-                        lanes[j] += f32::from(hits[j]) * cos.max(0.0);
+        let stride = blocks * LANES;
+        let simd = simd_token();
+        let mut out = vec![[0.0; 3]; self.normals.len()];
+        out.par_chunks_mut(ELEMENTS_PER_TASK)
+            .zip(self.normals.par_chunks(ELEMENTS_PER_TASK))
+            .zip(self.escaped.par_chunks(ELEMENTS_PER_TASK * stride))
+            .for_each(|((out, normals), escaped)| {
+                // max(0, n·S_f) per facet for the normal of the element before: elements come
+                // patch by patch, so most share their predecessor's normal and its weights.
+                let mut weights = vec![[0.0_f32; LANES]; blocks];
+                let mut weights_of: Option<Vector3<f64>> = None;
+                for ((e, n), hits) in out
+                    .iter_mut()
+                    .zip(normals)
+                    .zip(escaped.chunks_exact(stride))
+                {
+                    if weights_of != Some(*n) {
+                        facet_weights(n, &axes, &mut weights);
+                        weights_of = Some(*n);
                     }
+                    let sum = escaped_sum(simd, hits, &weights);
+                    *e = scale.map(|k| k * sum);
                 }
-                let e: f64 = lanes.iter().map(|&v| f64::from(v)).sum();
-                scale.map(|k| k * e)
-            })
-            .collect())
+            });
+        Ok(out)
     }
+}
+
+/// Elements per parallel task of [`SkyTransfer::direct`].
+const ELEMENTS_PER_TASK: usize = 256;
+
+/// `weights[b][j]` = max(0, n·S_f) for facet f = b·LANES + j (`axes` as in
+/// [`SkyTransfer::direct`]), in `f32`.
+fn facet_weights(n: &Vector3<f64>, axes: &[[[f32; LANES]; 3]], weights: &mut [[f32; LANES]]) {
+    #[allow(clippy::cast_possible_truncation)]
+    let [nx, ny, nz] = [n.x as f32, n.y as f32, n.z as f32];
+    for ([x, y, z], w) in axes.iter().zip(weights.iter_mut()) {
+        for j in 0..LANES {
+            w[j] = (nx * x[j] + ny * y[j] + nz * z[j]).max(0.0);
+        }
+    }
+}
+
+/// Σ_f escaped_f · weight_f: LANES partial sums in a fixed order (the same on any machine and
+/// thread count; with AVX2 in [`super::gather_avx2`], the same bits), then added lane by lane.
+fn escaped_sum(simd: Option<Simd>, hits: &[u8], weights: &[[f32; LANES]]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    let lanes = match simd {
+        Some(token) => token.escaped_lanes(hits, weights),
+        None => escaped_lanes(hits, weights),
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let lanes = {
+        let _ = simd;
+        escaped_lanes(hits, weights)
+    };
+    lanes.iter().map(|&v| f64::from(v)).sum()
+}
+
+/// The portable loop of [`escaped_sum`].
+fn escaped_lanes(hits: &[u8], weights: &[[f32; LANES]]) -> [f32; LANES] {
+    let mut lanes = [0.0_f32; LANES];
+    for (w, hits) in weights.iter().zip(hits.chunks_exact(LANES)) {
+        for j in 0..LANES {
+            lanes[j] += f32::from(hits[j]) * w[j];
+        }
+    }
+    lanes
 }
 
 /// Partial sums per element in the facet sum.
@@ -440,5 +488,44 @@ mod tests {
             "{}",
             sum_f / sum_t
         );
+    }
+
+    /// The facet sum's AVX2 kernel gives the portable loop's lane sums bit for bit, on counts
+    /// 0–255 and weights of every magnitude the sum meets (zeros included).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn vector_facet_sum_equals_the_portable_loop() {
+        let Some(token) = simd_token() else {
+            eprintln!("notice: this CPU has no vector kernel; nothing to compare");
+            return;
+        };
+        let blocks = 37;
+        #[allow(clippy::cast_possible_truncation)]
+        let hits: Vec<u8> = (0..blocks * LANES)
+            .map(|i| (i * 7919 % 256) as u8)
+            .collect();
+        #[allow(clippy::cast_precision_loss)]
+        let weights: Vec<[f32; LANES]> = (0..blocks)
+            .map(|b| {
+                std::array::from_fn(|j| {
+                    let i = b * LANES + j;
+                    if i.is_multiple_of(5) {
+                        0.0
+                    } else {
+                        (i * 104_729 % 1000) as f32 * 1.37e-3 * 10f32.powi((i % 7) as i32 - 3)
+                    }
+                })
+            })
+            .collect();
+        for n in [0, 1, 2, blocks] {
+            let (a, b) = (
+                escaped_lanes(&hits[..n * LANES], &weights[..n]),
+                token.escaped_lanes(&hits[..n * LANES], &weights[..n]),
+            );
+            assert!(
+                a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{n} blocks: {a:?} against {b:?}"
+            );
+        }
     }
 }

@@ -252,7 +252,7 @@ impl Solution {
     /// all interreflected light, theirs included. The differential renderer adds the named
     /// groups' direct light itself with exact shadow rays (the sun, the luminaires).
     #[must_use]
-    pub fn without_direct_of(&self, exact: &dyn Fn(&str) -> bool) -> Self {
+    pub fn without_direct_of(&self, exact: &(dyn Fn(&str) -> bool + Sync)) -> Self {
         let mesh = &self.mesh;
         let groups = self
             .groups
@@ -261,7 +261,9 @@ impl Solution {
                 if !exact(&g.name) {
                     return g.clone();
                 }
+                // Each element on its own: the same values on any number of threads.
                 let radiosity_rgb = (0..mesh.elements.len())
+                    .into_par_iter()
                     .map(|e| {
                         let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
                         std::array::from_fn(|c| {

@@ -90,7 +90,7 @@ impl RadiosityLight {
     pub fn new(
         with_artificial: &Solution,
         without_artificial: &Solution,
-        traced_exactly: &dyn Fn(&str) -> bool,
+        traced_exactly: &(dyn Fn(&str) -> bool + Sync),
     ) -> Result<Self, RadiosityError> {
         let gather = |s: &Solution| {
             VertexGather::new(Arc::clone(&s.mesh), DEFAULT_RAYS_PER_AXIS).map(Arc::new)
@@ -114,7 +114,7 @@ impl RadiosityLight {
         &self,
         with_artificial: &Solution,
         without_artificial: &Solution,
-        traced_exactly: &dyn Fn(&str) -> bool,
+        traced_exactly: &(dyn Fn(&str) -> bool + Sync),
     ) -> Result<Self, RadiosityError> {
         let keep = |k: usize, s: &Solution| {
             if self.gathers[k].mesh().geometry_hash == s.mesh.geometry_hash {
@@ -135,18 +135,24 @@ impl RadiosityLight {
     fn with_gathers(
         with_artificial: &Solution,
         without_artificial: &Solution,
-        traced_exactly: &dyn Fn(&str) -> bool,
+        traced_exactly: &(dyn Fn(&str) -> bool + Sync),
         gathers: [Arc<VertexGather>; 2],
     ) -> Self {
+        // The two solutions are independent: side by side.
+        let side = |s: &Solution| {
+            (
+                Arc::new(s.without_direct_of(traced_exactly)),
+                total_radiosity(s),
+            )
+        };
+        let ((with, with_total), (without, without_total)) =
+            rayon::join(|| side(with_artificial), || side(without_artificial));
         Self {
-            with_artificial: Arc::new(with_artificial.without_direct_of(traced_exactly)),
-            without_artificial: Arc::new(without_artificial.without_direct_of(traced_exactly)),
+            with_artificial: with,
+            without_artificial: without,
             change_fraction: DEFAULT_CHANGE_FRACTION,
             gathers,
-            radiosity_rgb: [
-                total_radiosity(with_artificial),
-                total_radiosity(without_artificial),
-            ],
+            radiosity_rgb: [with_total, without_total],
         }
     }
 

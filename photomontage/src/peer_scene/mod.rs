@@ -2,7 +2,7 @@
 //! ground-plus-box pair described by the shared bench's `data/mitsuba/scene.json` (written by
 //! `peers/mitsuba/render_pair.py`). The accuracy test (`tests/tests/render_mitsuba.rs`) and the
 //! render-speed bench (`render_bench`) both build their scene, camera and lights here, so they
-//! measure the same thing.
+//! measure the same thing; [`radiosity`] adds the pair's radiosity lighting mode.
 //!
 //! Conventions of the JSON (its `units_and_axes` and `camera.pixel_convention` fields): metres,
 //! right-handed, Z up; a look-at pinhole camera with a vertical field of view, forward =
@@ -15,6 +15,8 @@
 //! # Known limitations
 //! Only the ground-plus-box pair is understood (other peer scenes have no JSON description). The
 //! constant sky's lower hemisphere is hidden by the ground in this scene and is not modelled.
+
+pub mod radiosity;
 
 use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
 use serde_json::Value;
@@ -59,6 +61,9 @@ pub enum PeerSceneError {
     /// Building the sky dome failed.
     #[error(transparent)]
     Dome(#[from] DomeError),
+    /// A radiosity solve of the pair failed ([`radiosity::mitsuba_pair_radiosity`]).
+    #[error(transparent)]
+    Radiosity(#[from] crate::radiosity::RadiosityError),
 }
 
 /// The Mitsuba pair as the differential renderer sees it.
