@@ -46,19 +46,22 @@ fn cell_of(p: &Point3<f64>, level: i32) -> [i64; 4] {
     ]
 }
 
+/// The bounding box of element `e`, padded by `pad_m` on every side (low and high corner).
+fn padded_box(mesh: &Mesh, e: usize, pad_m: f64) -> [Point3<f64>; 2] {
+    let v = &mesh.element_node(e).vertices_in_world_m;
+    let pad = Vector3::repeat(pad_m);
+    let lo = v.iter().fold(Point3::from([f64::MAX; 3]), |a, p| a.inf(p)) - pad;
+    let hi = v.iter().fold(Point3::from([f64::MIN; 3]), |a, p| a.sup(p)) + pad;
+    [lo, hi]
+}
+
 impl ElementGrid {
     /// The grid of `mesh`'s elements, each box padded by `pad_m` on every side.
     pub(crate) fn new(mesh: &Mesh, pad_m: f64) -> Self {
         let mut cells: HashMap<[i64; 4], Vec<u32>> = HashMap::new();
         let mut levels: Vec<i32> = Vec::new();
-        let pad = Vector3::repeat(pad_m);
         let boxes: Vec<[Point3<f64>; 2]> = (0..mesh.elements.len())
-            .map(|e| {
-                let v = &mesh.element_node(e).vertices_in_world_m;
-                let lo = v.iter().fold(Point3::from([f64::MAX; 3]), |a, p| a.inf(p)) - pad;
-                let hi = v.iter().fold(Point3::from([f64::MIN; 3]), |a, p| a.sup(p)) + pad;
-                [lo, hi]
-            })
+            .map(|e| padded_box(mesh, e, pad_m))
             .collect();
         for (e, [lo, hi]) in boxes.iter().enumerate() {
             let level = level_of((hi - lo).max());
@@ -160,14 +163,8 @@ mod tests {
     fn candidates_hold_every_box_that_contains_the_point() {
         let mesh = mixed();
         let grid = ElementGrid::new(&mesh, PAD_M);
-        let pad = Vector3::repeat(PAD_M);
-        let boxes: Vec<(Point3<f64>, Point3<f64>)> = (0..mesh.elements.len())
-            .map(|e| {
-                let v = &mesh.element_node(e).vertices_in_world_m;
-                let lo = v.iter().fold(Point3::from([f64::MAX; 3]), |a, p| a.inf(p)) - pad;
-                let hi = v.iter().fold(Point3::from([f64::MIN; 3]), |a, p| a.sup(p)) + pad;
-                (lo, hi)
-            })
+        let boxes: Vec<[Point3<f64>; 2]> = (0..mesh.elements.len())
+            .map(|e| padded_box(&mesh, e, PAD_M))
             .collect();
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut found = 0;
@@ -190,7 +187,7 @@ mod tests {
             let inside: Vec<u32> = boxes
                 .iter()
                 .enumerate()
-                .filter(|(_, (lo, hi))| (0..3).all(|k| lo[k] <= point[k] && point[k] <= hi[k]))
+                .filter(|(_, [lo, hi])| (0..3).all(|k| lo[k] <= point[k] && point[k] <= hi[k]))
                 .map(|(e, _)| e as u32)
                 .collect();
             assert_eq!(got, inside, "at {point}");

@@ -6,8 +6,8 @@
 //! at its vertices over the elements of the same plane that share the vertex (Cohen & Wallace,
 //! seed 002, §9.2 "nodal averaging"); a point is located on its element through a hash grid of
 //! element bounding boxes, one level per power-of-two size (module `element_grid`), and takes the
-//! barycentric blend of the three vertex values. The lookup is built once per solution ([`std::sync::OnceLock`])
-//! and only read afterwards, so queries run from any number of threads.
+//! barycentric blend of the three vertex values. The lookup is built once per solution
+//! ([`std::sync::OnceLock`]) and only read afterwards, so queries run from any number of threads.
 //!
 //! **Final gather** (Cohen & Wallace §9.3.2; the renderer's fallback): the direct term exactly
 //! at the point (one shadow ray per distant source and point source, and the ground below the
