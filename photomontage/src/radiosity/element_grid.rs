@@ -10,9 +10,9 @@
 //! The grid answers "whose padded box may contain the point"; [`super::query`] then checks the
 //! candidates' planes and barycentric coordinates.
 
-use std::collections::HashMap;
-
 use nalgebra::{Point3, Vector3};
+
+use rustc_hash::FxHashMap;
 
 use super::mesh::Mesh;
 
@@ -21,7 +21,8 @@ use super::mesh::Mesh;
 pub(crate) struct ElementGrid {
     /// The levels that hold elements, ascending.
     levels: Vec<i32>,
-    cells: HashMap<[i64; 4], Vec<u32>>,
+    /// Integer keys hash with Fx (the renderer looks up every level at every shading point).
+    cells: FxHashMap<[i64; 4], Vec<u32>>,
     /// Per element, its padded box (low and high corner).
     boxes: Vec<[Point3<f64>; 2]>,
 }
@@ -58,7 +59,7 @@ fn padded_box(mesh: &Mesh, e: usize, pad_m: f64) -> [Point3<f64>; 2] {
 impl ElementGrid {
     /// The grid of `mesh`'s elements, each box padded by `pad_m` on every side.
     pub(crate) fn new(mesh: &Mesh, pad_m: f64) -> Self {
-        let mut cells: HashMap<[i64; 4], Vec<u32>> = HashMap::new();
+        let mut cells: FxHashMap<[i64; 4], Vec<u32>> = FxHashMap::default();
         let mut levels: Vec<i32> = Vec::new();
         let boxes: Vec<[Point3<f64>; 2]> = (0..mesh.elements.len())
             .map(|e| padded_box(mesh, e, pad_m))

@@ -91,7 +91,7 @@ pub use transfer::{
     LightingChange, NamedLuminaire, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, RelightStrategy, Sky,
     Sun, Sweep, Transfer, TransferLighting, TransferParams,
 };
-pub use vertex_gather::VertexGather;
+pub use vertex_gather::{GatheredExitance, VertexGather};
 
 /// RGB triple (linear).
 pub type Rgb = [f64; 3];

@@ -30,8 +30,8 @@ use rand_chacha::ChaCha8Rng;
 
 use super::element_grid::ElementGrid;
 use super::sources::{DIRECT_RAY_OFFSET_M, DistantSource};
-use super::surface_point::{barycentric, cosine_direction, point_seed, vertex_key};
-use super::vertex_gather::VertexGather;
+use super::surface_point::{TriangleShape, cosine_direction, point_seed, vertex_key};
+use super::vertex_gather::GatheredExitance;
 use super::{RadiosityError, Rgb, Solution, Transfer};
 
 /// A query point lies on an element when it is within this distance of its plane, metres
@@ -91,15 +91,8 @@ pub struct ElementLocator {
     radiosity: Vec<Rgb>,
     /// Per element: reflects (ρ > 0 in some channel).
     reflects: Vec<bool>,
-    /// Per element, longest edge, metres.
-    longest_edge_m: Vec<f64>,
-}
-
-fn longest_edge(v: &[Point3<f64>; 3]) -> f64 {
-    (v[1] - v[0])
-        .norm()
-        .max((v[2] - v[1]).norm())
-        .max((v[0] - v[2]).norm())
+    /// Per element, its triangle as the lookup tests it.
+    shapes: Vec<TriangleShape>,
 }
 
 impl ElementLocator {
@@ -141,8 +134,11 @@ impl ElementLocator {
                 })
             })
             .collect();
-        let longest_edge_m: Vec<f64> = (0..n)
-            .map(|e| longest_edge(&mesh.element_node(e).vertices_in_world_m))
+        let shapes: Vec<TriangleShape> = (0..n)
+            .map(|e| {
+                let node = mesh.element_node(e);
+                TriangleShape::new(&node.vertices_in_world_m, &node.normal_in_world)
+            })
             .collect();
         let grid = ElementGrid::new(mesh, GRID_PAD_M);
         let radiosity = solution.total_radiosity_rgb();
@@ -159,32 +155,25 @@ impl ElementLocator {
             vertex_values,
             radiosity,
             reflects,
-            longest_edge_m,
+            shapes,
         }
     }
 
     /// The element `point` lies on (normal within [`NORMAL_MATCH_COS`], plane within
     /// [`ON_SURFACE_TOL_M`]) and its barycentric weights.
-    fn locate(
-        &self,
-        solution: &Solution,
-        point: &Point3<f64>,
-        normal: &Vector3<f64>,
-    ) -> Option<(usize, [f64; 3])> {
+    fn locate(&self, point: &Point3<f64>, normal: &Vector3<f64>) -> Option<(usize, [f64; 3])> {
         let mut best: Option<(f64, usize, [f64; 3])> = None;
         for e in self.grid.candidates(point) {
-            let node = solution.mesh.element_node(e as usize);
-            let n = &node.normal_in_world;
-            if n.dot(normal) < NORMAL_MATCH_COS {
+            let shape = &self.shapes[e as usize];
+            if shape.normal.dot(normal) < NORMAL_MATCH_COS {
                 continue;
             }
-            let [a, b, c] = node.vertices_in_world_m;
-            let distance = (point - a).dot(n).abs();
+            let distance = shape.distance_m(point);
             if distance > ON_SURFACE_TOL_M {
                 continue;
             }
-            let w = barycentric(point, &a, &b, &c, n);
-            let outside = w.iter().map(|&x| (-x).max(0.0)).sum::<f64>() * longest_edge(&[a, b, c]);
+            let w = shape.weights(point);
+            let outside = w.iter().map(|&x| (-x).max(0.0)).sum::<f64>() * shape.longest_edge_m;
             if outside > BARYCENTRIC_SLACK + ON_SURFACE_TOL_M {
                 continue;
             }
@@ -215,7 +204,7 @@ impl Solution {
         normal_in_world: &Vector3<f64>,
     ) -> Option<IrradianceSample> {
         let locator = self.locator();
-        let (e, w) = locator.locate(self, point_in_world_m, normal_in_world)?;
+        let (e, w) = locator.locate(point_in_world_m, normal_in_world)?;
         let values = &locator.vertex_values[e];
         let mut total = [0.0; 3];
         let mut direct = [0.0; 3];
@@ -237,32 +226,29 @@ impl Solution {
 
 impl Solution {
     /// Irradiance at a point as [`Solution::irradiance_at`], with the interreflected part taken
-    /// from the vertex gathers `gather` of this solution's mesh for the exitances
-    /// `radiosity_rgb` (per element) instead of the elements' own values
+    /// from vertex gathers of this solution's mesh summing the exitances `gathered` holds
+    /// instead of the elements' own values
     /// ([`super::vertex_gather`]); the direct part stays interpolated. `None` where the point
-    /// lies on no element, or when `gather` belongs to another geometry.
+    /// lies on no element, or when the gathers belong to another geometry.
     #[must_use]
     pub fn irradiance_gathered_at(
         &self,
         point_in_world_m: &Point3<f64>,
         normal_in_world: &Vector3<f64>,
-        gather: &VertexGather,
-        radiosity_rgb: &[Rgb],
+        gathered: &GatheredExitance,
     ) -> Option<IrradianceSample> {
-        if gather.mesh().geometry_hash != self.mesh.geometry_hash
-            || radiosity_rgb.len() != self.mesh.elements.len()
-        {
+        if gathered.gather().mesh().geometry_hash != self.mesh.geometry_hash {
             return None;
         }
         let locator = self.locator();
-        let (e, w) = locator.locate(self, point_in_world_m, normal_in_world)?;
+        let (e, w) = locator.locate(point_in_world_m, normal_in_world)?;
         let mut direct = [0.0; 3];
         for (k, (_, d)) in locator.vertex_values[e].iter().enumerate() {
             for c in 0..3 {
                 direct[c] += w[k] * d[c];
             }
         }
-        let indirect = gather.indirect_rgb(e, w, radiosity_rgb);
+        let indirect = gathered.indirect_rgb(e, w);
         Some(IrradianceSample {
             direct_rgb: direct,
             indirect_rgb: indirect,
@@ -305,7 +291,9 @@ impl Transfer {
         if let Some(sample) = solution.irradiance_at(point_in_world_m, normal_in_world) {
             let e = sample.element.unwrap_or(usize::MAX);
             let locator = solution.locator();
-            if locator.reflects[e] && locator.longest_edge_m[e] <= params.max_interpolation_edge_m {
+            if locator.reflects[e]
+                && locator.shapes[e].longest_edge_m <= params.max_interpolation_edge_m
+            {
                 return Ok(sample);
             }
         }
@@ -382,7 +370,7 @@ impl Transfer {
                 continue; // the back of a one-sided surface emits nothing
             }
             let x = tracer.hit_point_in_world_m(&ray, hit.hit.t);
-            if let Some((e, _)) = locator.locate(solution, &x, &hit_normal) {
+            if let Some((e, _)) = locator.locate(&x, &hit_normal) {
                 for c in 0..3 {
                     sum[c] += locator.radiosity[e][c];
                 }

@@ -163,7 +163,7 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
     // A relight keeps the vertex gathers (the rays they traced): the geometry is the same.
     for k in 0..2 {
         assert!(
-            Arc::ptr_eq(&built.gathers()[k], &light.gathers()[k]),
+            Arc::ptr_eq(built.gathers()[k], light.gathers()[k]),
             "gather {k}"
         );
     }
@@ -173,5 +173,5 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
     let scene = site_scene(&doc).unwrap().scene;
     let (moved, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Built);
-    assert!(!Arc::ptr_eq(&built.gathers()[0], &moved.gathers()[0]));
+    assert!(!Arc::ptr_eq(built.gathers()[0], moved.gathers()[0]));
 }

@@ -39,7 +39,7 @@ use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
-use crate::radiosity::{RadiosityError, Solution, VertexGather};
+use crate::radiosity::{GatheredExitance, RadiosityError, Solution, VertexGather};
 use crate::render::illumination::Rgb;
 
 /// A radiosity change below this fraction of the natural irradiance, in every channel, leaves a
@@ -73,11 +73,9 @@ pub struct RadiosityLight {
     pub without_artificial: Arc<Solution>,
     /// The change threshold (module doc).
     pub change_fraction: f64,
-    /// Vertex gathers of the two meshes (with, without).
-    gathers: [Arc<VertexGather>; 2],
-    /// Exitance per element of the two solutions as solved (every group's direct light in),
-    /// which the gathers sum.
-    radiosity_rgb: [Vec<Rgb>; 2],
+    /// Vertex gathers of the two meshes (with, without) and the exitance per element of the two
+    /// solutions as solved (every group's direct light in) that they sum.
+    gathered: [GatheredExitance; 2],
 }
 
 impl RadiosityLight {
@@ -92,21 +90,27 @@ impl RadiosityLight {
         without_artificial: &Solution,
         traced_exactly: &(dyn Fn(&str) -> bool + Sync),
     ) -> Result<Self, RadiosityError> {
-        let gather = |s: &Solution| {
-            VertexGather::new(Arc::clone(&s.mesh), DEFAULT_RAYS_PER_AXIS).map(Arc::new)
-        };
-        let gathers = [gather(with_artificial)?, gather(without_artificial)?];
-        Ok(Self::with_gathers(
+        let without = Arc::new(VertexGather::new(
+            Arc::clone(&without_artificial.mesh),
+            DEFAULT_RAYS_PER_AXIS,
+        )?);
+        let with = Arc::new(VertexGather::over(
+            Arc::clone(&with_artificial.mesh),
+            DEFAULT_RAYS_PER_AXIS,
+            Arc::clone(&without),
+        )?);
+        Self::with_gathers(
             with_artificial,
             without_artificial,
             traced_exactly,
-            gathers,
-        ))
+            [with, without],
+        )
     }
 
     /// The same for relit solutions: the vertex gathers (the rays they traced) are kept where a
     /// solution's mesh has the geometry this light was built on (a relight changes at most its
-    /// reflectances), and set up anew where it has not.
+    /// reflectances), and set up anew where it has not (those with the artificial objects on
+    /// those without, which share their traces, [`VertexGather::over`]).
     ///
     /// # Errors
     /// As [`RadiosityLight::new`].
@@ -116,20 +120,27 @@ impl RadiosityLight {
         without_artificial: &Solution,
         traced_exactly: &(dyn Fn(&str) -> bool + Sync),
     ) -> Result<Self, RadiosityError> {
-        let keep = |k: usize, s: &Solution| {
-            if self.gathers[k].mesh().geometry_hash == s.mesh.geometry_hash {
-                Ok(Arc::clone(&self.gathers[k]))
-            } else {
-                VertexGather::new(Arc::clone(&s.mesh), DEFAULT_RAYS_PER_AXIS).map(Arc::new)
-            }
+        let kept = |k: usize, s: &Solution| {
+            let g = self.gathered[k].gather();
+            (g.mesh().geometry_hash == s.mesh.geometry_hash).then(|| Arc::clone(g))
         };
-        let gathers = [keep(0, with_artificial)?, keep(1, without_artificial)?];
-        Ok(Self::with_gathers(
-            with_artificial,
-            without_artificial,
-            traced_exactly,
-            gathers,
-        ))
+        let without = match kept(1, without_artificial) {
+            Some(g) => g,
+            None => Arc::new(VertexGather::new(
+                Arc::clone(&without_artificial.mesh),
+                DEFAULT_RAYS_PER_AXIS,
+            )?),
+        };
+        let with = match kept(0, with_artificial) {
+            Some(g) => g,
+            None => Arc::new(VertexGather::over(
+                Arc::clone(&with_artificial.mesh),
+                DEFAULT_RAYS_PER_AXIS,
+                Arc::clone(&without),
+            )?),
+        };
+        let gathers = [with, without];
+        Self::with_gathers(with_artificial, without_artificial, traced_exactly, gathers)
     }
 
     fn with_gathers(
@@ -137,23 +148,26 @@ impl RadiosityLight {
         without_artificial: &Solution,
         traced_exactly: &(dyn Fn(&str) -> bool + Sync),
         gathers: [Arc<VertexGather>; 2],
-    ) -> Self {
+    ) -> Result<Self, RadiosityError> {
         // The two solutions are independent: side by side.
-        let side = |s: &Solution| {
-            (
+        let side = |s: &Solution, gather: Arc<VertexGather>| -> Result<_, RadiosityError> {
+            Ok((
                 Arc::new(s.without_direct_of(traced_exactly)),
-                total_radiosity(s),
-            )
+                GatheredExitance::new(gather, total_radiosity(s))?,
+            ))
         };
-        let ((with, with_total), (without, without_total)) =
-            rayon::join(|| side(with_artificial), || side(without_artificial));
-        Self {
+        let [with_gather, without_gather] = gathers;
+        let (with, without) = rayon::join(
+            || side(with_artificial, with_gather),
+            || side(without_artificial, without_gather),
+        );
+        let ((with, with_gathered), (without, without_gathered)) = (with?, without?);
+        Ok(Self {
             with_artificial: with,
             without_artificial: without,
             change_fraction: DEFAULT_CHANGE_FRACTION,
-            gathers,
-            radiosity_rgb: [with_total, without_total],
-        }
+            gathered: [with_gathered, without_gathered],
+        })
     }
 
     /// The groups the renderer traces exactly: the sun and every luminaire.
@@ -166,7 +180,7 @@ impl RadiosityLight {
     #[must_use]
     pub fn with_at(&self, point: &Point3<f64>, normal: &Vector3<f64>) -> Option<Rgb> {
         self.with_artificial
-            .irradiance_gathered_at(point, normal, &self.gathers[0], &self.radiosity_rgb[0])
+            .irradiance_gathered_at(point, normal, &self.gathered[0])
             .map(|s| s.total_rgb)
     }
 
@@ -174,14 +188,14 @@ impl RadiosityLight {
     #[must_use]
     pub fn without_at(&self, point: &Point3<f64>, normal: &Vector3<f64>) -> Option<Rgb> {
         self.without_artificial
-            .irradiance_gathered_at(point, normal, &self.gathers[1], &self.radiosity_rgb[1])
+            .irradiance_gathered_at(point, normal, &self.gathered[1])
             .map(|s| s.total_rgb)
     }
 
     /// The vertex gathers of the two meshes (with, without the artificial objects).
     #[must_use]
-    pub fn gathers(&self) -> &[Arc<VertexGather>; 2] {
-        &self.gathers
+    pub fn gathers(&self) -> [&Arc<VertexGather>; 2] {
+        self.gathered.each_ref().map(GatheredExitance::gather)
     }
 
     /// Whether a radiosity change `delta` counts against the natural irradiance `natural`.
