@@ -260,17 +260,17 @@ impl<'a> FormFactorEngine<'a> {
     #[must_use]
     pub fn facing(&self, p: u32, q: u32) -> bool {
         let (np, nq) = (self.node(p), self.node(q));
-        let in_front = |a: &MeshNode, b: &MeshNode| {
-            let scale = b
-                .vertices_in_world_m
-                .iter()
-                .map(|v| (v - a.vertices_in_world_m[0]).norm())
-                .fold(0.0, f64::max);
-            b.vertices_in_world_m
-                .iter()
-                .any(|v| a.normal_in_world.dot(&(v - a.vertices_in_world_m[0])) > 1e-12 * scale)
-        };
-        p != q && in_front(np, nq) && in_front(nq, np)
+        p != q
+            && in_front(
+                &np.vertices_in_world_m,
+                &np.normal_in_world,
+                &nq.vertices_in_world_m,
+            )
+            && in_front(
+                &nq.vertices_in_world_m,
+                &nq.normal_in_world,
+                &np.vertices_in_world_m,
+            )
     }
 
     /// F_pq, the fraction of the light leaving node p that arrives at node q (module doc).
@@ -357,4 +357,26 @@ impl<'a> FormFactorEngine<'a> {
             .map(|&p| self.node_to_node(p, q))
             .collect()
     }
+}
+
+/// Whether some vertex of triangle `b` lies in front of the plane of triangle `a` (vertices,
+/// unit normal) by more than 1e-12 of b's reach from a's first vertex: height h >
+/// 1e-12·max|v − a₀|, tested as h > 0 and h² > 1e-24·max|v − a₀|² (no square roots: the
+/// hierarchical solver asks it for every pair of patches, [`FormFactorEngine::facing`]).
+#[must_use]
+pub fn in_front(a: &[Point3<f64>; 3], a_normal: &Vector3<f64>, b: &[Point3<f64>; 3]) -> bool {
+    let a0 = a[0];
+    let offsets = b.map(|v| v - a0);
+    let highest = offsets
+        .iter()
+        .map(|d| a_normal.dot(d))
+        .fold(f64::NEG_INFINITY, f64::max);
+    if highest <= 0.0 {
+        return false;
+    }
+    let reach2 = offsets
+        .iter()
+        .map(Vector3::norm_squared)
+        .fold(0.0, f64::max);
+    highest * highest > 1e-24 * reach2
 }

@@ -33,10 +33,11 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_change};
-use super::form_factor::FormFactorEngine;
+use super::form_factor::{FormFactorEngine, in_front};
 use super::mesh::Mesh;
 use super::{RadiosityError, Rgb, luminance};
 
@@ -183,14 +184,33 @@ impl Hierarchy {
         }
         let mesh = engine.mesh();
         let patches = &mesh.patches;
+        // Every pair of patches is tested for facing first on a compact copy of their
+        // triangles, read in order: the nodes themselves lie far apart (each patch before its
+        // subtree), and fetching them for every pair cost more than the test.
+        let shapes: Vec<([Point3<f64>; 3], Vector3<f64>)> = patches
+            .iter()
+            .map(|&p| {
+                let node = &mesh.nodes[p as usize];
+                (node.vertices_in_world_m, node.normal_in_world)
+            })
+            .collect();
         let pair_lists: Vec<Option<Vec<(u32, u32)>>> = patches
             .par_iter()
-            .map(|&r| {
+            .zip(&shapes)
+            .map(|(&r, (r_vertices, r_normal))| {
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
                 let mut out = Vec::new();
-                for &s in patches {
+                for (&s, (s_vertices, s_normal)) in patches.iter().zip(&shapes) {
+                    // The same test as `FormFactorEngine::facing`, which `initial_pairs`
+                    // repeats for the pairs that pass.
+                    if r == s
+                        || !in_front(r_vertices, r_normal, s_vertices)
+                        || !in_front(s_vertices, s_normal, r_vertices)
+                    {
+                        continue;
+                    }
                     initial_pairs(engine, params.form_factor_tolerance, r, s, &mut out);
                 }
                 Some(out)

@@ -438,11 +438,7 @@ impl VertexGather {
     /// The hit lists vertex `v`'s rays give for the two elements `hit` returns per ray
     /// direction (world, and the same normalised in `f32` as the tracers take it), as
     /// (element, rays) pairs.
-    fn trace(
-        &self,
-        v: usize,
-        hit: &mut RayElements<'_>,
-    ) -> [VertexHits; 2] {
+    fn trace(&self, v: usize, hit: &mut RayElements<'_>) -> [VertexHits; 2] {
         let (_, normal, seed) = &self.origins[v];
         let mut rng = ChaCha8Rng::seed_from_u64(*seed);
         let frame = CosineFrame::new(normal);
