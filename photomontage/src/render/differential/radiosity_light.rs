@@ -21,7 +21,9 @@
 //! element vertices ([`crate::radiosity::vertex_gather`]): the exitances of the elements the
 //! vertex sees, not the element's own value, which a hierarchical solution only knows as a mean
 //! over a coarse receiver node. The gathers trace their rays once per vertex the renderer
-//! reaches and are kept across relights of the same meshes ([`RadiosityLight::relit`]).
+//! reaches and are kept across relights of the same meshes ([`RadiosityLight::relit`]); the
+//! with-objects gathers are built over the photographed state's, so one trace fills both
+//! ([`VertexGather::over`]), and each vertex's sum is kept per solution.
 //!
 //! Where a point lies on no element of a solution (a back face, geometry the mesh skipped), the
 //! facet path of the ordinary mode is used for that ray.
