@@ -100,7 +100,15 @@ struct RootTracer {
     tracer: SceneTracer,
     /// Root node of each traced triangle (the tracer's triangle ids).
     roots: Vec<u32>,
+    /// The triangles' bounding box (low, high corner), world metres, padded by
+    /// [`BOUNDS_PAD_M`] and [`BOUNDS_PAD_REL`] of its diagonal.
+    bounds: [Point3<f64>; 2],
 }
+
+/// Absolute padding of a [`RootTracer`]'s box, metres (far beyond the `f32` tracer's rounding).
+const BOUNDS_PAD_M: f64 = 0.01;
+/// Relative padding of a [`RootTracer`]'s box, of its diagonal.
+const BOUNDS_PAD_REL: f64 = 1e-3;
 
 impl RootTracer {
     /// The roots of `mesh` that `keep` accepts (each root once, as the first node of its
@@ -130,7 +138,42 @@ impl RootTracer {
             return Ok(None);
         }
         let tracer = SceneTracer::new(&scene, BuildQuality::Medium)?;
-        Ok(Some(Self { tracer, roots }))
+        let (mut lo, mut hi) = (Point3::from([f64::MAX; 3]), Point3::from([f64::MIN; 3]));
+        for t in scene.triangles() {
+            for v in &t.vertices_in_world_m {
+                lo = lo.inf(v);
+                hi = hi.sup(v);
+            }
+        }
+        let pad = Vector3::repeat(BOUNDS_PAD_M + BOUNDS_PAD_REL * (hi - lo).norm());
+        Ok(Some(Self {
+            tracer,
+            roots,
+            bounds: [lo - pad, hi + pad],
+        }))
+    }
+
+    /// Whether the ray `origin + t·dir`, 0 ≤ t ≤ `t_max`, meets the padded box (the slab test):
+    /// a ray that does not meets none of the triangles, and the tracer is not asked. Most gather
+    /// rays leave the scene without a hit, and this test costs less than the tracer's setup.
+    fn may_hit(&self, origin: &Point3<f64>, dir: &Vector3<f64>, t_max: f64) -> bool {
+        let [lo, hi] = &self.bounds;
+        let (mut near, mut far) = (0.0_f64, t_max);
+        for k in 0..3 {
+            if dir[k] == 0.0 {
+                if origin[k] < lo[k] || origin[k] > hi[k] {
+                    return false;
+                }
+                continue;
+            }
+            let (a, b) = ((lo[k] - origin[k]) / dir[k], (hi[k] - origin[k]) / dir[k]);
+            near = near.max(a.min(b));
+            far = far.min(a.max(b));
+            if near > far {
+                return false;
+            }
+        }
+        true
     }
 }
 
@@ -370,6 +413,9 @@ impl VertexGather {
                 };
                 let from = local(own);
                 let [list, _] = self.trace(v, &mut |dir, dir_local| {
+                    if !own.may_hit(origin, dir, f64::from(GATHER_RAY_LENGTH_M)) {
+                        return [None, None];
+                    }
                     let ray = Ray::new(from, dir_local, ray_offset_m(), GATHER_RAY_LENGTH_M);
                     let hit = own.tracer.closest_hit(&ray);
                     let stop = hit.map(|h| {
@@ -393,7 +439,11 @@ impl VertexGather {
             let extra = self.tracer.as_ref().map(|x| (x, local(x)));
             let [own, in_base] = self.trace(v, &mut |dir, dir_local| {
                 let base_ray = Ray::new(from_base, dir_local, ray_offset_m(), GATHER_RAY_LENGTH_M);
-                let base_hit = base_tracer.tracer.closest_hit(&base_ray);
+                let base_hit = if base_tracer.may_hit(origin, dir, f64::from(GATHER_RAY_LENGTH_M)) {
+                    base_tracer.tracer.closest_hit(&base_ray)
+                } else {
+                    None
+                };
                 let t_base = base_hit.map_or(GATHER_RAY_LENGTH_M, |h| h.hit.t);
                 let base_stop = base_hit.map(|h| {
                     let tri = h.hit.triangle_id as usize;
@@ -407,6 +457,9 @@ impl VertexGather {
                 });
                 // The extra triangles, only closer than the base's hit.
                 let extra_hit = extra.and_then(|(x, from)| {
+                    if !x.may_hit(origin, dir, f64::from(t_base)) {
+                        return None;
+                    }
                     let ray = Ray::new(from, dir_local, ray_offset_m(), t_base);
                     x.tracer.closest_hit(&ray).map(|h| (x, ray, h))
                 });
