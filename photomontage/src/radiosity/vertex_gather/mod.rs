@@ -154,7 +154,7 @@ impl RootTracer {
     }
 
     /// Whether the ray `origin + t·dir`, 0 ≤ t ≤ `t_max`, meets the padded box (the slab test):
-    /// a ray that does not meets none of the triangles, and the tracer is not asked. Most gather
+    /// a ray that misses it meets none of the triangles, and the tracer is not asked. Most gather
     /// rays leave the scene without a hit, and this test costs less than the tracer's setup.
     fn may_hit(&self, origin: &Point3<f64>, dir: &Vector3<f64>, t_max: f64) -> bool {
         let [lo, hi] = &self.bounds;
