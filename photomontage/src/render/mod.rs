@@ -8,7 +8,9 @@
 //! stream, so the output is identical for any thread count. Antialiasing is adaptive stochastic
 //! sampling (Cook 1986, as Durisch §7 used it): 4 jittered rays per pixel (one per 2×2 stratum),
 //! then 4 more at a time up to 8, 12 or 16 while the standard error of the pixel mean exceeds
-//! [`RenderSettings::max_standard_error`]; box reconstruction.
+//! [`RenderSettings::max_standard_error`]; then a second pass gives the pixels whose estimate
+//! differs from a neighbour's (an outline or shadow edge whose first rays all fell on one side)
+//! up to `max_rays_per_pixel` (Mitchell 1987; `adaptive`); box reconstruction.
 //!
 //! **Only what changes is traced**: when none of a pixel's first 4 rays involves an artificial
 //! object (no artificial hit, no natural light blocked only by an artificial object, no
@@ -31,6 +33,7 @@
 //! Box filter only. See [`differential`] for the per-ray limitations and [`glass`],
 //! [`specular`], [`water`], [`luminaire_light`], [`spectral`] for those of each physical model.
 
+mod adaptive;
 pub mod differential;
 
 pub mod illumination;
@@ -48,7 +51,7 @@ use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
 use nalgebra::Point2;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 pub use differential::{
@@ -348,106 +351,141 @@ fn render_tile(
     let _cache = irradiance_cache::TileScope::enter();
     let photo = tracer.photo();
     let camera = tracer.camera();
+    let count = (size_px[0] * size_px[1]) as usize;
+    // Per pixel of the tile: its first ray's hit (layers), the summed change of its natural
+    // samples (shadow-change layer), and the ratio-of-means parts of its natural samples.
+    let mut first_hit: Vec<Option<Option<PrimaryHit>>> = vec![None; count];
+    let mut natural_change = vec![[0.0_f64; 3]; count];
+    let mut ratios = TileRatios::default();
+    let tallies = adaptive::sample_tile(
+        settings,
+        &mut rng,
+        origin_px,
+        size_px,
+        photo,
+        &mut |i, [x, y], pixel| {
+            let photo_rgb = photo.get_pixel(x, y).0.map(f64::from);
+            let sample = tracer.trace_primary(&camera.ray_dir_in_world(pixel), photo_rgb);
+            first_hit[i].get_or_insert(sample.first_hit);
+            if !sample.hit_artificial {
+                for k in 0..3 {
+                    natural_change[i][k] += sample.radiance_rgb[k] - photo_rgb[k];
+                }
+            }
+            ratios.add(i, &sample, pixel);
+            adaptive::RayOutcome {
+                radiance_rgb: sample.radiance_rgb,
+                changed: sample.changed,
+                hit_artificial: sample.hit_artificial,
+            }
+        },
+    );
     let mut out = TileOut {
-        rgba: Vec::with_capacity((size_px[0] * size_px[1]) as usize),
+        rgba: Vec::with_capacity(count),
         layers: OutputLayers::new(layers, 0),
         changed: 0,
         rays: 0,
     };
-    // One buffer for every pixel of the tile (cleared per pixel).
-    let mut ratios = PixelRatios::default();
-    for y in origin_px[1]..origin_px[1] + size_px[1] {
-        for x in origin_px[0]..origin_px[0] + size_px[0] {
-            let photo_f32 = photo.get_pixel(x, y).0;
-            let photo_rgb = photo_f32.map(f64::from);
-            let mut sum = [0.0_f64; 3];
-            let mut sum_sq = [0.0_f64; 3];
-            let mut natural_change = [0.0_f64; 3];
-            let mut first_hit = None;
-            let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
-            ratios.clear();
-            loop {
-                for s in 0..4 {
-                    let (sx, sy) = (f64::from(s % 2), f64::from(s / 2));
-                    let (u, v): (f64, f64) = (rng.random(), rng.random());
-                    let pixel = Point2::new(
-                        f64::from(x) - 0.5 + (sx + u) / 2.0,
-                        f64::from(y) - 0.5 + (sy + v) / 2.0,
-                    );
-                    let sample = tracer.trace_primary(&camera.ray_dir_in_world(pixel), photo_rgb);
-                    if n == 0 && s == 0 {
-                        first_hit = Some(sample.first_hit);
-                    }
-                    if !sample.hit_artificial {
-                        for k in 0..3 {
-                            natural_change[k] += sample.radiance_rgb[k] - photo_rgb[k];
-                        }
-                    }
-                    ratios.add(&sample, pixel);
-                    changed |= sample.changed;
-                    covered += u32::from(sample.hit_artificial);
-                    for k in 0..3 {
-                        sum[k] += sample.radiance_rgb[k];
-                        sum_sq[k] += sample.radiance_rgb[k] * sample.radiance_rgb[k];
-                    }
-                }
-                n += 4;
-                if !settings.wants_more_rays(n, changed, &sum, &sum_sq) {
-                    break;
-                }
+    let mut pixel_ratios = ratios.by_pixel();
+    for (i, tally) in tallies.iter().enumerate() {
+        #[allow(clippy::cast_possible_truncation)]
+        let (x, y) = (
+            origin_px[0] + i as u32 % size_px[0],
+            origin_px[1] + i as u32 / size_px[0],
+        );
+        let photo_f32 = photo.get_pixel(x, y).0;
+        let photo_rgb = photo_f32.map(f64::from);
+        let own_ratios = pixel_ratios.next_pixel(i);
+        let (mut sum, mut change) = (tally.sum, natural_change[i]);
+        if tally.changed {
+            let fix = own_ratios.correction(tracer, photo_rgb);
+            for k in 0..3 {
+                sum[k] += fix[k];
+                change[k] += fix[k];
             }
-            if changed {
-                let fix = ratios.correction(tracer, photo_rgb);
-                for k in 0..3 {
-                    sum[k] += fix[k];
-                    natural_change[k] += fix[k];
-                }
-            }
-            out.rays += u64::from(n);
-            out.layers
-                .push_pixel(first_hit.flatten(), natural_change, changed, n);
-            if changed {
-                out.changed += 1;
-                let nf = f64::from(n);
-                #[allow(clippy::cast_possible_truncation)]
-                out.rgba.push([
-                    (sum[0] / nf) as f32,
-                    (sum[1] / nf) as f32,
-                    (sum[2] / nf) as f32,
-                    (f64::from(covered) / nf) as f32,
-                ]);
-            } else {
-                out.rgba
-                    .push([photo_f32[0], photo_f32[1], photo_f32[2], 0.0]);
-            }
+        }
+        out.rays += u64::from(tally.n);
+        out.layers
+            .push_pixel(first_hit[i].flatten(), change, tally.changed, tally.n);
+        if tally.changed {
+            out.changed += 1;
+            let nf = f64::from(tally.n);
+            #[allow(clippy::cast_possible_truncation)]
+            out.rgba.push([
+                (sum[0] / nf) as f32,
+                (sum[1] / nf) as f32,
+                (sum[2] / nf) as f32,
+                (f64::from(tally.covered) / nf) as f32,
+            ]);
+        } else {
+            out.rgba
+                .push([photo_f32[0], photo_f32[1], photo_f32[2], 0.0]);
         }
     }
     out
 }
 
-/// A pixel's natural samples for the ratio of means of [`NaturalRatio`]: the changed ones'
-/// parts and the positions of the unchanged ones (their parts are traced only when the pixel
-/// changed).
+/// A tile's natural samples for the ratio of means of [`NaturalRatio`], tagged with their
+/// pixel (row-major in the tile): the changed ones' parts and the positions of the unchanged
+/// ones (their parts are traced only when the pixel changed).
 #[derive(Default)]
-struct PixelRatios {
-    changed: Vec<(NaturalRatio, Rgb)>,
-    unchanged_px: Vec<Point2<f64>>,
+struct TileRatios {
+    changed: Vec<(usize, (NaturalRatio, Rgb))>,
+    unchanged_px: Vec<(usize, Point2<f64>)>,
 }
 
-impl PixelRatios {
-    fn clear(&mut self) {
-        self.changed.clear();
-        self.unchanged_px.clear();
-    }
-
-    fn add(&mut self, sample: &RaySample, pixel: Point2<f64>) {
+impl TileRatios {
+    fn add(&mut self, i: usize, sample: &RaySample, pixel: Point2<f64>) {
         if let Some(r) = sample.natural_ratio {
-            self.changed.push((r, sample.radiance_rgb));
+            self.changed.push((i, (r, sample.radiance_rgb)));
         } else if !sample.changed && !sample.hit_artificial && sample.first_hit.is_some() {
-            self.unchanged_px.push(pixel);
+            self.unchanged_px.push((i, pixel));
         }
     }
 
+    /// The records grouped by pixel, each pixel's in the order they were traced (the second
+    /// sampling pass appends to pixels of the first, so a stable sort restores that order).
+    fn by_pixel(mut self) -> RatioCursor {
+        self.changed.sort_by_key(|r| r.0);
+        self.unchanged_px.sort_by_key(|r| r.0);
+        RatioCursor {
+            ratios: self,
+            next: [0, 0],
+        }
+    }
+}
+
+/// Walks [`TileRatios::by_pixel`] pixel by pixel, in increasing pixel order.
+struct RatioCursor {
+    ratios: TileRatios,
+    next: [usize; 2],
+}
+
+impl RatioCursor {
+    /// Pixel `i`'s records (`i` at least the previous call's).
+    fn next_pixel(&mut self, i: usize) -> PixelRatios<'_> {
+        fn take<T>(records: &[(usize, T)], start: &mut usize, i: usize) -> std::ops::Range<usize> {
+            let from = *start + records[*start..].partition_point(|r| r.0 < i);
+            let to = from + records[from..].partition_point(|r| r.0 == i);
+            *start = to;
+            from..to
+        }
+        let rc = take(&self.ratios.changed, &mut self.next[0], i);
+        let ru = take(&self.ratios.unchanged_px, &mut self.next[1], i);
+        PixelRatios {
+            changed: &self.ratios.changed[rc],
+            unchanged_px: &self.ratios.unchanged_px[ru],
+        }
+    }
+}
+
+/// One pixel's records of [`TileRatios`].
+struct PixelRatios<'a> {
+    changed: &'a [(usize, (NaturalRatio, Rgb))],
+    unchanged_px: &'a [(usize, Point2<f64>)],
+}
+
+impl PixelRatios<'_> {
     /// What to add to the pixel's sum of sample radiances so that its natural samples count as
     /// `L_photo + mean(τ·L₀)·ΣΔE/ΣE` each instead of their own `L_photo + τ·L₀·ΔE/E`.
     fn correction(&self, tracer: &DifferentialTracer<'_>, photo_rgb: Rgb) -> Rgb {
@@ -455,14 +493,15 @@ impl PixelRatios {
             return [0.0; 3];
         }
         let camera = tracer.camera();
-        let unchanged = self.unchanged_px.iter().filter_map(|px| {
+        let unchanged = self.unchanged_px.iter().filter_map(|(_, px)| {
             tracer
                 .unchanged_natural_ratio(&camera.ray_dir_in_world(*px), photo_rgb)
                 .map(|r| (r, photo_rgb))
         });
         let (mut tau_l0, mut e, mut de, mut old) = ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
         let mut count = 0.0;
-        for (r, radiance) in self.changed.iter().copied().chain(unchanged) {
+        let changed = self.changed.iter().map(|&(_, pair)| pair);
+        for (r, radiance) in changed.chain(unchanged) {
             for k in 0..3 {
                 tau_l0[k] += r.tau_l0_rgb[k];
                 e[k] += r.e_natural_rgb[k];

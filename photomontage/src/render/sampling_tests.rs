@@ -131,7 +131,8 @@ fn the_strip_lies_where_the_test_says() {
 }
 
 /// A pixel whose first four rays miss a thin shadow still gets `spp_min` rays; with
-/// `spp_min = 4` such pixels keep the photo (the behaviour the rule fixes is shown to occur).
+/// `spp_min = spp_max = 4` such pixels keep the photo (the behaviour the rules fix is shown to
+/// occur), and at 4–16 the neighbour rule of the second pass finds them.
 #[test]
 fn spp_min_rays_find_a_thin_shadow_that_four_rays_miss() {
     let scene = plate_scene();
@@ -164,9 +165,32 @@ fn spp_min_rays_find_a_thin_shadow_that_four_rays_miss() {
             })
             .count()
     };
-    // Four rays: some rows of the strip are missed (expected 48/16 = 3).
-    let four = render(4, 16);
+    // Four rays and no more: some rows of the strip are missed (expected 48/16 = 3).
+    let four = render(4, 4);
     assert!(missed(&four) >= 1, "four rays found every row");
+    // 4–16: a row whose four rays missed differs from the strip rows above and below it, so the
+    // second pass (`adaptive`) samples it to 16 and finds the strip; the lit columns beside
+    // the strip keep the photo.
+    // Two columns either side of the strip: the photo, bit for bit.
+    let assert_beside_is_photo = |img: &RenderedImage| {
+        for y in 0..SIZE_PX[1] {
+            for x in [STRIP_COLUMN_PX - 2, STRIP_COLUMN_PX + 2] {
+                let q = img.rgba[(y * SIZE_PX[0] + x) as usize];
+                assert_eq!(
+                    [q[0], q[1], q[2]].map(f32::to_bits),
+                    photo_bits,
+                    "({x}, {y})"
+                );
+            }
+        }
+    };
+    let edge_pass = render(4, 16);
+    assert_eq!(
+        missed(&edge_pass),
+        0,
+        "the edge pass left a row of the strip"
+    );
+    assert_beside_is_photo(&edge_pass);
 
     let sixteen = render(16, 16);
     assert_eq!(missed(&sixteen), 0, "sixteen rays miss a row");
@@ -177,15 +201,8 @@ fn spp_min_rays_find_a_thin_shadow_that_four_rays_miss() {
         let k = 1;
         let f = (ground_radiance()[k] - f64::from(p[k])) / (ground_radiance()[k] * sun_share(k));
         fraction_sum += f;
-        for x in [STRIP_COLUMN_PX - 2, STRIP_COLUMN_PX + 2] {
-            let q = sixteen.rgba[(y * SIZE_PX[0] + x) as usize];
-            assert_eq!(
-                [q[0], q[1], q[2]].map(f32::to_bits),
-                photo_bits,
-                "({x}, {y})"
-            );
-        }
     }
+    assert_beside_is_photo(&sixteen);
     let mean = fraction_sum / f64::from(SIZE_PX[1]);
     assert!(
         (mean - STRIP_FRACTION).abs() <= FRACTION_TOL,

@@ -33,7 +33,7 @@ use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
 use nalgebra::Point2;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::differential::{DifferentialTracer, Lighting};
@@ -343,47 +343,42 @@ impl Job<'_, '_> {
             changed: 0,
             rays: 0,
         };
-        for y in origin_px[1]..origin_px[1] + size_px[1] {
-            for x in origin_px[0]..origin_px[0] + size_px[0] {
-                let mut sum = [0.0_f64; 3];
-                let mut sum_sq = [0.0_f64; 3];
-                let (mut n, mut covered, mut changed) = (0_u32, 0_u32, false);
-                loop {
-                    for s in 0..4 {
-                        let (sx, sy) = (f64::from(s % 2), f64::from(s / 2));
-                        let (u, v): (f64, f64) = (rng.random(), rng.random());
-                        let pixel = Point2::new(
-                            f64::from(x) - 0.5 + (sx + u) / 2.0,
-                            f64::from(y) - 0.5 + (sy + v) / 2.0,
-                        );
-                        let (rgb, ch, art) = self.sample(x, y, pixel, &mut bands);
-                        changed |= ch;
-                        covered += u32::from(art);
-                        for k in 0..3 {
-                            sum[k] += rgb[k];
-                            sum_sq[k] += rgb[k] * rgb[k];
-                        }
-                    }
-                    n += 4;
-                    if !settings.wants_more_rays(n, changed, &sum, &sum_sq) {
-                        break;
-                    }
+        let photo = self.tracer.photo();
+        let tallies = super::adaptive::sample_tile(
+            settings,
+            &mut rng,
+            origin_px,
+            size_px,
+            photo,
+            &mut |_, [x, y], pixel| {
+                let (radiance_rgb, changed, hit_artificial) = self.sample(x, y, pixel, &mut bands);
+                super::adaptive::RayOutcome {
+                    radiance_rgb,
+                    changed,
+                    hit_artificial,
                 }
-                out.rays += u64::from(n);
-                let photo = self.tracer.photo().get_pixel(x, y).0;
-                if changed {
-                    out.changed += 1;
-                    let nf = f64::from(n);
-                    #[allow(clippy::cast_possible_truncation)]
-                    out.rgba.push([
-                        (sum[0] / nf) as f32,
-                        (sum[1] / nf) as f32,
-                        (sum[2] / nf) as f32,
-                        (f64::from(covered) / nf) as f32,
-                    ]);
-                } else {
-                    out.rgba.push([photo[0], photo[1], photo[2], 0.0]);
-                }
+            },
+        );
+        for (i, tally) in tallies.iter().enumerate() {
+            #[allow(clippy::cast_possible_truncation)]
+            let (x, y) = (
+                origin_px[0] + i as u32 % size_px[0],
+                origin_px[1] + i as u32 / size_px[0],
+            );
+            out.rays += u64::from(tally.n);
+            let photo_px = photo.get_pixel(x, y).0;
+            if tally.changed {
+                out.changed += 1;
+                let nf = f64::from(tally.n);
+                #[allow(clippy::cast_possible_truncation)]
+                out.rgba.push([
+                    (tally.sum[0] / nf) as f32,
+                    (tally.sum[1] / nf) as f32,
+                    (tally.sum[2] / nf) as f32,
+                    (f64::from(tally.covered) / nf) as f32,
+                ]);
+            } else {
+                out.rgba.push([photo_px[0], photo_px[1], photo_px[2], 0.0]);
             }
         }
         out
