@@ -102,6 +102,7 @@ fn ctrl_c_cancels_without_writing() {
     let site = common::make_site(dir.path());
     let ply = dir.path().join("mesh.ply");
     let csv = dir.path().join("convergence.csv");
+    let png = dir.path().join("convergence.png");
     let child = Command::new(env!("CARGO_BIN_EXE_photomontage"))
         .arg("radiosity")
         .arg(&site)
@@ -115,6 +116,8 @@ fn ctrl_c_cancels_without_writing() {
         .arg(&ply)
         .arg("--convergence")
         .arg(&csv)
+        .arg("--convergence-plot")
+        .arg(&png)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -122,7 +125,7 @@ fn ctrl_c_cancels_without_writing() {
     let (status, rest) = common::interrupt_once_started(child);
     assert!(!status.success(), "{rest:?}");
     assert!(rest.iter().any(|l| l.contains("cancelled")), "{rest:?}");
-    assert!(!ply.exists() && !csv.exists());
+    assert!(!ply.exists() && !csv.exists() && !png.exists());
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
