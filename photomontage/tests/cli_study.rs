@@ -271,6 +271,50 @@ fn shadow_maps_are_written_beside_the_frames() {
     // The box's shadow: some pixels have the added-shadow colour.
     assert!(map.pixels().any(|p| p.0 == [214, 40, 40]));
 
+    // Shadow maps only: no montage, the map stands for the frame on the contact sheet.
+    let maps_only = dir.path().join("maps");
+    let o = study(
+        &site,
+        &maps_only,
+        "2026-06-21",
+        "15:00",
+        &[
+            "--json",
+            "--shadow-maps",
+            "--no-montages",
+            "--cell-m",
+            "0.5",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(json["frames"][0].get("file").is_none(), "{json}");
+    assert_eq!(
+        json["frames"][0]["shadow_map"].as_str(),
+        Some("p1_2026-06-21_1500_shadow.png")
+    );
+    assert!(!maps_only.join("p1_2026-06-21_1500.png").exists());
+    let again = image::open(maps_only.join("p1_2026-06-21_1500_shadow.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(again, map, "the same map with and without the montage");
+    assert!(maps_only.join("p1_contact_sheet.png").exists());
+    // --no-montages needs --shadow-maps: nothing would be made.
+    let nothing = study(
+        &site,
+        &dir.path().join("nothing"),
+        "2026-06-21",
+        "15:00",
+        &["--no-montages"],
+    );
+    assert!(!nothing.status.success());
+    assert!(
+        stderr(&nothing).contains("--shadow-maps"),
+        "{}",
+        stderr(&nothing)
+    );
+    assert!(!dir.path().join("nothing").exists());
+
     let bad = study(
         &site,
         &dir.path().join("bad"),

@@ -10,9 +10,9 @@
 //! offset of the current sun time). A slider position that is no local time (the hour the
 //! clocks skip) or that happens twice is refused with a message and writes nothing.
 //!
-//! # Known limitations
-//! The montage preview is not relit by the sliders (the renderer wiring is separate work); a
-//! render started afterwards uses the new time.
+//! The sliders only edit the site; with the Render tab's **Live** preview on, the preview is
+//! relit from them (`render_panel::live`), otherwise a render started afterwards uses the new
+//! time.
 
 use chrono::{
     DateTime, Datelike, FixedOffset, NaiveDate, NaiveDateTime, NaiveTime, Offset as _, Timelike,

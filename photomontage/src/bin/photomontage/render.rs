@@ -4,7 +4,7 @@
 //! `--variant NAME` renders a design variant (`photomontage::site::variants`).
 
 use anyhow::{Context, bail};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{HumanDuration, ProgressBar, ProgressState, ProgressStyle};
 use photomontage::colour::ToneMap;
 use photomontage::render::Band;
 use photomontage::render::output::{self, LayerSet, OutputFormat};
@@ -17,7 +17,7 @@ use photomontage::verified::image_metadata::{view_metadata, write_render};
 use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Set by the Ctrl-C handler; the renderer polls it between tiles.
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -128,14 +128,45 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A progress bar over `tiles` render tiles with a time estimate.
+/// A progress bar over `tiles` render tiles with a time estimate: elapsed × remaining / done
+/// ([`time_left`]). Tiles start in a fixed shuffled order, so the finished ones are a fair sample
+/// of the image's cost; indicatif's own `{eta}` follows the recent rate instead, which swings
+/// between the cheap sky tiles and the costly building ones.
 pub fn tile_bar(tiles: u64) -> ProgressBar {
     let bar = ProgressBar::new(tiles);
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} tiles {elapsed} (eta {eta})")
+        ProgressStyle::with_template("{bar:40} {pos}/{len} tiles {elapsed} (left {left})")
+            .map(|style| {
+                style.with_key(
+                    "left",
+                    |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                        let left = time_left(state.elapsed(), state.pos(), state.len());
+                        let _ = match left {
+                            Some(d) => write!(w, "{}", HumanDuration(d)),
+                            None => write!(w, "…"),
+                        };
+                    },
+                )
+            })
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar
+}
+
+/// Time left of a job `done` of whose `total` units took `elapsed`, at the mean cost per unit so
+/// far: elapsed × (total − done) / done; `None` before the first unit or without a total.
+#[must_use]
+pub fn time_left(elapsed: Duration, done: u64, total: Option<u64>) -> Option<Duration> {
+    let total = total?;
+    if done == 0 {
+        return None;
+    }
+    #[allow(clippy::cast_precision_loss)]
+    let per_unit = elapsed.as_secs_f64() / done as f64;
+    #[allow(clippy::cast_precision_loss)]
+    Some(Duration::from_secs_f64(
+        per_unit * total.saturating_sub(done) as f64,
+    ))
 }
 
 /// Runs `work` on `threads` worker threads (all cores for `None`).
@@ -324,4 +355,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!("  object ids: {}", t.display());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_left_is_the_mean_cost_so_far_times_what_remains() {
+        let ten_s = Duration::from_secs(10);
+        // 10 s for 25 of 100 tiles: 0.4 s each, 75 left.
+        let left = time_left(ten_s, 25, Some(100)).expect("an estimate");
+        assert!((left.as_secs_f64() - 30.0).abs() < 1e-9, "{left:?}");
+        assert_eq!(time_left(ten_s, 100, Some(100)), Some(Duration::ZERO));
+        // Nothing done yet, or no total: no estimate.
+        assert_eq!(time_left(ten_s, 0, Some(100)), None);
+        assert_eq!(time_left(ten_s, 5, None), None);
+    }
 }

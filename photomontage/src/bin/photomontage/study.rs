@@ -40,6 +40,10 @@ pub struct Args {
     /// existing shadow, shadow added by the proposal, proposal roof.
     #[arg(long)]
     shadow_maps: bool,
+    /// Write the shadow maps only, no montages (with --shadow-maps): the contact sheet then
+    /// shows the maps.
+    #[arg(long, requires = "shadow_maps")]
+    no_montages: bool,
     /// Cell edge of the shadow maps, metres.
     #[arg(long, value_name = "M", default_value_t = photomontage::study::shadow_map::DEFAULT_CELL_M)]
     cell_m: f64,
@@ -95,7 +99,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let cancel = install_cancel()?;
     let bar = tile_bar(0);
     let options = StudyOptions {
-        montages: true,
+        montages: !args.no_montages,
         shadow_maps: args.shadow_maps,
         cell_m: args.cell_m,
     };
