@@ -20,7 +20,7 @@ use photomontage::colour::designer::{
 };
 use photomontage::scene::Material;
 use photomontage::scene::material::Specular;
-use photomontage::site::render::site_scene;
+use photomontage::site::render::{SiteWarning, site_scene};
 use photomontage::site::{PaletteColour, SiteDocument, SiteMaterial};
 
 use crate::commands::Command;
@@ -43,6 +43,8 @@ pub struct MaterialsPanel {
     cache_key: String,
     scene_materials: Vec<Material>,
     scene_error: Option<String>,
+    /// The scene build's warnings about site materials (`[[materials]]`), by material name.
+    scene_warnings: Vec<(String, String)>,
     /// "Pick from photo" mode: a click on the photo selects the material it shows.
     pick_mode: bool,
     /// What the last pick found (or that it found no surface).
@@ -138,6 +140,7 @@ impl MaterialsPanel {
             &mut self.cache_key,
             &mut self.scene_materials,
             &mut self.scene_error,
+            &mut self.scene_warnings,
         );
     }
 
@@ -207,6 +210,16 @@ impl MaterialsPanel {
             Err(e) => {
                 ui.colored_label(egui::Color32::RED, e.to_string());
             }
+        }
+        // What the scene build clamped (a reflectance above 1 typed into the site file); the
+        // gamut warning above already covers a designer's colour.
+        for (_, message) in self
+            .scene_warnings
+            .iter()
+            .filter(|(m, text)| *m == base.name && !text.contains("sRGB gamut"))
+        {
+            let r = ui.colored_label(egui::Color32::from_rgb(200, 120, 0), message);
+            name_widget(ui, &r, "Material warning");
         }
         ui.horizontal(|ui| {
             ui.label("Hex");
@@ -424,12 +437,14 @@ fn triple_row(
 }
 
 /// Refills `materials` (the one scene's materials by name, or `error` when the scene cannot be
-/// built) when the site's models, materials, library or polygon count changed since `key`.
+/// built) and `warnings` (the build's site-material warnings: material name, message) when the
+/// site's models, materials, library or polygon count changed since `key`.
 pub(crate) fn refresh_scene_materials(
     doc: &SiteDocument,
     key: &mut String,
     materials: &mut Vec<Material>,
     error: &mut Option<String>,
+    warnings: &mut Vec<(String, String)>,
 ) {
     let now = format!(
         "{:?}{:?}{:?}{}",
@@ -449,9 +464,20 @@ pub(crate) fn refresh_scene_materials(
             m.dedup_by(|a, b| a.name == b.name);
             *materials = m;
             *error = None;
+            *warnings = s
+                .warnings
+                .iter()
+                .filter_map(|w| match w {
+                    SiteWarning::SiteMaterial { material, message } => {
+                        Some((material.clone(), message.clone()))
+                    }
+                    _ => None,
+                })
+                .collect();
         }
         Err(e) => {
             materials.clear();
+            warnings.clear();
             *error = Some(e.to_string());
         }
     }

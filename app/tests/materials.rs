@@ -74,3 +74,28 @@ fn palette_colour_sets_material_undo_restores_and_gamut_warns() {
             .any(|w| w.to_string().contains("outside the sRGB gamut"))
     );
 }
+
+/// A reflectance above 1 typed into the site file is clamped by the scene build; the Materials
+/// tab shows that warning for the material (issue 17, bad input).
+#[test]
+fn a_reflectance_above_one_shows_its_clamp_warning() {
+    let (_dir, site) = common::copy_sample();
+    let mut text = std::fs::read_to_string(&site).unwrap();
+    text.push_str("\n[[materials]]\nname = \"brick\"\ndiffuse_rgb = [1.2, 0.5, 0.5]\n");
+    std::fs::write(&site, text).unwrap();
+    let mut h = common::harness(&site, common::WINDOW);
+    h.get_by_label("Materials tab").click();
+    h.run();
+    h.get_by_label("Material brick").click();
+    h.run();
+    let warning = h.get_by_label_contains("outside [0, 1]; clamped to");
+    let shown = format!("{warning:?}");
+    assert!(shown.contains("1.2"), "{shown}");
+    // Another material shows none.
+    h.get_by_label("Material plaster").click();
+    h.run();
+    assert!(
+        h.query_by_label_contains("outside [0, 1]; clamped to")
+            .is_none()
+    );
+}

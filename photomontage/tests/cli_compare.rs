@@ -200,6 +200,18 @@ fn bad_variants_are_refused_by_name_and_nothing_is_written() {
     let e = stderr(&o);
     assert!(e.contains("`red_box`") && e.contains("`tower`"), "{e}");
     assert!(!pdf.exists());
+    // `render --variant` names it the same way and writes nothing.
+    let r = bin()
+        .arg("render")
+        .arg(&site)
+        .args(["--view", "p1", "--variant", "red_box", "--out"])
+        .arg(dir.path().join("x.png"))
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    let e = stderr(&r);
+    assert!(e.contains("`red_box`") && e.contains("`tower`"), "{e}");
+    assert!(!dir.path().join("x.png").exists());
 
     // Two variants of one name: the site does not load, naming the field.
     std::fs::write(&site, format!("{text}\n[[variants]]\nname = \"no_box\"\n")).unwrap();

@@ -37,6 +37,8 @@ impl EditorCache {
             &mut self.key,
             &mut self.scene_materials,
             &mut self.scene_error,
+            // The variant editor shows its own problems; the Materials tab shows these.
+            &mut Vec::new(),
         );
     }
 }
