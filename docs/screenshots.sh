@@ -8,7 +8,8 @@
 # Without TAB arguments it takes the Study tab shots (docs/images/studio-study-shadow.png, which
 # the user guide shows, and studio-study.png with montages, which takes long in a debug build and
 # is not in the guide yet) and one shot of each further side tab it knows by label
-# ("Site & light", "Materials", "Variants": docs/images/studio-<tab>.png); a tab the studio does
+# ("Site & light", "Materials", "Variants": docs/images/studio-<tab>.png; "Elevation": the Materials
+# tab with its unfolded elevation drawn by irradiance); a tab the studio does
 # not know yet (`--tab` refuses it) is skipped with a note. With TAB arguments only those tabs.
 # A new tab needs its label in `Studio::select_tab` (app/src/study_panel.rs).
 #
@@ -77,13 +78,18 @@ if [[ ${#tabs[@]} -eq 0 ]]; then
         --study-dates 2026-06-21 --study-times 09:00,12:00,15:00 --study-frame 1
     shot docs/images/studio-study-shadow.png --tab Study --study-dates 2026-03-20,2026-06-21 \
         --study-times 09:00,12:00,17:00 --study-shadow-maps --study-no-montages --study-frame 4
-    tabs=("Site & light" "Materials" "Variants")
+    tabs=("Site & light" "Materials" "Variants" "Elevation")
 fi
 for tab in "${tabs[@]}"; do
     slug=$(echo "$tab" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\+/-/g; s/-$//')
     extra=()
     if [[ $tab == Variants ]]; then
         extra=(--render-variants)  # both variants rendered, shown on the A/B slider
+    fi
+    if [[ $tab == Elevation ]]; then
+        # The Materials tab's unfolded elevation of the planned building, by irradiance.
+        tab=Materials
+        extra=(--elevation --elevation-irradiance)
     fi
     if "$bin/photomontage-studio" --help >/dev/null && shot "docs/images/studio-$slug.png" --tab "$tab" "${extra[@]}"; then
         :

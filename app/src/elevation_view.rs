@@ -38,6 +38,11 @@ pub struct ElevationView {
     worker: Worker<Result<SiteElevation, String>>,
     drawn: Option<(SiteElevation, egui::TextureHandle)>,
     message: Option<String>,
+    /// Draw on the next frame the section is shown (the studio's `--elevation` start option).
+    draw_requested: bool,
+    /// Close the solve options on the next frame (after a requested draw, so that the drawing
+    /// shows below them).
+    fold_options: bool,
 }
 
 impl Default for ElevationView {
@@ -51,6 +56,8 @@ impl Default for ElevationView {
             export_path: String::new(),
             worker: Worker::new("elevation"),
             drawn: None,
+            draw_requested: false,
+            fold_options: false,
             message: None,
         }
     }
@@ -151,6 +158,20 @@ impl ElevationView {
         }
     }
 
+    /// Asks for a drawing of the first visible model, with its irradiance when `irradiance`,
+    /// the next time the section is shown.
+    pub fn request_draw(&mut self, irradiance: bool) {
+        self.irradiance = irradiance;
+        self.draw_requested = true;
+        self.fold_options = true;
+    }
+
+    /// Whether a drawing is running or asked for.
+    #[must_use]
+    pub fn busy(&self) -> bool {
+        self.draw_requested || self.worker.busy()
+    }
+
     /// Starts the drawing on the worker, or says why the typed options are refused.
     fn start(&mut self, ctx: &egui::Context, doc: &SiteDocument) {
         let irradiance = if self.irradiance {
@@ -181,7 +202,9 @@ impl ElevationView {
 
     /// The irradiance view's solve options, as the CLI names them.
     fn options_ui(&mut self, ui: &mut egui::Ui, doc: &SiteDocument) {
+        let open = std::mem::take(&mut self.fold_options).then_some(false);
         egui::CollapsingHeader::new("solve options")
+            .open(open)
             .default_open(true)
             .show(ui, |ui| {
                 egui::Grid::new("elevation solve options").show(ui, |ui| {
@@ -299,7 +322,7 @@ impl ElevationView {
             let busy = self.worker.busy();
             let b = ui.add_enabled(!busy, egui::Button::new("Draw elevation"));
             name_widget(ui, &b, "Draw elevation");
-            if b.clicked() {
+            if b.clicked() || (std::mem::take(&mut self.draw_requested) && !busy) {
                 self.start(ui.ctx(), doc);
             }
             if busy && ui.button("Cancel").clicked() {

@@ -28,6 +28,13 @@ impl Studio {
             && !self.fit.worker.busy()
             && !self.study.busy()
             && !self.variants.busy()
+            && !self.materials.elevation_busy()
+    }
+
+    /// Opens the Materials tab's unfolded elevation and draws it (the `--elevation` start
+    /// option; the tab must be shown for the drawing to start).
+    pub fn start_elevation(&mut self, irradiance: bool) {
+        self.materials.request_elevation(irradiance);
     }
 
     /// Starts a solve of the site as it is now on the worker thread.

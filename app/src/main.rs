@@ -71,6 +71,13 @@ struct Args {
     /// With --study-dates: the preview frame shown (0 = first).
     #[arg(long, value_name = "N", requires = "study_dates")]
     study_frame: Option<usize>,
+    /// Open the Materials tab's "Unfolded elevation" and draw the first visible model there on
+    /// the first frame (with --tab Materials; the screenshot waits for it).
+    #[arg(long)]
+    elevation: bool,
+    /// With --elevation: colour the façades by their irradiance from a radiosity solve.
+    #[arg(long, requires = "elevation")]
+    elevation_irradiance: bool,
     /// Largest photo the studio decodes, in megapixels (as the CLI's option).
     #[arg(long, value_name = "MP", default_value_t = 250.0)]
     max_photo_megapixels: f64,
@@ -106,6 +113,8 @@ struct Shell {
     study_on_start: bool,
     study_frame: Option<usize>,
     variants_on_start: bool,
+    /// `--elevation`: `Some(irradiance)` until asked for on the first frame.
+    elevation_on_start: Option<bool>,
 }
 
 impl eframe::App for Shell {
@@ -117,6 +126,9 @@ impl eframe::App for Shell {
         if std::mem::take(&mut self.study_on_start) {
             let ctx = ui.ctx().clone();
             self.studio.start_study(&ctx);
+        }
+        if let Some(irradiance) = self.elevation_on_start.take() {
+            self.studio.start_elevation(irradiance);
         }
         if std::mem::take(&mut self.variants_on_start) {
             let ctx = ui.ctx().clone();
@@ -240,6 +252,7 @@ fn main() -> anyhow::Result<()> {
         study_on_start: args.study_dates.is_some(),
         study_frame: args.study_frame,
         variants_on_start: args.render_variants,
+        elevation_on_start: args.elevation.then_some(args.elevation_irradiance),
     };
     eframe::run_native(
         "photomontage studio",

@@ -51,6 +51,8 @@ pub struct MaterialsPanel {
     pick_result: Option<String>,
     /// The unfolded elevation section.
     elevation: crate::elevation_view::ElevationView,
+    /// Open the elevation section on the next frame.
+    open_elevation: bool,
 }
 
 /// The stored colour of `name`: the site entry's colour text, else the hex of its diffuse.
@@ -97,6 +99,19 @@ fn swatch(ui: &mut egui::Ui, rgb8: [u8; 3], name: &str) {
 }
 
 impl MaterialsPanel {
+    /// Opens the "Unfolded elevation" section and draws the first visible model there (with its
+    /// irradiance from a radiosity solve when `irradiance`): the studio's `--elevation`.
+    pub fn request_elevation(&mut self, irradiance: bool) {
+        self.open_elevation = true;
+        self.elevation.request_draw(irradiance);
+    }
+
+    /// Whether the elevation section is drawing (or about to).
+    #[must_use]
+    pub fn elevation_busy(&self) -> bool {
+        self.elevation.busy()
+    }
+
     /// Whether a click on the photo picks a material.
     #[must_use]
     pub fn pick_mode(&self) -> bool {
@@ -358,6 +373,16 @@ impl Panel for MaterialsPanel {
             ui.label("No site open.");
             return Vec::new();
         };
+        // The editor and the unfolded elevation below it outgrow a small window: they scroll.
+        egui::ScrollArea::vertical()
+            .id_salt("materials tab")
+            .show(ui, |ui| self.contents(ui, doc))
+            .inner
+    }
+}
+
+impl MaterialsPanel {
+    fn contents(&mut self, ui: &mut egui::Ui, doc: &SiteDocument) -> Vec<Action> {
         self.refresh(doc);
         if let Some(e) = &self.scene_error {
             ui.colored_label(egui::Color32::RED, e);
@@ -394,8 +419,10 @@ impl Panel for MaterialsPanel {
             }
         };
         ui.separator();
+        let open = std::mem::take(&mut self.open_elevation).then_some(true);
         let r = egui::CollapsingHeader::new("Unfolded elevation")
             .default_open(false)
+            .open(open)
             .show(ui, |ui| self.elevation.ui(ui, doc));
         name_widget(ui, &r.header_response, "Unfolded elevation");
         actions

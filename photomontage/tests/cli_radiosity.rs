@@ -202,3 +202,29 @@ fn a_sun_below_the_horizon_is_named_and_lights_nothing() {
     );
     assert!(err.contains("nothing lights"), "{err}");
 }
+
+/// A 1 km ground at the default 1 m elements would be about 8 million elements: the solve gives
+/// the ground an element size of its own (with a note naming it) instead of refusing the site.
+#[test]
+fn a_large_ground_is_sized_to_fit_with_a_note() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = common::make_site(dir.path());
+    let text = std::fs::read_to_string(&site).unwrap();
+    let big = text
+        .replace("[-10.0, -10.0, 0.0]", "[-500.0, -500.0, 0.0]")
+        .replace("[10.0, -10.0, 0.0]", "[500.0, -500.0, 0.0]")
+        .replace("[10.0, 10.0, 0.0]", "[500.0, 500.0, 0.0]")
+        .replace("[-10.0, 10.0, 0.0]", "[-500.0, 500.0, 0.0]");
+    assert_ne!(big, text);
+    std::fs::write(&site, big).unwrap();
+    let out = photomontage(&["radiosity".as_ref(), site.as_os_str(), "--json".as_ref()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("ground") && err.contains("element edge") && err.contains("instead of 1 m"),
+        "{err}"
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let elements = json["elements"].as_u64().unwrap();
+    assert!(elements <= 200_000, "{elements}");
+}

@@ -49,6 +49,10 @@ pub struct MeshParams {
     pub max_element_edge_m: f64,
     /// Per-object element sizes by object name (Tonn's local sizes), metres.
     pub object_element_edge_m: BTreeMap<String, f64>,
+    /// Per-object patch sizes by object name, metres (else [`MeshParams::max_patch_edge_m`]):
+    /// an object with a coarse element size of its own keeps patches a few elements across
+    /// ([`MeshParams::sized_for`]) instead of one patch per element.
+    pub object_patch_edge_m: BTreeMap<String, f64>,
     /// Refuse to mesh beyond this many elements.
     pub max_elements: usize,
     /// Split elements that a sun shadow edge crosses down to this edge, metres, when the mesh
@@ -63,6 +67,7 @@ impl Default for MeshParams {
             max_patch_edge_m: 4.0,
             max_element_edge_m: 1.0,
             object_element_edge_m: BTreeMap::new(),
+            object_patch_edge_m: BTreeMap::new(),
             max_elements: 200_000,
             shadow_edge_element_m: None,
         }
@@ -288,7 +293,11 @@ impl Mesh {
         check_positive("max_patch_edge_m", params.max_patch_edge_m)?;
         check_positive("max_element_edge_m", params.max_element_edge_m)?;
         let object_names: Vec<String> = scene.objects().iter().map(|o| o.name.clone()).collect();
-        for (name, &size) in &params.object_element_edge_m {
+        for (name, &size) in params
+            .object_element_edge_m
+            .iter()
+            .chain(&params.object_patch_edge_m)
+        {
             check_positive("object_element_edge_m", size)?;
             if !object_names.contains(name) {
                 return Err(RadiosityError::UnknownObject {
@@ -358,7 +367,12 @@ impl Mesh {
                 .copied()
                 .unwrap_or(params.max_element_edge_m);
             let element_levels = levels_for(longest, element_edge_m);
-            let patch_levels = levels_for(longest, params.max_patch_edge_m).min(element_levels);
+            let patch_edge_m = params
+                .object_patch_edge_m
+                .get(&object_name)
+                .copied()
+                .unwrap_or(params.max_patch_edge_m);
+            let patch_levels = levels_for(longest, patch_edge_m).min(element_levels);
             let new_elements = 1usize << (2 * element_levels.min(31));
             if element_levels > 15 || mesh.elements.len() + new_elements > params.max_elements {
                 return Err(RadiosityError::TooManyElements {

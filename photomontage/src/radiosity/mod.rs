@@ -48,6 +48,7 @@ pub mod form_factor;
 mod gather_avx2;
 pub mod hierarchical;
 pub mod mesh;
+pub mod mesh_sizing;
 pub mod progressive;
 pub mod query;
 pub mod shadow_refinement;

@@ -129,6 +129,9 @@ pub fn site_elevation(
             warnings.extend(notes);
             let mut p = l.params;
             p.solve.ground = site_ground_below_horizon(doc, &site.scene)?;
+            let (mesh, notes) = p.solve.mesh.sized_for(&site.scene);
+            p.solve.mesh = mesh;
+            warnings.extend(notes);
             let t = Transfer::build(&site.scene, &lights, &p, l.cancel, &|_| {})?;
             warnings.extend(t.solution().warnings.iter().map(ToString::to_string));
             Some(t)

@@ -66,7 +66,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!("note: {n}");
     }
     let ground = site_ground_below_horizon(&doc, &site.scene)?;
-    let params = TransferParams {
+    let mut params = TransferParams {
         solve: args.solve.params(
             Solver::Hierarchical(HierarchicalParams {
                 bf_tolerance: args.solve.bf_tolerance,
@@ -77,6 +77,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         sky_tolerance: args.solve.sky_tolerance,
         ..TransferParams::default()
     };
+    let (mesh, notes) = params.solve.mesh.sized_for(&site.scene);
+    params.solve.mesh = mesh;
+    for n in notes {
+        eprintln!("note: {n}");
+    }
     let query = QueryParams {
         max_interpolation_edge_m: args.max_interpolation_edge_m,
         gather_rays: args.gather_rays,

@@ -195,7 +195,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             g.albedo_rgb
         );
     }
-    let params = args.solve.params(
+    let mut params = args.solve.params(
         match args.solver {
             SolverArg::Hierarchical => Solver::Hierarchical(HierarchicalParams {
                 bf_tolerance: args.solve.bf_tolerance,
@@ -206,6 +206,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         },
         ground,
     )?;
+    let (mesh, notes) = params.mesh.sized_for(&site.scene);
+    params.mesh = mesh;
+    for n in notes {
+        eprintln!("note: {n}");
+    }
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")
