@@ -9,8 +9,8 @@
 # the user guide shows, and studio-study.png with montages, which takes long in a debug build and
 # is not in the guide yet) and one shot of each further side tab it knows by label
 # ("Site & light", "Materials", "Variants": docs/images/studio-<tab>.png; "Elevation": the Materials
-# tab with its unfolded elevation drawn by irradiance); a tab the studio does
-# not know yet (`--tab` refuses it) is skipped with a note. With TAB arguments only those tabs.
+# tab with its unfolded elevation drawn by irradiance; "Study": the shadow-map shot alone); a tab
+# the studio does not know yet (`--tab` refuses it) is skipped with a note. With TAB arguments only those tabs.
 # A new tab needs its label in `Studio::select_tab` (app/src/study_panel.rs).
 #
 # The site is a temporary copy of sample_sites/street with `location.time_zone =
@@ -85,6 +85,12 @@ for tab in "${tabs[@]}"; do
     extra=()
     if [[ $tab == Variants ]]; then
         extra=(--render-variants)  # both variants rendered, shown on the A/B slider
+    fi
+    if [[ $tab == Study ]]; then
+        # The shadow-map study alone (quick); the montage study only without TAB arguments.
+        shot docs/images/studio-study-shadow.png --tab Study --study-dates 2026-03-20,2026-06-21 \
+            --study-times 09:00,12:00,17:00 --study-shadow-maps --study-no-montages --study-frame 4
+        continue
     fi
     if [[ $tab == Elevation ]]; then
         # The Materials tab's unfolded elevation of the planned building, by irradiance.
