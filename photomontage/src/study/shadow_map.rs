@@ -11,8 +11,15 @@
 //! differential renderer's direct term (Durisch 1992 §6.2, cases B and C) sampled at one point per
 //! cell, without the sun disc's penumbra.
 //!
+//! **Extent.** The natural geometry's plan extent, cut to the planned objects' plan extent grown
+//! by [`SHADOW_REACH`] × their height (at least [`MIN_MARGIN_M`]): a site modelled on a 1 km
+//! ground would otherwise be mapped at 1 km, with the proposal a speck in it. The margin holds a
+//! shadow cast with the sun 15° or more above the horizon; a scene without planned objects is
+//! mapped whole.
+//!
 //! Known limitations: one ray per cell (a cell on a shadow edge takes the class of its centre);
-//! the sun is a point (no penumbra); surfaces under an overhang are not seen from above.
+//! the sun is a point (no penumbra); surfaces under an overhang are not seen from above; a shadow
+//! cast with the sun lower than 15° can reach past the map's edge.
 
 use image::{Rgb, RgbImage};
 use nalgebra::{Point3, Vector3};
@@ -22,6 +29,13 @@ use super::StudyError;
 use crate::bvh::BuildQuality;
 use crate::radiosity::convergence_plot::text;
 use crate::scene::{ObjectKind, Scene, SceneTracer};
+
+/// The map reaches this many times the planned objects' height beyond their plan extent: the
+/// length of a shadow cast with the sun 15° above the horizon (cot 15° = 3.73).
+pub const SHADOW_REACH: f64 = 3.75;
+
+/// The map reaches at least this far beyond the planned objects' plan extent, metres.
+pub const MIN_MARGIN_M: f64 = 20.0;
 
 /// Default cell size, metres.
 pub const DEFAULT_CELL_M: f64 = 0.25;
@@ -144,6 +158,23 @@ pub fn shadow_map(
                 lo[a] = lo[a].min(v[a]);
                 hi[a] = hi[a].max(v[a]);
             }
+        }
+    }
+    // Around the planned objects (module doc).
+    let (mut art_lo, mut art_hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for t in scene.triangles().iter().filter(|t| !natural(t)) {
+        for v in &t.vertices_in_world_m {
+            for a in 0..3 {
+                art_lo[a] = art_lo[a].min(v[a]);
+                art_hi[a] = art_hi[a].max(v[a]);
+            }
+        }
+    }
+    if art_lo[2] <= art_hi[2] {
+        let margin = MIN_MARGIN_M.max(SHADOW_REACH * (art_hi[2] - art_lo[2]));
+        for a in 0..2 {
+            lo[a] = lo[a].max(art_lo[a] - margin);
+            hi[a] = hi[a].min(art_hi[a] + margin);
         }
     }
     let Some([_, top]) = scene.bounding_box_in_world_m() else {

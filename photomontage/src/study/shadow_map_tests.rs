@@ -163,3 +163,62 @@ fn legend_and_classes_are_drawn_north_up() {
     assert_eq!(at(1, 1), CellClass::ExistingShadow.colour());
     assert_eq!(map.count(CellClass::Lit), 1);
 }
+
+/// A 1 km natural ground with a planned 10 m cube: the map covers the cube's plan extent grown by
+/// 3.75 × its height (37.5 m), not the whole ground; with no planned object, the whole ground.
+#[test]
+fn the_map_covers_the_proposal_and_its_shadow_reach_not_the_whole_ground() {
+    use crate::scene::{Material, ObjectKind, Scene, SceneObject};
+    use nalgebra::{Point3, Vector3};
+    let quad = |scene: &mut Scene, corners: [[f64; 3]; 4], kind: ObjectKind| {
+        let m = scene
+            .add_material(Material::diffuse("grey", [0.3; 3]))
+            .unwrap();
+        let o = scene
+            .add_object(SceneObject {
+                name: format!("o{}", scene.objects().len()),
+                kind,
+                image_attribute: None,
+            })
+            .unwrap();
+        let poly: Vec<Point3<f64>> = corners.iter().map(|c| Point3::from(*c)).collect();
+        scene.add_polygon(&poly, m, o).unwrap();
+    };
+    let mut scene = Scene::new();
+    let g = 500.0;
+    quad(
+        &mut scene,
+        [[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]],
+        ObjectKind::Natural,
+    );
+    let sun = Vector3::new(0.3, -0.5, 0.8).normalize();
+    let whole = shadow_map(&scene, &sun, 1.0).unwrap();
+    assert_eq!(whole.size_cells, [1000, 1000]);
+    // A 10 m planned cube at the origin (its roof is enough to give it a height in plan).
+    let (h, s) = (10.0, 5.0);
+    quad(
+        &mut scene,
+        [[-s, -s, h], [s, -s, h], [s, s, h], [-s, s, h]],
+        ObjectKind::Artificial,
+    );
+    quad(
+        &mut scene,
+        [[-s, -s, 0.0], [-s, s, 0.0], [-s, s, h], [-s, -s, h]],
+        ObjectKind::Artificial,
+    );
+    let map = shadow_map(&scene, &sun, 1.0).unwrap();
+    let reach = SHADOW_REACH * h;
+    assert!(
+        (map.min_xy_m[0] - (-s - reach)).abs() < 1e-9,
+        "{:?}",
+        map.min_xy_m
+    );
+    assert!(
+        (map.min_xy_m[1] - (-s - reach)).abs() < 1e-9,
+        "{:?}",
+        map.min_xy_m
+    );
+    let side = ((2.0 * (s + reach)) / 1.0).ceil() as usize;
+    assert_eq!(map.size_cells, [side, side]);
+    assert!(map.count(CellClass::AddedShadow) > 0);
+}
