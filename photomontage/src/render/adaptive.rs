@@ -55,6 +55,23 @@ pub(crate) struct PixelTally {
 }
 
 impl PixelTally {
+    /// The pixel's linear RGBA: the mean of `sum` (the tally's sum, or a corrected one) over its
+    /// rays with the coverage as alpha where it changed, else the photo's value `photo` bit for
+    /// bit with alpha 0.
+    pub fn rgba(&self, sum: Rgb, photo: [f32; 3]) -> [f32; 4] {
+        if !self.changed {
+            return [photo[0], photo[1], photo[2], 0.0];
+        }
+        let nf = f64::from(self.n);
+        #[allow(clippy::cast_possible_truncation)]
+        [
+            (sum[0] / nf) as f32,
+            (sum[1] / nf) as f32,
+            (sum[2] / nf) as f32,
+            (f64::from(self.covered) / nf) as f32,
+        ]
+    }
+
     fn add(&mut self, ray: &RayOutcome) {
         self.changed |= ray.changed;
         self.covered += u32::from(ray.hit_artificial);
@@ -149,6 +166,13 @@ pub(crate) fn pixels_at_edges(
     edge
 }
 
+/// The photo pixel of pixel `i` (row-major) of the tile at `origin_px` of `size_px`.
+pub(crate) fn tile_pixel(origin_px: [u32; 2], size_px: [u32; 2], i: usize) -> [u32; 2] {
+    #[allow(clippy::cast_possible_truncation)]
+    let i = i as u32;
+    [origin_px[0] + i % size_px[0], origin_px[1] + i / size_px[0]]
+}
+
 /// Samples the tile at `origin_px` of `size_px`: pass 1 and pass 2 of the module doc, with 4
 /// stratified jittered positions per batch drawn from `rng`. `trace(i, [x, y], position)`
 /// traces one ray of pixel `i` (row-major in the tile) at pixel `[x, y]` through `position`
@@ -164,11 +188,7 @@ pub(crate) fn sample_tile(
 ) -> Vec<PixelTally> {
     let count = (size_px[0] * size_px[1]) as usize;
     let mut tallies = vec![PixelTally::default(); count];
-    let pixel_of = |i: usize| {
-        #[allow(clippy::cast_possible_truncation)]
-        let i = i as u32;
-        [origin_px[0] + i % size_px[0], origin_px[1] + i / size_px[0]]
-    };
+    let pixel_of = |i: usize| tile_pixel(origin_px, size_px, i);
     let mut batch = |tally: &mut PixelTally, i: usize, rng: &mut ChaCha8Rng| {
         let [x, y] = pixel_of(i);
         for s in 0..4 {

@@ -388,11 +388,7 @@ fn render_tile(
     };
     let mut pixel_ratios = ratios.by_pixel();
     for (i, tally) in tallies.iter().enumerate() {
-        #[allow(clippy::cast_possible_truncation)]
-        let (x, y) = (
-            origin_px[0] + i as u32 % size_px[0],
-            origin_px[1] + i as u32 / size_px[0],
-        );
+        let [x, y] = adaptive::tile_pixel(origin_px, size_px, i);
         let photo_f32 = photo.get_pixel(x, y).0;
         let photo_rgb = photo_f32.map(f64::from);
         let own_ratios = pixel_ratios.next_pixel(i);
@@ -407,20 +403,8 @@ fn render_tile(
         out.rays += u64::from(tally.n);
         out.layers
             .push_pixel(first_hit[i].flatten(), change, tally.changed, tally.n);
-        if tally.changed {
-            out.changed += 1;
-            let nf = f64::from(tally.n);
-            #[allow(clippy::cast_possible_truncation)]
-            out.rgba.push([
-                (sum[0] / nf) as f32,
-                (sum[1] / nf) as f32,
-                (sum[2] / nf) as f32,
-                (f64::from(tally.covered) / nf) as f32,
-            ]);
-        } else {
-            out.rgba
-                .push([photo_f32[0], photo_f32[1], photo_f32[2], 0.0]);
-        }
+        out.changed += usize::from(tally.changed);
+        out.rgba.push(tally.rgba(sum, photo_f32));
     }
     out
 }

@@ -360,26 +360,11 @@ impl Job<'_, '_> {
             },
         );
         for (i, tally) in tallies.iter().enumerate() {
-            #[allow(clippy::cast_possible_truncation)]
-            let (x, y) = (
-                origin_px[0] + i as u32 % size_px[0],
-                origin_px[1] + i as u32 / size_px[0],
-            );
+            let [x, y] = super::adaptive::tile_pixel(origin_px, size_px, i);
             out.rays += u64::from(tally.n);
-            let photo_px = photo.get_pixel(x, y).0;
-            if tally.changed {
-                out.changed += 1;
-                let nf = f64::from(tally.n);
-                #[allow(clippy::cast_possible_truncation)]
-                out.rgba.push([
-                    (tally.sum[0] / nf) as f32,
-                    (tally.sum[1] / nf) as f32,
-                    (tally.sum[2] / nf) as f32,
-                    (f64::from(tally.covered) / nf) as f32,
-                ]);
-            } else {
-                out.rgba.push([photo_px[0], photo_px[1], photo_px[2], 0.0]);
-            }
+            out.changed += usize::from(tally.changed);
+            out.rgba
+                .push(tally.rgba(tally.sum, photo.get_pixel(x, y).0));
         }
         out
     }
