@@ -137,14 +137,74 @@ fn the_residual_table_sorts_by_a_header_click() {
     h.run();
     let up = format!("{header} (ascending)");
     assert!(h.query_by_label(&up).is_some(), "sorted ascending");
+    let shown = column_on_screen(&h, &up);
+    let mut expected = shown.clone();
+    expected.sort_by(f64::total_cmp);
+    assert_eq!(shown, expected, "rows in ascending |v|");
+    assert!(
+        shown.first() < shown.last(),
+        "the column has distinct values"
+    );
     h.get_by_label(&up).click();
     h.run();
     let down = format!("{header} (descending)");
     assert!(h.query_by_label(&down).is_some(), "sorted descending");
+    let shown = column_on_screen(&h, &down);
+    expected.reverse();
+    assert_eq!(shown, expected, "rows in descending |v|");
     h.get_by_label(&down).click();
     h.run();
     assert!(
         h.query_by_label(header).is_some(),
         "third click: the file's order"
     );
+    // The file's order again: the residuals as the solve lists them.
+    let file_order: Vec<f64> = p1_residuals(&h)
+        .iter()
+        .map(|r| photomontage_studio::solve::row_numbers(r)[2])
+        .map(|v| format!("{v:.3}").parse().unwrap())
+        .collect();
+    assert_eq!(column_on_screen(&h, header), file_order);
+    assert_ne!(
+        file_order, expected,
+        "the sample's file order is not sorted"
+    );
+}
+
+fn p1_residuals(h: &H) -> Vec<photomontage::photogrammetry::ObservationResidual> {
+    h.state()
+        .solution()
+        .expect("solved")
+        .photos
+        .iter()
+        .find(|p| p.id == "P1")
+        .expect("P1 solved")
+        .residuals
+        .clone()
+}
+
+/// The |v| cells of P1's residual table, top to bottom: the cells that show one of P1's |v|
+/// values, left-aligned under the column's header (`header`, its accessible name) and below it.
+fn column_on_screen(h: &H, header: &str) -> Vec<f64> {
+    let head = h.get_by_label(header).rect();
+    let rows = p1_residuals(h);
+    let texts: std::collections::BTreeSet<String> = rows
+        .iter()
+        .map(|r| format!("{:.3}", photomontage_studio::solve::row_numbers(r)[2]))
+        .collect();
+    let mut cells: Vec<(f32, f64)> = texts
+        .iter()
+        .flat_map(|t| {
+            h.query_all_by_label(t)
+                .map(|n| n.rect())
+                .filter(|r| (r.min.x - head.min.x).abs() < 2.0 && r.min.y > head.max.y)
+                .map(|r| (r.min.y, t.parse::<f64>().unwrap()))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // P2's table follows with the same columns: P1's rows are the first ones.
+    cells.truncate(rows.len());
+    assert_eq!(cells.len(), rows.len(), "every P1 row is on screen");
+    cells.into_iter().map(|(_, v)| v).collect()
 }

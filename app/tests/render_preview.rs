@@ -193,3 +193,93 @@ fn check_progressive_preview(
         "{changed_in} {changed_out}"
     );
 }
+
+/// Control marks: 6-px rings, one per observation on the photo (`photo_view::paint_marks`).
+fn mark_rings(h: &egui_kittest::Harness<'static, photomontage_studio::Studio>) -> usize {
+    h.output()
+        .shapes
+        .iter()
+        .filter(|s| {
+            matches!(&s.shape, eframe::egui::Shape::Circle(c)
+                if (c.radius - 6.0).abs() < 1e-3 && c.fill == eframe::egui::Color32::TRANSPARENT)
+        })
+        .count()
+}
+
+/// Outlines of finished tiles: 1-px strokes in the outline colour (`RenderPanel::paint`).
+fn tile_outlines(h: &egui_kittest::Harness<'static, photomontage_studio::Studio>) -> usize {
+    let colour = eframe::egui::Color32::from_rgb(80, 200, 255);
+    h.output()
+        .shapes
+        .iter()
+        .filter(|s| matches!(&s.shape, eframe::egui::Shape::Rect(r) if r.stroke.color == colour))
+        .count()
+}
+
+/// The Render tab's two overlay switches, driven by their labels: "show control marks" hides
+/// and shows the observation marks, "show tile outlines" the finished tiles' outlines of a
+/// running render (which goes on underneath).
+#[test]
+fn render_tab_hides_control_marks_and_tile_outlines() {
+    let (_dir, site) = copy_sample();
+    add_box_model(&site);
+    let mut h = harness(&site, WINDOW);
+    h.get_by_label("Solve").click();
+    step_until(&mut h, "solve", |s| s.solution().is_some() && s.is_idle());
+    h.get_by_label("Render").click();
+    h.run();
+    let on_p1 = h
+        .state()
+        .document()
+        .unwrap()
+        .site
+        .observations
+        .iter()
+        .filter(|o| o.photo == "P1" && o.enabled)
+        .count();
+    assert!(on_p1 > 3, "the sample has marks on P1");
+    assert!(mark_rings(&h) >= on_p1, "marks drawn on the Render tab");
+    h.get_by_label("show control marks").click();
+    h.run();
+    assert_eq!(mark_rings(&h), 0, "marks hidden");
+    h.get_by_label("show control marks").click();
+    h.run();
+    assert!(mark_rings(&h) >= on_p1, "marks shown again");
+
+    // A slow render (many rays where the box is), to look at it while it runs.
+    {
+        let q = &mut h.state_mut().render_panel_mut().quality;
+        q.spp_min = 16;
+        q.spp_max = 16;
+    }
+    h.get_by_label("Start").click();
+    // A running render asks for frames all the time: step, never `run`, until it ends.
+    let start = std::time::Instant::now();
+    loop {
+        h.step();
+        let (done, total) = h.state().render_panel().progress();
+        if done >= 1 {
+            assert!(done < total, "the render ran past the first tiles unseen");
+            break;
+        }
+        assert!(start.elapsed().as_secs() < 300, "no tile finished");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    h.run_steps(2);
+    assert!(h.state().render_panel().busy(), "still running");
+    assert!(tile_outlines(&h) >= 1, "finished tiles outlined");
+    h.get_by_label("show tile outlines").click();
+    h.run_steps(2);
+    assert!(h.state().render_panel().busy(), "the render goes on");
+    assert_eq!(tile_outlines(&h), 0, "outlines hidden");
+    h.get_by_label("show tile outlines").click();
+    h.run_steps(2);
+    assert!(tile_outlines(&h) >= 1, "outlines shown again");
+    h.get_by_label("Cancel").click();
+    let start = std::time::Instant::now();
+    while h.state().render_panel().busy() {
+        h.step();
+        assert!(start.elapsed().as_secs() < 300, "the render did not stop");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
