@@ -14,12 +14,13 @@
 //! **Extent.** The natural geometry's plan extent, cut to the planned objects' plan extent grown
 //! by [`SHADOW_REACH`] × their height (at least [`MIN_MARGIN_M`]): a site modelled on a 1 km
 //! ground would otherwise be mapped at 1 km, with the proposal a speck in it. The margin holds a
-//! shadow cast with the sun 15° or more above the horizon; a scene without planned objects is
-//! mapped whole.
+//! shadow cast with the sun 15° or more above the horizon; for a lower sun the map grows on the side
+//! away from the sun to the end of the proposal's shadow ([`planned_extent`]), so a winter
+//! morning's long shadow is mapped whole. A scene without planned objects is mapped whole.
 //!
 //! Known limitations: one ray per cell (a cell on a shadow edge takes the class of its centre);
-//! the sun is a point (no penumbra); surfaces under an overhang are not seen from above; a shadow
-//! cast with the sun lower than 15° can reach past the map's edge.
+//! the sun is a point (no penumbra); surfaces under an overhang are not seen from above; frames of
+//! one study with the sun lower than 15° are mapped over a larger extent than the others.
 
 use image::{Rgb, RgbImage};
 use nalgebra::{Point3, Vector3};
@@ -170,11 +171,12 @@ pub fn shadow_map(
             }
         }
     }
+    let sun = sun_dir_in_world.normalize();
     if art_lo[2] <= art_hi[2] {
-        let margin = MIN_MARGIN_M.max(SHADOW_REACH * (art_hi[2] - art_lo[2]));
+        let [cut_lo, cut_hi] = planned_extent(art_lo, art_hi, &sun);
         for a in 0..2 {
-            lo[a] = lo[a].max(art_lo[a] - margin);
-            hi[a] = hi[a].min(art_hi[a] + margin);
+            lo[a] = lo[a].max(cut_lo[a]);
+            hi[a] = hi[a].min(cut_hi[a]);
         }
     }
     let Some([_, top]) = scene.bounding_box_in_world_m() else {
@@ -195,7 +197,6 @@ pub fn shadow_map(
     let from_z = top.z + 1.0;
     #[allow(clippy::cast_possible_truncation)]
     let down_t_max = (from_z - scene_bottom(scene) + 1.0) as f32;
-    let sun = sun_dir_in_world.normalize();
     let cells: Vec<(CellClass, f64)> = (0..size[0] * size[1])
         .into_par_iter()
         .map(|k| {
@@ -216,6 +217,31 @@ pub fn shadow_map(
         classes: cells.iter().map(|c| c.0).collect(),
         surface_z_m: cells.iter().map(|c| c.1).collect(),
     })
+}
+
+/// The plan extent kept around planned objects whose bounding box is `art_lo`..`art_hi` (world
+/// metres) for a sun in `sun` (unit, towards the sun): their plan extent grown by [`SHADOW_REACH`]
+/// × their height (at least [`MIN_MARGIN_M`]) on every side, and, when the sun is lower than
+/// that margin allows, further on the side away from the sun, to the end of the shadow their top
+/// casts on the level of their base (height × cot elevation) plus [`MIN_MARGIN_M`].
+#[must_use]
+pub fn planned_extent(art_lo: [f64; 3], art_hi: [f64; 3], sun: &Vector3<f64>) -> [[f64; 2]; 2] {
+    let height = art_hi[2] - art_lo[2];
+    let margin = MIN_MARGIN_M.max(SHADOW_REACH * height);
+    let mut lo = [art_lo[0] - margin, art_lo[1] - margin];
+    let mut hi = [art_hi[0] + margin, art_hi[1] + margin];
+    if sun.z > 0.0 {
+        // The top's shadow on the base level lies at −height·(sx, sy)/sz from the top.
+        for a in 0..2 {
+            let reach = -height * sun[a] / sun.z;
+            if reach < 0.0 {
+                lo[a] = lo[a].min(art_lo[a] + reach - MIN_MARGIN_M);
+            } else {
+                hi[a] = hi[a].max(art_hi[a] + reach + MIN_MARGIN_M);
+            }
+        }
+    }
+    [lo, hi]
 }
 
 fn scene_bottom(scene: &Scene) -> f64 {

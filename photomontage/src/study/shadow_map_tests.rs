@@ -165,7 +165,8 @@ fn legend_and_classes_are_drawn_north_up() {
 }
 
 /// A 1 km natural ground with a planned 10 m cube: the map covers the cube's plan extent grown by
-/// 3.75 × its height (37.5 m), not the whole ground; with no planned object, the whole ground.
+/// 3.75 × its height (37.5 m), not the whole ground, and further on the far side of a low sun;
+/// with no planned object, the whole ground.
 #[test]
 fn the_map_covers_the_proposal_and_its_shadow_reach_not_the_whole_ground() {
     use crate::scene::{Material, ObjectKind, Scene, SceneObject};
@@ -221,4 +222,32 @@ fn the_map_covers_the_proposal_and_its_shadow_reach_not_the_whole_ground() {
     let side = ((2.0 * (s + reach)) / 1.0).ceil() as usize;
     assert_eq!(map.size_cells, [side, side]);
     assert!(map.count(CellClass::AddedShadow) > 0);
+
+    // A winter sun 5° up in the east (+x): the cube's roof casts its shadow 10 m × cot 5° =
+    // 114.3 m to the west, past the 15° margin. The map grows to the west only, the shadow ends
+    // inside it, and no added shadow touches its edge.
+    let elevation = 5f64.to_radians();
+    let low_sun = Vector3::new(elevation.cos(), 0.0, elevation.sin());
+    let long = h / elevation.tan();
+    let map = shadow_map(&scene, &low_sun, 1.0).unwrap();
+    assert!(
+        (map.min_xy_m[0] - (-s - long - MIN_MARGIN_M)).abs() < 1e-9,
+        "{:?}",
+        map.min_xy_m
+    );
+    assert!((map.min_xy_m[1] - (-s - reach)).abs() < 1e-9);
+    let east_edge = map.min_xy_m[0] + map.size_cells[0] as f64 * map.cell_m;
+    assert!((east_edge - (s + reach)).abs() < 1.0, "{east_edge}");
+    let added_x: Vec<f64> = (0..map.classes.len())
+        .filter(|&k| map.classes[k] == CellClass::AddedShadow)
+        .map(|k| map.min_xy_m[0] + ((k % map.size_cells[0]) as f64 + 0.5) * map.cell_m)
+        .collect();
+    let west_end = added_x.iter().copied().fold(f64::INFINITY, f64::min);
+    // The shadow's far end is the roof's west edge moved by the shadow length (one cell).
+    assert!(
+        (west_end - (-s - long)).abs() <= map.cell_m,
+        "shadow ends at x {west_end}, expected {}",
+        -s - long
+    );
+    assert!(west_end - map.min_xy_m[0] > MIN_MARGIN_M - map.cell_m);
 }
