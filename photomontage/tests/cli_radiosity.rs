@@ -69,6 +69,45 @@ fn radiosity_reports_and_writes_mesh_and_convergence() {
     assert_eq!((plot.width(), plot.height()), (720, 440));
 }
 
+/// `--corner-element-m`: the ground's elements around the box's foot are split (more elements,
+/// all in the PLY); the box's own faces see nothing in front and keep theirs.
+#[test]
+fn corners_are_refined_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = common::make_site(dir.path());
+    let ply = dir.path().join("mesh.ply");
+    let run = |extra: &[&str]| -> serde_json::Value {
+        let mut args: Vec<&std::ffi::OsStr> = vec![
+            "radiosity".as_ref(),
+            site.as_os_str(),
+            "--element-edge-m".as_ref(),
+            "2".as_ref(),
+            "--json".as_ref(),
+        ];
+        args.extend(extra.iter().map(std::ffi::OsStr::new));
+        let out = photomontage(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let plain = run(&[])["elements"].as_u64().unwrap();
+    let refined = run(&[
+        "--corner-element-m",
+        "0.25",
+        "--mesh-out",
+        ply.to_str().unwrap(),
+    ])["elements"]
+        .as_u64()
+        .unwrap();
+    assert_eq!(plain, 2 * 256 + 12);
+    assert!(refined > plain + 12, "{plain} → {refined}");
+    let mesh = std::fs::read_to_string(&ply).unwrap();
+    assert!(mesh.contains(&format!("element face {refined}\n")));
+}
+
 #[test]
 fn bad_input_is_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -82,6 +121,8 @@ fn bad_input_is_named() {
     };
     let err = run(&["--element-edge-m", "0"]);
     assert!(err.contains("max_element_edge_m"), "{err}");
+    let err = run(&["--corner-element-m=-1"]);
+    assert!(err.contains("corner_element_m"), "{err}");
     let err = run(&["--object-element-edge", "nope=1"]);
     assert!(err.contains("`nope`"), "{err}");
     let err = run(&["--object-element-edge", "box"]);

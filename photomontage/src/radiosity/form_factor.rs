@@ -39,6 +39,10 @@ pub const RAY_OFFSET_REL: f64 = 1e-4;
 /// local origin is 7.6e-6 m).
 pub const RAY_OFFSET_ABS_M: f64 = 2e-5;
 
+/// Corner points of the refinement test lie this fraction of the way toward the centroid
+/// ([`FormFactorEngine::largest_estimate`]): off the edge a touching node shares.
+pub const ORACLE_CORNER_INSET: f64 = 0.01;
+
 /// Random stream family of the sender's sample points (apart from the pair streams).
 const SENDER_SEED_SALT: u64 = 0x5E4D_E000_0000_0001;
 
@@ -249,6 +253,31 @@ impl<'a> FormFactorEngine<'a> {
             &nq.vertices_in_world_m,
             &nq.normal_in_world,
         )
+    }
+
+    /// Unoccluded estimate of the largest point factor F_{dx→q} over p: the largest of the
+    /// factors from p's centroid and from its corners (taken [`ORACLE_CORNER_INSET`] of the way
+    /// toward the centroid). Where q lies close to one end of p (a wall standing on the ground
+    /// next to a ground node), the centroid sees q small while the near corner sees it under up
+    /// to half its hemisphere: a link judged by the centroid alone then hands all of p's leaves
+    /// the light that only its near end gets (the BF refinement test of
+    /// [`super::hierarchical`]).
+    #[must_use]
+    pub fn largest_estimate(&self, p: u32, q: u32) -> f64 {
+        let (np, nq) = (self.node(p), self.node(q));
+        let c = np.centroid_in_world_m();
+        let at = |x: &Point3<f64>| {
+            point_to_triangle(
+                x,
+                &np.normal_in_world,
+                &nq.vertices_in_world_m,
+                &nq.normal_in_world,
+            )
+        };
+        np.vertices_in_world_m
+            .iter()
+            .map(|v| at(&(v + (c - v) * ORACLE_CORNER_INSET)))
+            .fold(at(&c), f64::max)
     }
 
     fn node(&self, n: u32) -> &MeshNode {

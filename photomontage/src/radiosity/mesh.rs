@@ -58,10 +58,14 @@ pub struct MeshParams {
     /// Split elements that a sun shadow edge crosses down to this edge, metres, when the mesh
     /// is built for a lighting with a sun ([`Mesh::build_lit`]); `None` meshes uniformly.
     pub shadow_edge_element_m: Option<f64>,
+    /// Split elements that face another surface closer than their own size (concave corners,
+    /// overhangs; [`super::corner_refinement`]) down to this edge, metres; `None` leaves corners
+    /// at the element size.
+    pub corner_element_m: Option<f64>,
 }
 
 impl Default for MeshParams {
-    /// 4 m patches, 1 m elements, at most 200 000 elements, no shadow-edge refinement.
+    /// 4 m patches, 1 m elements, at most 200 000 elements, no shadow-edge or corner refinement.
     fn default() -> Self {
         Self {
             max_patch_edge_m: 4.0,
@@ -70,6 +74,7 @@ impl Default for MeshParams {
             object_patch_edge_m: BTreeMap::new(),
             max_elements: 200_000,
             shadow_edge_element_m: None,
+            corner_element_m: None,
         }
     }
 }
@@ -183,6 +188,10 @@ pub struct Mesh {
     /// built. A reflectance edit keeps it, so that what depends on geometry only (the
     /// renderer's vertex gathers) can tell a relit mesh from a new one without comparing nodes.
     pub geometry_hash: u64,
+    /// Whether elements were split at corners ([`MeshParams::corner_element_m`]): the
+    /// hierarchical solver then judges links by their largest point factor
+    /// ([`super::form_factor::FormFactorEngine::largest_estimate`]).
+    pub corner_refined: bool,
 }
 
 fn longest_edge_m(v: &[Point3<f64>; 3]) -> f64 {
@@ -226,7 +235,8 @@ impl std::fmt::Debug for Refinement<'_> {
 const MAX_LEVEL: u32 = 24;
 
 impl Mesh {
-    /// Meshes every triangle of `scene` (see the module doc).
+    /// Meshes every triangle of `scene` (see the module doc), refined at corners when
+    /// [`MeshParams::corner_element_m`] is set.
     ///
     /// # Errors
     /// [`RadiosityError::InvalidParameter`] for a non-positive size,
@@ -234,14 +244,17 @@ impl Mesh {
     /// [`RadiosityError::TooManyElements`] past the budget, [`RadiosityError::NoPatches`] when
     /// nothing (non-degenerate) remains.
     pub fn build(scene: &Scene, params: &MeshParams) -> Result<Self, RadiosityError> {
-        Self::build_refined(scene, params, None)
+        Self::build_lit(scene, params, &[], &[])
     }
 
     /// [`Mesh::build`] for a lighting whose suns shine from `dirs_to_sun` (unit vectors toward
     /// them): with [`MeshParams::shadow_edge_element_m`] set, elements that a shadow edge of
     /// theirs crosses are split down to that size
-    /// ([`super::shadow_refinement::crosses_shadow_edge`]). The shadows are those each of
-    /// `occluders` casts (an edge in any of them splits), or `scene`'s own when it is empty.
+    /// ([`super::shadow_refinement::crosses_shadow_edge`]); with
+    /// [`MeshParams::corner_element_m`] set, elements facing another surface closer than their
+    /// size are split down to that size ([`super::corner_refinement::faces_a_surface_nearby`]).
+    /// The shadows and the surfaces are those of each of `occluders` (one that asks splits), or
+    /// `scene`'s own when it is empty.
     ///
     /// # Errors
     /// As [`Mesh::build_refined`]; a tracer error for the scene.
@@ -251,12 +264,19 @@ impl Mesh {
         dirs_to_sun: &[Vector3<f64>],
         occluders: &[&SceneTracer],
     ) -> Result<Self, RadiosityError> {
-        let Some(min_element_edge_m) = params
+        let shadow_m = params
             .shadow_edge_element_m
-            .filter(|_| !dirs_to_sun.is_empty())
-        else {
-            return Self::build(scene, params);
+            .filter(|_| !dirs_to_sun.is_empty());
+        let corner_m = params.corner_element_m;
+        if let Some(m) = corner_m {
+            check_positive("corner_element_m", m)?;
+        }
+        let min_element_edge_m = match (shadow_m, corner_m) {
+            (None, None) => return Self::build_refined(scene, params, None),
+            (Some(a), Some(b)) => a.min(b),
+            (Some(a), None) | (None, Some(a)) => a,
         };
+        check_positive("min_element_edge_m", min_element_edge_m)?;
         let own;
         let tracers: &[&SceneTracer] = if occluders.is_empty() {
             own = [SceneTracer::new(scene, BuildQuality::Medium)?];
@@ -265,15 +285,24 @@ impl Mesh {
             occluders
         };
         let split = |v: &[Point3<f64>; 3], n: &Vector3<f64>| {
-            tracers
-                .iter()
-                .any(|t| super::shadow_refinement::crosses_shadow_edge(t, dirs_to_sun, v, n))
+            let edge_m = longest_edge_m(v);
+            let shadow = shadow_m.is_some_and(|m| edge_m > m)
+                && tracers
+                    .iter()
+                    .any(|t| super::shadow_refinement::crosses_shadow_edge(t, dirs_to_sun, v, n));
+            shadow
+                || corner_m.is_some_and(|m| edge_m > m)
+                    && tracers
+                        .iter()
+                        .any(|t| super::corner_refinement::faces_a_surface_nearby(t, v, n))
         };
         let refinement = Refinement {
             min_element_edge_m,
             split: &split,
         };
-        Self::build_refined(scene, params, Some(&refinement))
+        let mut mesh = Self::build_refined(scene, params, Some(&refinement))?;
+        mesh.corner_refined = corner_m.is_some();
+        Ok(mesh)
     }
 
     /// [`Mesh::build`], splitting elements further where `refinement` asks (module doc).
@@ -313,6 +342,7 @@ impl Mesh {
             object_names,
             warnings: Vec::new(),
             geometry_hash: 0,
+            corner_refined: false,
         };
         let name_of = |id: ObjectId| {
             scene

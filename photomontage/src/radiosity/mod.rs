@@ -40,6 +40,7 @@
 pub mod city_block;
 pub mod convergence;
 pub mod convergence_plot;
+pub mod corner_refinement;
 pub mod covered;
 pub mod direct;
 mod element_grid;
@@ -64,6 +65,8 @@ pub mod transfer;
 pub mod transfer_lighting;
 pub mod vertex_gather;
 
+#[cfg(test)]
+mod corner_refinement_tests;
 #[cfg(test)]
 mod form_factor_tests;
 #[cfg(test)]

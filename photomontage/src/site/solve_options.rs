@@ -39,11 +39,14 @@ pub struct SolveOptions {
     pub mean_change: f64,
     /// … and the relative residual is below this.
     pub residual: f64,
+    /// Split elements at concave corners down to this edge, metres
+    /// ([`crate::radiosity::corner_refinement`]); `None`: no corner refinement.
+    pub corner_element_m: Option<f64>,
 }
 
 impl Default for SolveOptions {
     /// 4 m patches, 1 m elements, 4 × 4 form-factor samples, seed 0, the hierarchical
-    /// solver's BF tolerance, sky tolerance 0.1 and the seed's stop rule.
+    /// solver's BF tolerance, sky tolerance 0.1, the seed's stop rule, no corner refinement.
     fn default() -> Self {
         Self {
             patch_edge_m: 4.0,
@@ -55,6 +58,7 @@ impl Default for SolveOptions {
             sky_tolerance: 0.1,
             mean_change: StopRule::default().mean_change,
             residual: StopRule::default().residual,
+            corner_element_m: None,
         }
     }
 }
@@ -87,6 +91,7 @@ impl SolveOptions {
                 max_patch_edge_m: self.patch_edge_m,
                 max_element_edge_m: self.element_edge_m,
                 object_element_edge_m: self.object_element_edge_m.clone(),
+                corner_element_m: self.corner_element_m,
                 ..MeshParams::default()
             },
             form_factors: FormFactorParams {
@@ -132,6 +137,7 @@ mod tests {
             sky_tolerance: 0.2,
             mean_change: 0.02,
             residual: 1e-4,
+            corner_element_m: Some(0.125),
         };
         let t = options.elevation_transfer_params();
         let s = &t.solve;
@@ -140,6 +146,7 @@ mod tests {
             (3.0, 0.5)
         );
         assert_eq!(s.mesh.object_element_edge_m["model:box"], 0.25);
+        assert_eq!(s.mesh.corner_element_m, Some(0.125));
         assert_eq!(
             (s.form_factors.samples_per_axis, s.form_factors.seed),
             (6, 9)

@@ -71,6 +71,11 @@ pub struct SolveArgs {
     /// polygons and models).
     #[arg(long, value_name = "NAME=METRES")]
     pub object_element_edge: Vec<String>,
+    /// Split elements that face another surface closer than their own size (the feet of walls,
+    /// inner corners, under overhangs) down to this edge, metres: irradiance read off the
+    /// elements there follows the fall-off instead of an element's mean (docs/methodology.md).
+    #[arg(long, value_name = "METRES")]
+    pub corner_element_m: Option<f64>,
     /// Form-factor samples per axis (n² per pair).
     #[arg(long, default_value_t = SolveOptions::default().samples_per_axis)]
     pub samples: u32,
@@ -115,6 +120,7 @@ impl SolveArgs {
             sky_tolerance: self.sky_tolerance,
             mean_change: self.mean_change,
             residual: self.residual,
+            corner_element_m: self.corner_element_m,
         })
     }
 
