@@ -1,20 +1,19 @@
-//! The render jobs of the studio's Render panel, as `photomontage render` runs them: the site
-//! prepared by the library (`photomontage::site::render::prepare_view`), the panel's quality
-//! override, the differential tracer (`photomontage::render::DifferentialTracer`, Debevec 1998
-//! differential rendering) driven by `photomontage::render::render_view`, and the AVR0/AVR1
+//! The render jobs of the studio's Render panel, through the entry point `photomontage render`
+//! uses (`photomontage::site::render_photo::RenderPlan`: the panel's quality as the request,
+//! checked as the CLI checks it; the view prepared once and traced per pass), and the AVR0/AVR1
 //! overlays of `photomontage::verified` (LVMF Appendix C). Public so that tests compare the
 //! panel's render with the library's.
 //!
 //! # Known limitations
-//! Spectral mode and the auxiliary EXR layers are not offered (use the CLI).
+//! The auxiliary EXR layers are not offered (use the CLI); spectral mode follows the site's
+//! `render.spectral`, as the CLI's does without `--spectral`.
 
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::ToneCurve;
-use photomontage::render::{
-    DifferentialTracer, RenderError, RenderedImage, TileProgress, render_view,
-};
+use photomontage::render::{RenderError, RenderSettings, RenderedImage, TileProgress};
 use photomontage::site::SiteDocument;
-use photomontage::site::render::{ViewJob, prepare_view};
+use photomontage::site::render::SiteRenderError;
+use photomontage::site::render_photo::{PreparedView, RenderPlan, RenderRequest, SPP_RANGE};
 use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::sync::atomic::AtomicBool;
 
@@ -48,9 +47,9 @@ pub enum RenderPanelError {
     /// The photo has no solved orientation.
     #[error("photo {photo} is not solved yet: press Solve first")]
     NotSolved { photo: String },
-    /// Rays per pixel not a positive multiple of 4 or min above max.
+    /// Rays per pixel not a multiple of 4 in 4–64 (the CLI's range) or min above max.
     #[error(
-        "rays per pixel {spp_min}–{spp_max}: both must be multiples of 4, 4 or more, min ≤ max"
+        "rays per pixel {spp_min}–{spp_max}: both must be multiples of 4 from 4 to 64, min ≤ max"
     )]
     BadQuality { spp_min: u32, spp_max: u32 },
     /// The site could not be prepared (no models, unreadable model, …).
@@ -83,7 +82,7 @@ pub fn site_tone_map(doc: &SiteDocument) -> ToneMap {
 }
 
 /// Renders `photo_id` of `doc` as the panel does (prepare, quality override, trace), calling
-/// `on_tile` per finished tile. Used by the worker; public so that tests can compare.
+/// `on_tile` per finished tile. Public so that tests can compare.
 ///
 /// # Errors
 /// [`RenderPanelError`] variants `NotSolved`, `BadQuality`, `Prepare`, `Render`, `Cancelled`.
@@ -95,11 +94,24 @@ pub fn render_photo(
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderPanelError> {
     let job = prepare_photo(doc, photo_id, quality)?;
-    trace_photo(&job, photo_id, on_tile, cancel)
+    let spp = (quality.spp_min, quality.spp_max);
+    trace_photo(&job, spp, on_tile, cancel)
 }
 
-/// Prepares the render of `photo_id` as the panel does (site → scene, lighting, camera,
-/// linear photo; quality override).
+/// A render of the panel: the library's plan (`photomontage::site::render_photo::RenderPlan`,
+/// the CLI's `render` entry point) with the panel's quality as its request, and the view it
+/// prepared.
+#[derive(Debug)]
+pub struct PhotoJob {
+    /// The checked request.
+    pub plan: RenderPlan,
+    /// The loaded view (its lighting takes the kept transfers' light in the radiosity mode).
+    pub prepared: PreparedView,
+}
+
+/// Prepares the render of `photo_id` as the panel does: the panel's quality as a
+/// [`RenderRequest`] checked by [`RenderPlan::new`] (the CLI's checks), the view loaded by
+/// [`RenderPlan::prepare`], with the AVR2 massing material as its edit.
 ///
 /// # Errors
 /// [`RenderPanelError`] variants `NotSolved`, `BadQuality`, `Prepare`.
@@ -107,8 +119,18 @@ pub fn prepare_photo(
     doc: &SiteDocument,
     photo_id: &str,
     quality: Quality,
-) -> Result<ViewJob, RenderPanelError> {
+) -> Result<PhotoJob, RenderPanelError> {
     let photo = photo_id.to_owned();
+    let Quality {
+        spp_min,
+        spp_max,
+        seed,
+        avr,
+    } = quality;
+    let in_range = |n: u32| SPP_RANGE.contains(&n) && n % 4 == 0;
+    if !in_range(spp_min) || !in_range(spp_max) || spp_min > spp_max {
+        return Err(RenderPanelError::BadQuality { spp_min, spp_max });
+    }
     if !doc
         .site
         .photos
@@ -117,29 +139,27 @@ pub fn prepare_photo(
     {
         return Err(RenderPanelError::NotSolved { photo });
     }
-    let Quality {
-        spp_min,
-        spp_max,
-        seed,
-        avr,
-    } = quality;
-    if spp_min < 4 || spp_min % 4 != 0 || spp_max % 4 != 0 || spp_min > spp_max {
-        return Err(RenderPanelError::BadQuality { spp_min, spp_max });
-    }
-    let mut job = prepare_view(doc, photo_id).map_err(|e| RenderPanelError::Prepare {
+    let prepare_error = |e: &dyn std::fmt::Display| RenderPanelError::Prepare {
         photo: photo.clone(),
         message: e.to_string(),
-    })?;
-    job.settings.min_rays_per_pixel = spp_min;
-    job.settings.max_rays_per_pixel = spp_max;
-    job.settings.seed = seed;
-    if avr == AvrLevel::Avr2 {
-        apply_massing(&mut job.scene.scene).map_err(|e| RenderPanelError::Prepare {
-            photo: photo.clone(),
-            message: e.to_string(),
-        })?;
-    }
-    Ok(job)
+    };
+    let request = RenderRequest {
+        spp_min: Some(spp_min),
+        spp_max: Some(spp_max),
+        seed: Some(seed),
+        ..RenderRequest::view(photo_id)
+    };
+    let plan = RenderPlan::new(doc, &request).map_err(|e| prepare_error(&e))?;
+    let massing = avr == AvrLevel::Avr2;
+    let prepared = plan
+        .prepare(doc, &|scene| {
+            if massing {
+                apply_massing(scene)?;
+            }
+            Ok(())
+        })
+        .map_err(|e| prepare_error(&e))?;
+    Ok(PhotoJob { plan, prepared })
 }
 
 /// AVR0/AVR1: the silhouette or wireline of `photo_id` drawn over the photo.
@@ -159,33 +179,69 @@ pub fn overlay_photo(
         })
 }
 
-/// Traces a prepared job, calling `on_tile` per finished tile.
+/// Traces a prepared job with `spp` = (min, max) rays per pixel ([`RenderPlan::trace`]), calling
+/// `on_tile` per finished tile.
 ///
 /// # Errors
 /// [`RenderPanelError`] variants `Prepare`, `Render`, `Cancelled`.
 pub fn trace_photo(
-    job: &ViewJob,
-    photo_id: &str,
+    job: &PhotoJob,
+    (spp_min, spp_max): (u32, u32),
     on_tile: &(dyn Fn(TileProgress) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderedImage, RenderPanelError> {
-    let photo = photo_id.to_owned();
-    let tracer = DifferentialTracer::new(
-        &job.scene.scene,
-        &job.lighting,
-        &job.camera,
-        &job.photo_linear,
-        job.settings.max_depth,
-    )
-    .map_err(|e| RenderPanelError::Prepare {
-        photo: photo.clone(),
-        message: e.to_string(),
-    })?;
-    render_view(&tracer, &job.settings, on_tile, cancel).map_err(|e| match e {
-        RenderError::Cancelled => RenderPanelError::Cancelled { photo },
-        other => RenderPanelError::Render {
-            photo,
-            message: other.to_string(),
-        },
-    })
+    let photo = job.plan.request.view.clone();
+    let settings = RenderSettings {
+        min_rays_per_pixel: spp_min,
+        max_rays_per_pixel: spp_max,
+        ..job.plan.settings.clone()
+    };
+    job.plan
+        .trace(&job.prepared, &settings, on_tile, cancel)
+        .map(|rendered| rendered.image)
+        .map_err(|e| match e {
+            SiteRenderError::Render(RenderError::Cancelled) => {
+                RenderPanelError::Cancelled { photo }
+            }
+            SiteRenderError::Render(other) => RenderPanelError::Render {
+                photo,
+                message: other.to_string(),
+            },
+            other => RenderPanelError::Prepare {
+                photo,
+                message: other.to_string(),
+            },
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The panel's quality is checked as the CLI checks rays per pixel (multiples of 4 from 4
+    /// to 64, min ≤ max) before anything is loaded; a good quality on an unsolved photo is
+    /// `NotSolved`.
+    #[test]
+    fn quality_is_checked_as_the_cli_checks_it() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../sample_sites/courtyard/site.toml");
+        let doc = SiteDocument::load(&path).expect("sample site");
+        let id = doc.site.photos[0].id.clone();
+        let with = |spp_min, spp_max| Quality {
+            spp_min,
+            spp_max,
+            ..Quality::default()
+        };
+        for (lo, hi) in [(4, 128), (0, 16), (6, 16), (16, 8)] {
+            let e = prepare_photo(&doc, &id, with(lo, hi)).unwrap_err();
+            assert!(
+                matches!(e, RenderPanelError::BadQuality { spp_min, spp_max } if (spp_min, spp_max) == (lo, hi)),
+                "{lo}–{hi}: {e}"
+            );
+        }
+        assert!(matches!(
+            prepare_photo(&doc, &id, with(4, 64)).unwrap_err(),
+            RenderPanelError::NotSolved { .. }
+        ));
+    }
 }

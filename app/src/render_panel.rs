@@ -28,6 +28,7 @@ use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::ToneCurve;
 use photomontage::render::{OutputLayers, RenderedImage, TileProgress};
 use photomontage::site::SiteDocument;
+use photomontage::site::render_photo::SPP_RANGE;
 use photomontage::verified::image_metadata::{view_metadata, write_render};
 use photomontage::verified::standard_view::StandardView;
 use photomontage::verified::{AvrLevel, PaperSize, ViewGeometry, ViewMetadata};
@@ -158,12 +159,14 @@ fn render_job(
         return overlay_photo(doc, id, quality.avr).map(|image| (image, None));
     }
     let mut job = prepare_photo(doc, id, quality)?;
-    let photo = &job.photo_linear;
+    let photo = &job.prepared.job.photo_linear;
     progress.send(RenderUpdate::Photo {
         size_px: [photo.width(), photo.height()],
         image: display_photo(photo, &tone_map),
     });
-    options.prepare_radiosity(doc, id, &mut job, progress)?;
+    if job.plan.radiosity && !job.prepared.photo_only {
+        options.prepare_radiosity(doc, id, &mut job.prepared.job, progress)?;
+    }
     let tiles = progress.clone();
     let on_tile = move |t: TileProgress| tiles.send(RenderUpdate::Tile(t));
     let passes = live::passes(options, quality);
@@ -171,9 +174,12 @@ fn render_job(
     let mut last = None;
     for (index, (spp_min, spp_max)) in (1..).zip(passes) {
         progress.send(RenderUpdate::Pass { index, count });
-        job.settings.min_rays_per_pixel = spp_min;
-        job.settings.max_rays_per_pixel = spp_max;
-        last = Some(trace_photo(&job, id, &on_tile, progress.cancel_flag())?);
+        last = Some(trace_photo(
+            &job,
+            (spp_min, spp_max),
+            &on_tile,
+            progress.cancel_flag(),
+        )?);
     }
     last.map(|image| (image, None))
         .ok_or_else(|| RenderPanelError::Render {
@@ -540,14 +546,14 @@ impl Panel for RenderPanel {
         ui.horizontal(|ui| {
             let r = ui.add(
                 egui::DragValue::new(&mut q.spp_min)
-                    .range(4..=1024)
+                    .range(SPP_RANGE)
                     .speed(0.2),
             );
             name_widget(ui, &r, "spp min");
             ui.label("–");
             let r = ui.add(
                 egui::DragValue::new(&mut q.spp_max)
-                    .range(4..=1024)
+                    .range(SPP_RANGE)
                     .speed(0.2),
             );
             name_widget(ui, &r, "spp max");

@@ -297,43 +297,91 @@ impl RenderPlan {
         on_tile: &(dyn Fn(TileProgress) + Sync),
         cancel: &AtomicBool,
     ) -> Result<RenderedPhoto, SiteRenderError> {
+        let mut prepared = self.prepare(doc, edit)?;
+        let radiosity = self.solve_radiosity(doc, &mut prepared, cancel)?;
+        let mut rendered = self.trace(&prepared, &self.settings, on_tile, cancel)?;
+        rendered.radiosity = radiosity;
+        Ok(rendered)
+    }
+
+    /// The first step of [`RenderPlan::render_edited`]: the view loaded (scene, lights, camera,
+    /// photo) and `edit` applied to its scene. The studio prepares once and traces its passes
+    /// (a coarse one, then the full one) from the same preparation.
+    ///
+    /// # Errors
+    /// Any error of [`prepare_view`], and the edit's [`SceneError`].
+    pub fn prepare(
+        &self,
+        doc: &SiteDocument,
+        edit: &dyn Fn(&mut Scene) -> Result<(), SceneError>,
+    ) -> Result<PreparedView, SiteRenderError> {
         let mut job = prepare_view(doc, &self.request.view)?;
         edit(&mut job.scene.scene)?;
-        if job
+        // Only a design variant gets here without a model (prepare_view refuses the site
+        // itself): nothing is added, the band is the photo.
+        let photo_only = job
             .scene
             .object_sources
             .iter()
             .all(|s| !matches!(s, ObjectSource::Model(_)))
-            && self.request.layers.is_empty()
-        {
-            // Only a design variant gets here without a model (prepare_view refuses the
-            // site itself): nothing is added, the band is the photo.
-            return Ok(self.photo_band(&job));
+            && self.request.layers.is_empty();
+        Ok(PreparedView { job, photo_only })
+    }
+
+    /// In the radiosity mode, solves the site's radiosity for the prepared scene and hands it
+    /// to its lighting ([`super::render_radiosity::site_radiosity_arc`]); the report, or `None`
+    /// when the mode is off or nothing is added. The studio hands its kept transfers' light
+    /// instead ([`super::live_relight`]).
+    ///
+    /// # Errors
+    /// A solve error as [`SiteRenderError::Request`], [`SiteRenderError::Render`] when cancelled.
+    pub fn solve_radiosity(
+        &self,
+        doc: &SiteDocument,
+        prepared: &mut PreparedView,
+        cancel: &AtomicBool,
+    ) -> Result<Option<super::render_radiosity::RadiosityReport>, SiteRenderError> {
+        if !self.radiosity || prepared.photo_only {
+            return Ok(None);
         }
-        let radiosity = if self.radiosity {
-            let (light, report) = super::render_radiosity::site_radiosity_arc(
-                doc,
-                &job.scene.scene,
-                &self.request.view,
-                cancel,
-            )?;
-            job.lighting.radiosity = Some(light);
-            Some(report)
-        } else {
-            None
-        };
+        let (light, report) = super::render_radiosity::site_radiosity_arc(
+            doc,
+            &prepared.job.scene.scene,
+            &self.request.view,
+            cancel,
+        )?;
+        prepared.job.lighting.radiosity = Some(light);
+        Ok(Some(report))
+    }
+
+    /// Traces the plan's band of a prepared view with `settings` (the plan's, or the same with
+    /// other rays per pixel for a coarse pass; the seed and tiles are the caller's to keep).
+    ///
+    /// # Errors
+    /// [`SiteRenderError::Render`] (a cancelled render included), a tracer error.
+    pub fn trace(
+        &self,
+        prepared: &PreparedView,
+        settings: &RenderSettings,
+        on_tile: &(dyn Fn(TileProgress) + Sync),
+        cancel: &AtomicBool,
+    ) -> Result<RenderedPhoto, SiteRenderError> {
+        let job = &prepared.job;
+        if prepared.photo_only {
+            return Ok(self.photo_band(job));
+        }
         let tracer = DifferentialTracer::new(
             &job.scene.scene,
             &job.lighting,
             &job.camera,
             &job.photo_linear,
-            self.settings.max_depth,
+            settings.max_depth,
         )?;
         let band = self.request.band;
         let (image, layers) = if self.spectral {
             let image = render_band_spectral(
                 &tracer,
-                &self.settings,
+                settings,
                 SampleSet::Durisch9,
                 band,
                 on_tile,
@@ -343,7 +391,7 @@ impl RenderPlan {
         } else {
             render_band_with_layers(
                 &tracer,
-                &self.settings,
+                settings,
                 self.request.layers,
                 band,
                 on_tile,
@@ -364,7 +412,7 @@ impl RenderPlan {
                 .collect(),
             sun_dir_in_world: job.sun_dir_in_world,
             warnings,
-            radiosity,
+            radiosity: None,
         })
     }
 
@@ -388,6 +436,16 @@ impl RenderPlan {
             view_json: None,
         }
     }
+}
+
+/// A view loaded for a plan ([`RenderPlan::prepare`]): the scene with the plan's edit applied,
+/// lights, camera and photo.
+#[derive(Debug)]
+pub struct PreparedView {
+    /// The loaded view; its lighting takes the radiosity light in the radiosity mode.
+    pub job: super::render::ViewJob,
+    /// Nothing is added (a design variant without models): the band is the photo.
+    pub photo_only: bool,
 }
 
 /// A rendered view or band.
