@@ -33,6 +33,7 @@ pub mod daylight;
 pub mod interreflection;
 pub mod natural_scene;
 pub mod pick;
+pub mod radiosity_interreflection;
 pub mod report;
 pub mod site;
 pub mod sun_check;

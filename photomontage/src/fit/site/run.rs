@@ -1,10 +1,12 @@
 //! The fits proper on the located samples (Durisch 1992 §4.2–4.3): the horizon colour L∞ from
 //! the `[[horizon_samples]]`, the atmosphere (eq. 7) and the daylight weights (eq. 9), repeated
-//! with the gathered interreflection until the weights settle, the sun/shadow cross-checks
+//! with the gathered interreflection (in the radiosity mode: read off the photographed state's
+//! radiosity solution) until the weights settle, the sun/shadow cross-checks
 //! against the SPA, and the check that a fit's samples share one material.
 
 use std::collections::HashMap;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use nalgebra::{Point3, Vector3};
 
@@ -20,6 +22,7 @@ use crate::fit::interreflection::{
     GatherPoint, INTERREFLECTION_MAX_PASSES, INTERREFLECTION_SETTLED_REL, gather_interreflection,
     scene_with_probe, weights_settled,
 };
+use crate::fit::radiosity_interreflection::RadiosityInterreflection;
 use crate::fit::report::{FitResidual, NamedSunCheck, SampleReading, SiteFitReport};
 use crate::fit::sun_check::check_sun;
 use crate::scene::{Material, MaterialLibrary, Scene, SceneTracer};
@@ -293,7 +296,7 @@ pub(super) fn run_fits(
         let mut gather_doc = doc.clone();
         gather_doc.site.lighting.atmosphere.extinction_per_m = extinction_per_m;
         gather_doc.site.lighting.atmosphere.horizon_colour = horizon_colour;
-        let probe_scene = if gather {
+        let probe_scene = if gather && !doc.site.render.radiosity {
             Some(
                 scene_with_probe(scene)
                     .map_err(|e| SiteFitError::Interreflection(e.to_string()))?,
@@ -301,12 +304,46 @@ pub(super) fn run_fits(
         } else {
             None
         };
+        // In the radiosity mode E_r comes from the photographed state's radiosity solution,
+        // solved once with the first pass's weights (that pass fits without E_r) and relit to
+        // each later pass's (`fit::radiosity_interreflection`).
+        let radiosity = gather && doc.site.render.radiosity;
+        let mut solved: Option<RadiosityInterreflection> = None;
         let mut previous: Option<DaylightFit> = None;
         let mut passes = 0_usize;
         let fit = loop {
             check_cancel(observer.as_ref())?;
             passes += 1;
-            if let Some(probe_scene) = &probe_scene {
+            if radiosity {
+                if passes > 1 {
+                    let points: Vec<GatherPoint<'_>> = day_samples
+                        .iter()
+                        .map(|s| GatherPoint {
+                            photo: &s.photo,
+                            point_in_world_m: s.point,
+                            normal_in_world: s.normal,
+                        })
+                        .collect();
+                    let interreflection = match &mut solved {
+                        Some(r) => r,
+                        None => solved.insert(
+                            RadiosityInterreflection::build(
+                                &gather_doc,
+                                scene,
+                                &points,
+                                &AtomicBool::new(false),
+                            )
+                            .map_err(|e| SiteFitError::Interreflection(e.to_string()))?,
+                        ),
+                    };
+                    let e_r = interreflection
+                        .at(&gather_doc)
+                        .map_err(|e| SiteFitError::Interreflection(e.to_string()))?;
+                    for (s, e) in samples.iter_mut().zip(e_r) {
+                        s.interreflection_rgb = e;
+                    }
+                }
+            } else if let Some(probe_scene) = &probe_scene {
                 let points: Vec<GatherPoint<'_>> = day_samples
                     .iter()
                     .map(|s| GatherPoint {
