@@ -127,7 +127,7 @@ pub fn prepare_photo(
         seed,
         avr,
     } = quality;
-    let in_range = |n: u32| SPP_RANGE.contains(&n) && n % 4 == 0;
+    let in_range = |n: u32| SPP_RANGE.contains(&n) && n.is_multiple_of(4);
     if !in_range(spp_min) || !in_range(spp_max) || spp_min > spp_max {
         return Err(RenderPanelError::BadQuality { spp_min, spp_max });
     }
@@ -194,7 +194,7 @@ pub fn trace_photo(
     let settings = RenderSettings {
         min_rays_per_pixel: spp_min,
         max_rays_per_pixel: spp_max,
-        ..job.plan.settings.clone()
+        ..job.plan.settings
     };
     job.plan
         .trace(&job.prepared, &settings, on_tile, cancel)

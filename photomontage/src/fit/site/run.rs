@@ -308,6 +308,14 @@ pub(super) fn run_fits(
         // solved once with the first pass's weights (that pass fits without E_r) and relit to
         // each later pass's (`fit::radiosity_interreflection`).
         let radiosity = gather && doc.site.render.radiosity;
+        let points: Vec<GatherPoint<'_>> = day_samples
+            .iter()
+            .map(|s| GatherPoint {
+                photo: &s.photo,
+                point_in_world_m: s.point,
+                normal_in_world: s.normal,
+            })
+            .collect();
         let mut solved: Option<RadiosityInterreflection> = None;
         let mut previous: Option<DaylightFit> = None;
         let mut passes = 0_usize;
@@ -316,14 +324,6 @@ pub(super) fn run_fits(
             passes += 1;
             if radiosity {
                 if passes > 1 {
-                    let points: Vec<GatherPoint<'_>> = day_samples
-                        .iter()
-                        .map(|s| GatherPoint {
-                            photo: &s.photo,
-                            point_in_world_m: s.point,
-                            normal_in_world: s.normal,
-                        })
-                        .collect();
                     let interreflection = match &mut solved {
                         Some(r) => r,
                         None => solved.insert(
@@ -344,14 +344,6 @@ pub(super) fn run_fits(
                     }
                 }
             } else if let Some(probe_scene) = &probe_scene {
-                let points: Vec<GatherPoint<'_>> = day_samples
-                    .iter()
-                    .map(|s| GatherPoint {
-                        photo: &s.photo,
-                        point_in_world_m: s.point,
-                        normal_in_world: s.normal,
-                    })
-                    .collect();
                 let e_r = gather_interreflection(
                     &gather_doc,
                     probe_scene,
