@@ -18,15 +18,14 @@
 //! The links are refined for the lighting of the build (the weights of the fit's first pass,
 //! which fits without E_r); on the synthetic test site the weights are recovered to 1e-3 all the
 //! same. A sample on a face the mesh has from the other side only is gathered
-//! ([`FALLBACK_GATHER_RAYS`]), with Monte Carlo noise. The ambient weight has no radiosity counterpart (as in the renderer's radiosity mode) and
-//! contributes no interreflection.
+//! ([`FALLBACK_GATHER_RAYS`]), with Monte Carlo noise. The ambient weight has no radiosity
+//! counterpart (as in the renderer's radiosity mode) and contributes no interreflection.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use nalgebra::{Point3, Vector3};
-
-use std::sync::Arc;
 
 use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
 use crate::radiosity::{
@@ -83,34 +82,14 @@ impl RadiosityInterreflection {
         for (i, p) in points.iter().enumerate() {
             by_photo.entry(p.photo.to_owned()).or_default().push(i);
         }
-        let mut out = Self {
-            photos: BTreeMap::new(),
-            points: points
-                .iter()
-                .map(|p| (p.point_in_world_m, p.normal_in_world))
-                .collect(),
-            natural: natural.clone(),
-        };
-        out.solve(doc, by_photo, cancel)?;
-        Ok(out)
-    }
-
-    /// Builds the transfer of every photo of `by_photo` for `doc`'s lighting.
-    fn solve(
-        &mut self,
-        doc: &SiteDocument,
-        by_photo: BTreeMap<String, Vec<usize>>,
-        cancel: &AtomicBool,
-    ) -> Result<(), InterreflectionError> {
         let doc = photographed(doc);
-        let natural = &self.natural;
         let (solve, _) = site_solve_params(&doc, natural).map_err(|e| lighting_error("*", &e))?;
         let params = TransferParams {
             solve,
             sky_tolerance: SKY_TOLERANCE,
             ..TransferParams::default()
         };
-        self.photos.clear();
+        let mut photos = BTreeMap::new();
         for (photo, indices) in by_photo {
             let (lighting, _) = site_transfer_lighting(&doc, natural, &photo)
                 .map_err(|e| lighting_error(&photo, &e))?;
@@ -119,10 +98,16 @@ impl RadiosityInterreflection {
             let gather =
                 VertexGather::new(Arc::clone(&transfer.solution().mesh), DEFAULT_RAYS_PER_AXIS)
                     .map_err(|e| lighting_error(&photo, &e))?;
-            self.photos
-                .insert(photo, (transfer, Arc::new(gather), indices));
+            photos.insert(photo, (transfer, Arc::new(gather), indices));
         }
-        Ok(())
+        Ok(Self {
+            photos,
+            points: points
+                .iter()
+                .map(|p| (p.point_in_world_m, p.normal_in_world))
+                .collect(),
+            natural: natural.clone(),
+        })
     }
 
     /// E_r (linear RGB, photo units) at every point, with the sun and sky weights of `doc`: each

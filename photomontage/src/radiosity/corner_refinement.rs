@@ -27,6 +27,7 @@
 
 use nalgebra::{Point3, Vector3};
 
+use super::mesh::longest_edge_m;
 use super::shadow_refinement::{CORNER_INSET, SURFACE_OFFSET_M};
 use crate::scene::SceneTracer;
 
@@ -45,9 +46,7 @@ pub fn faces_a_surface_nearby(
     v: &[Point3<f64>; 3],
     normal: &Vector3<f64>,
 ) -> bool {
-    let reach_m = (0..3)
-        .map(|i| (v[(i + 1) % 3] - v[i]).norm())
-        .fold(0.0, f64::max);
+    let reach_m = longest_edge_m(v);
     let centroid = Point3::from((v[0].coords + v[1].coords + v[2].coords) / 3.0);
     let points = [
         centroid,

@@ -11,7 +11,7 @@ use std::sync::atomic::AtomicBool;
 use nalgebra::{Point3, Vector3};
 
 use super::hierarchical::HierarchicalParams;
-use super::mesh::{Mesh, MeshParams};
+use super::mesh::{Mesh, MeshParams, longest_edge_m};
 use super::{LightGroup, SolveParams, Solver, solve, test_scenes};
 use crate::scene::Scene;
 

@@ -15,6 +15,10 @@
 //! replaced by links to the children of the larger node (one level per pass); F_rs there is the
 //! larger of the link's factor and its unoccluded centroid estimate, so that a link whose few
 //! samples were all shadowed is still refined where its children may see each other. The links are
+//! refined with the sum of all light groups (the [`Hierarchy`] is geometry plus the lighting it
+//! was refined for); every group is then solved on the same links, so group solutions add up
+//! exactly to the solution of the summed sources.
+//!
 //! On a mesh refined at corners ([`super::MeshParams::corner_element_m`]) the test takes the
 //! largest unoccluded point factor over the receiver (its centroid and corners,
 //! [`FormFactorEngine::largest_estimate`]) instead of the centroid's: next to a contact (a
@@ -24,10 +28,7 @@
 //! corner elements came out up to +30 % (1–2 cm from the foot) and +8 % (5 cm) with the
 //! centroid test, +5 % at 5 cm with this one; it costs ~20 % more links on the Cornell box and
 //! the courtyard, which is why meshes without corner refinement (whose leaves near a contact are
-//! large enough to average the error away) keep the centroid test. The links are
-//! refined with the sum of all light groups (the [`Hierarchy`] is geometry plus the lighting it
-//! was refined for); every group is then solved on the same links, so group solutions add up
-//! exactly to the solution of the summed sources.
+//! large enough to average the error away) keep the centroid test.
 //!
 //! When refinement is over, links whose factor is exactly 0 (all samples occluded) are dropped:
 //! they add nothing to any later gather.

@@ -194,7 +194,8 @@ pub struct Mesh {
     pub corner_refined: bool,
 }
 
-fn longest_edge_m(v: &[Point3<f64>; 3]) -> f64 {
+/// Longest edge of the triangle `v`, metres.
+pub(crate) fn longest_edge_m(v: &[Point3<f64>; 3]) -> f64 {
     (v[1] - v[0])
         .norm()
         .max((v[2] - v[1]).norm())
@@ -276,7 +277,6 @@ impl Mesh {
             (Some(a), Some(b)) => a.min(b),
             (Some(a), None) | (None, Some(a)) => a,
         };
-        check_positive("min_element_edge_m", min_element_edge_m)?;
         let own;
         let tracers: &[&SceneTracer] = if occluders.is_empty() {
             own = [SceneTracer::new(scene, BuildQuality::Medium)?];
