@@ -42,10 +42,7 @@ fn element_edge_at(mesh: &Mesh, x: f64) -> f64 {
             n.normal_in_world.z > 0.5 && inside(&n.vertices_in_world_m, &probe)
         })
         .unwrap();
-    let v = mesh.element_node(e).vertices_in_world_m;
-    (0..3)
-        .map(|i| (v[(i + 1) % 3] - v[i]).norm())
-        .fold(0.0, f64::max)
+    longest_edge_m(&mesh.element_node(e).vertices_in_world_m)
 }
 
 /// Whether `p` lies in the triangle `v` in plan.
@@ -92,12 +89,7 @@ fn elements_are_split_at_the_wall_foot_in_front_only() {
             .map(|e| mesh.element_node(e))
             .filter(|n| n.normal_in_world.x > 0.5)
             .filter(|n| z.contains(&n.centroid_in_world_m().z))
-            .map(|n| {
-                let v = n.vertices_in_world_m;
-                (0..3)
-                    .map(|i| (v[(i + 1) % 3] - v[i]).norm())
-                    .fold(0.0, f64::max)
-            })
+            .map(|n| longest_edge_m(&n.vertices_in_world_m))
             .fold(f64::INFINITY, f64::min)
     };
     assert!(wall_edges(&refined, 0.0..0.05) <= CORNER_M + 1e-9);
