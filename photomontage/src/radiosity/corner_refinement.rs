@@ -27,7 +27,6 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::mesh::longest_edge_m;
 use super::shadow_refinement::{CORNER_INSET, SURFACE_OFFSET_M};
 use crate::scene::SceneTracer;
 
@@ -39,14 +38,15 @@ pub const PROBE_AZIMUTHS: usize = 8;
 pub const PROBE_ELEVATION_DEG: f64 = 20.0;
 
 /// Whether a surface of `tracer` lies in front of the node `v` (unit normal `normal`) closer than
-/// the node's longest edge (module doc).
+/// `reach_m`, the node's longest edge (module doc; the mesher passes the edge it has measured, so
+/// this module needs nothing of the mesh).
 #[must_use]
 pub fn faces_a_surface_nearby(
     tracer: &SceneTracer,
     v: &[Point3<f64>; 3],
     normal: &Vector3<f64>,
+    reach_m: f64,
 ) -> bool {
-    let reach_m = longest_edge_m(v);
     let centroid = Point3::from((v[0].coords + v[1].coords + v[2].coords) / 3.0);
     let points = [
         centroid,

@@ -294,7 +294,7 @@ impl Mesh {
                 || corner_m.is_some_and(|m| edge_m > m)
                     && tracers
                         .iter()
-                        .any(|t| super::corner_refinement::faces_a_surface_nearby(t, v, n))
+                        .any(|t| super::corner_refinement::faces_a_surface_nearby(t, v, n, edge_m))
         };
         let refinement = Refinement {
             min_element_edge_m,
