@@ -69,9 +69,7 @@ pub fn solve(
     let mesh = engine.mesh();
     let n = mesh.elements.len();
     let areas: Vec<f64> = (0..n).map(|e| mesh.element_node(e).area_m2).collect();
-    let rho: Vec<Rgb> = (0..n)
-        .map(|e| mesh.reflectance_rgb(mesh.elements[e] as usize))
-        .collect();
+    let rho: Vec<Rgb> = (0..n).map(|e| mesh.element_reflectance_rgb(e)).collect();
     let mut b = b0.to_vec();
     let mut rows = Vec::new();
     let mut previous_mean = None;

@@ -498,7 +498,7 @@ fn push_pull(
     let g: Rgb = std::array::from_fn(|c| down[c] + gathered[n as usize][c]);
     let value = match (node.children, node.element) {
         (None, Some(e)) => {
-            let rho = mesh.surfaces[node.surface as usize].reflectance_rgb;
+            let rho = mesh.reflectance_rgb(n as usize);
             let v: Rgb = std::array::from_fn(|c| b0[e as usize][c] + rho[c] * g[c]);
             let old = old_b[n as usize];
             let diff: Rgb = std::array::from_fn(|c| (v[c] - old[c]).abs());

@@ -192,6 +192,9 @@ pub struct Mesh {
     /// hierarchical solver then judges links by their largest point factor
     /// ([`super::form_factor::FormFactorEngine::largest_estimate`]).
     pub corner_refined: bool,
+    /// Diffuse reflectance per node where it is not its surface's (ρ_d recovered from a photo,
+    /// [`super::element_reflectance`]), indexed by node; `None` when no node has one.
+    pub node_reflectance_rgb: Option<Arc<Vec<Option<Rgb>>>>,
 }
 
 /// Longest edge of the triangle `v`, metres.
@@ -343,6 +346,7 @@ impl Mesh {
             warnings: Vec::new(),
             geometry_hash: 0,
             corner_refined: false,
+            node_reflectance_rgb: None,
         };
         let name_of = |id: ObjectId| {
             scene
@@ -528,10 +532,20 @@ impl Mesh {
         &self.nodes[self.elements[e] as usize]
     }
 
-    /// Reflectance of node `n`.
+    /// Reflectance of node `n`: its own where one was set
+    /// ([`Mesh::set_element_reflectances`]), else its surface's.
     #[must_use]
     pub fn reflectance_rgb(&self, n: usize) -> Rgb {
-        self.surfaces[self.nodes[n].surface as usize].reflectance_rgb
+        self.node_reflectance_rgb
+            .as_ref()
+            .and_then(|r| r[n])
+            .unwrap_or(self.surfaces[self.nodes[n].surface as usize].reflectance_rgb)
+    }
+
+    /// Reflectance of element `e` ([`Mesh::reflectance_rgb`] of its node).
+    #[must_use]
+    pub fn element_reflectance_rgb(&self, e: usize) -> Rgb {
+        self.reflectance_rgb(self.elements[e] as usize)
     }
 
     /// The name of the object node `n` belongs to.

@@ -44,6 +44,7 @@ pub mod corner_refinement;
 pub mod covered;
 pub mod direct;
 mod element_grid;
+pub mod element_reflectance;
 pub mod form_factor;
 #[cfg(target_arch = "x86_64")]
 mod gather_avx2;
@@ -87,8 +88,8 @@ pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning, Refinement};
 pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
 pub use solve::{
-    GroupSolution, LightGroup, RadiosityDifference, SkyLight, Solution, SolveParams, Solver, solve,
-    solve_on_mesh, sun_directions,
+    GroupSolution, LightGroup, RadiosityDifference, Refit, SkyLight, Solution, SolveParams, Solver,
+    solve, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
 };
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 pub use transfer::{
@@ -155,6 +156,16 @@ pub enum RadiosityError {
     UnknownMaterial {
         /// The name given.
         material: String,
+    },
+    /// A per-element reflectance ([`Mesh::set_element_reflectances`]) that is unusable.
+    #[error("element {element} (object `{object}`): reflectance {reason}")]
+    ElementReflectance {
+        /// Element index.
+        element: usize,
+        /// Its object's name.
+        object: String,
+        /// What is wrong.
+        reason: String,
     },
     /// A light source with a non-finite or negative value.
     #[error("light group `{group}`: {reason}")]

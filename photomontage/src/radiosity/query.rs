@@ -143,12 +143,7 @@ impl ElementLocator {
         let grid = ElementGrid::new(mesh, GRID_PAD_M);
         let radiosity = solution.total_radiosity_rgb();
         let reflects = (0..n)
-            .map(|e| {
-                mesh.surfaces[mesh.element_node(e).surface as usize]
-                    .reflectance_rgb
-                    .iter()
-                    .any(|&r| r > 0.0)
-            })
+            .map(|e| mesh.element_reflectance_rgb(e).iter().any(|&r| r > 0.0))
             .collect();
         Self {
             grid,

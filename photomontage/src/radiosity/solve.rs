@@ -162,8 +162,9 @@ impl GroupSolution {
         (0..mesh.elements.len())
             .map(|e| {
                 let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+                let reflectance = mesh.element_reflectance_rgb(e);
                 std::array::from_fn(|c| {
-                    let rho = surface.reflectance_rgb[c];
+                    let rho = reflectance[c];
                     let emitted = if include_emission {
                         surface.emission_rgb[c]
                     } else {
@@ -265,10 +266,9 @@ impl Solution {
                 let radiosity_rgb = (0..mesh.elements.len())
                     .into_par_iter()
                     .map(|e| {
-                        let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+                        let rho = mesh.element_reflectance_rgb(e);
                         std::array::from_fn(|c| {
-                            g.radiosity_rgb[e][c]
-                                - surface.reflectance_rgb[c] * g.direct_irradiance_rgb[e][c]
+                            g.radiosity_rgb[e][c] - rho[c] * g.direct_irradiance_rgb[e][c]
                         })
                     })
                     .collect();
@@ -344,13 +344,56 @@ pub fn solve(
 /// # Errors
 /// As [`solve`].
 pub fn solve_on_mesh(
-    mut mesh: Mesh,
+    mesh: Mesh,
     tracer: &SceneTracer,
     groups: &[LightGroup],
     params: &SolveParams,
     cancel: &AtomicBool,
     on_pass: &dyn Fn(&ConvergenceRow),
 ) -> Result<Solution, RadiosityError> {
+    solve_on_mesh_refitting(
+        mesh,
+        tracer,
+        groups,
+        params,
+        cancel,
+        on_pass,
+        &mut |_| None,
+        0,
+    )
+}
+
+/// Per-element reflectances from a solution ([`solve_on_mesh_refitting`]): `None` to stop,
+/// else one entry per element (`None` where an element keeps its surface's ρ).
+pub type Refit<'a> = dyn FnMut(&Solution) -> Option<Vec<Option<Rgb>>> + 'a;
+
+/// [`solve_on_mesh`], then up to `rounds` times: `refit` reads the solution and returns
+/// per-element reflectances ([`Mesh::set_element_reflectances`]), and every group is solved
+/// again on the same links (the hierarchical solver's links are refined once, for the first
+/// reflectances). The site's photo reflectances use it: ρ_d = π·L₀/E needs E, which depends on
+/// the ρ_d of the surroundings (`site::photo_reflectance`).
+///
+/// # Errors
+/// As [`solve`]; [`RadiosityError::InvalidParameter`] for `rounds` > 0 with a solver other than
+/// the hierarchical one; [`RadiosityError::ElementReflectance`] for a refit value out of range.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_on_mesh_refitting(
+    mut mesh: Mesh,
+    tracer: &SceneTracer,
+    groups: &[LightGroup],
+    params: &SolveParams,
+    cancel: &AtomicBool,
+    on_pass: &dyn Fn(&ConvergenceRow),
+    refit: &mut Refit<'_>,
+    rounds: usize,
+) -> Result<Solution, RadiosityError> {
+    if rounds > 0 && !matches!(params.solver, Solver::Hierarchical(_)) {
+        return Err(RadiosityError::InvalidParameter {
+            name: "refit rounds",
+            value: rounds as f64,
+            reason: "reflectances refitted from a solution need the hierarchical solver",
+        });
+    }
     if params.form_factors.visibility {
         super::covered::mark_covered(&mut mesh, tracer, &params.form_factors);
     }
@@ -374,6 +417,7 @@ pub fn solve_on_mesh(
     let mut refinement = Vec::new();
     let mut solved = Vec::with_capacity(groups.len());
     let interactions;
+    let mut hierarchy = None;
     match params.solver {
         Solver::Progressive => {
             let mut cache = RowCache::new(n, params.row_cache_entries);
@@ -399,19 +443,13 @@ pub fn solve_on_mesh(
                     }
                 }
             }
-            let hierarchy = Hierarchy::build(&engine, &h, &b0_all, &params.stop, cancel, on_pass)?;
+            let built = Hierarchy::build(&engine, &h, &b0_all, &params.stop, cancel, on_pass)?;
             for (group, b0) in groups.iter().zip(&b0s) {
-                solved.push(hierarchy.solve(
-                    &mesh,
-                    b0,
-                    &group.name,
-                    &params.stop,
-                    cancel,
-                    on_pass,
-                )?);
+                solved.push(built.solve(&mesh, b0, &group.name, &params.stop, cancel, on_pass)?);
             }
-            interactions = hierarchy.links.len() as u64;
-            refinement = hierarchy.refinement;
+            interactions = built.links.len() as u64;
+            refinement.clone_from(&built.refinement);
+            hierarchy = Some(built);
         }
         Solver::Direct => {
             let matrix = direct::element_matrix(&engine, cancel)?;
@@ -428,27 +466,41 @@ pub fn solve_on_mesh(
             interactions = matrix.len() as u64;
         }
     }
-    let groups = groups
-        .iter()
-        .zip(directs)
-        .zip(solved)
-        .map(
-            |((group, direct), (radiosity, convergence))| GroupSolution {
-                name: group.name.clone(),
-                direct_irradiance_rgb: direct,
-                radiosity_rgb: radiosity,
-                convergence,
-            },
-        )
-        .collect();
-    Ok(Solution {
+    let assemble = |mesh: Mesh, solved: Vec<(Vec<Rgb>, Vec<ConvergenceRow>)>| Solution {
         mesh: Arc::new(mesh),
-        groups,
+        groups: groups
+            .iter()
+            .zip(&directs)
+            .zip(solved)
+            .map(
+                |((group, direct), (radiosity, convergence))| GroupSolution {
+                    name: group.name.clone(),
+                    direct_irradiance_rgb: direct.clone(),
+                    radiosity_rgb: radiosity,
+                    convergence,
+                },
+            )
+            .collect(),
         interactions,
-        refinement,
-        warnings,
+        refinement: refinement.clone(),
+        warnings: warnings.clone(),
         locator: std::sync::OnceLock::new(),
-    })
+    };
+    let mut solution = assemble(mesh, solved);
+    for _ in 0..rounds {
+        let (Some(rho), Some(hierarchy)) = (refit(&solution), hierarchy.as_ref()) else {
+            break;
+        };
+        let mut mesh = Arc::unwrap_or_clone(solution.mesh);
+        mesh.set_element_reflectances(&rho)?;
+        let mut solved = Vec::with_capacity(groups.len());
+        for (group, direct) in groups.iter().zip(&directs) {
+            let b0 = initial_exitance(&mesh, direct, group.emission);
+            solved.push(hierarchy.solve(&mesh, &b0, &group.name, &params.stop, cancel, on_pass)?);
+        }
+        solution = assemble(mesh, solved);
+    }
+    Ok(solution)
 }
 
 /// The ground below the horizon, ready to apply: its unit-radiance transfer per element.
@@ -567,13 +619,14 @@ pub(crate) fn initial_exitance(mesh: &Mesh, direct: &[Rgb], emission: bool) -> V
         .into_par_iter()
         .map(|e| {
             let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+            let rho = mesh.element_reflectance_rgb(e);
             std::array::from_fn(|c| {
                 let emitted = if emission {
                     surface.emission_rgb[c]
                 } else {
                     0.0
                 };
-                surface.reflectance_rgb[c] * direct[e][c] + emitted
+                rho[c] * direct[e][c] + emitted
             })
         })
         .collect()

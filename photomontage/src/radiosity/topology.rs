@@ -20,8 +20,6 @@ pub(super) struct Topology {
     pub(super) element: Vec<Option<u32>>,
     /// Per node, its children.
     pub(super) children: Vec<Option<[u32; 4]>>,
-    /// Per element, its mesh surface.
-    pub(super) element_surface: Vec<u32>,
     /// Per patch, its elements' range: the mesh numbers elements depth first, so each patch's
     /// elements are contiguous and the patches' ranges follow one another in patch order.
     pub(super) patch_elements: Vec<(usize, usize)>,
@@ -90,9 +88,6 @@ impl Topology {
             areas,
             element: mesh.nodes.iter().map(|node| node.element).collect(),
             children: mesh.nodes.iter().map(|node| node.children).collect(),
-            element_surface: (0..mesh.elements.len())
-                .map(|e| mesh.element_node(e).surface)
-                .collect(),
             patch_elements,
         }
     }

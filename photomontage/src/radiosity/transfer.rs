@@ -489,7 +489,34 @@ impl Transfer {
     /// # Errors
     /// As [`Self::relight`]; on error nothing changes.
     pub fn relight_in_place(&mut self, change: &LightingChange) -> Result<(), RadiosityError> {
+        self.relight_with(change, None)
+    }
+
+    /// Sets ρ_d per element (`None`: the surface's own; [`Mesh::set_element_reflectances`], the
+    /// site's photo reflectances) and iterates every group again on the stored links, as a
+    /// material change does; the lighting stays.
+    ///
+    /// # Errors
+    /// [`RadiosityError::ElementReflectance`] for a wrong length or a value out of [0, 1]; on
+    /// error nothing changes.
+    pub fn set_element_reflectances(&mut self, rho: &[Option<Rgb>]) -> Result<(), RadiosityError> {
+        self.relight_with(&LightingChange::default(), Some(rho))
+    }
+
+    fn relight_with(
+        &mut self,
+        change: &LightingChange,
+        element_rho: Option<&[Option<Rgb>]>,
+    ) -> Result<(), RadiosityError> {
         let (lighting, reflectance) = self.apply_to_lighting(change)?;
+        let element_mesh = match element_rho {
+            Some(rho) => {
+                let mut mesh = (*self.solution.mesh).clone();
+                mesh.set_element_reflectances(rho)?;
+                Some(mesh)
+            }
+            None => None,
+        };
         let (new_groups, warnings) =
             lighting.light_groups(self.sky_transfer.dome(), self.params.sky_tolerance)?;
         let actions = self.actions(&lighting);
@@ -515,7 +542,11 @@ impl Transfer {
             }
         }
         // Nothing fails past this point: commit.
-        let old_rho: Option<Vec<Rgb>> = reflectance.as_ref().map(|_| self.element_reflectance());
+        let old_rho: Option<Vec<Rgb>> =
+            (reflectance.is_some() || element_mesh.is_some()).then(|| self.element_reflectance());
+        if let Some(mesh) = element_mesh {
+            self.solution.mesh = Arc::new(mesh);
+        }
         if let Some(rho) = reflectance {
             let mesh = Arc::make_mut(&mut self.solution.mesh);
             for (s, r) in mesh.surfaces.iter_mut().zip(rho) {
@@ -659,11 +690,9 @@ impl Transfer {
     }
 
     fn element_reflectance(&self) -> Vec<Rgb> {
-        let surfaces = &self.solution.mesh.surfaces;
-        self.topology
-            .element_surface
-            .iter()
-            .map(|&s| surfaces[s as usize].reflectance_rgb)
+        let mesh = &self.solution.mesh;
+        (0..mesh.elements.len())
+            .map(|e| mesh.element_reflectance_rgb(e))
             .collect()
     }
 }
