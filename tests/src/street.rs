@@ -12,6 +12,7 @@ use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
+use photomontage::site::photo_reflectance::PhotoView;
 use photomontage::site::render::prepare_view;
 use photomontage::site::render_radiosity::site_radiosity_arc;
 use photomontage::site::{SiteDocument, apply_solution, solve_site};
@@ -192,8 +193,20 @@ pub fn render_street_view_in(
 ) -> StreetView {
     let mut job = prepare_view(doc, id).unwrap();
     if radiosity {
-        let (light, _report) =
-            site_radiosity_arc(doc, &job.scene.scene, id, &AtomicBool::new(false)).unwrap();
+        // The natural surfaces' reflectances from the full-size photo, as `render --radiosity`.
+        let photo = PhotoView {
+            camera: &job.camera,
+            photo_linear: &job.photo_linear,
+            lighting: &job.lighting,
+        };
+        let (light, _report) = site_radiosity_arc(
+            doc,
+            &job.scene.scene,
+            id,
+            doc.site.render.photo_reflectance.then_some(&photo),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
         job.lighting.radiosity = Some(light);
     }
     let photo = downscale(&job.photo_linear, scale);

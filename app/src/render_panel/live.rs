@@ -25,6 +25,7 @@ use std::time::Duration;
 use eframe::egui;
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::{RelightReport, SiteTransfers, TransferUpdate};
+use photomontage::site::photo_reflectance::PhotoView;
 use photomontage::site::render::ViewJob;
 
 use super::{Quality, RenderPanelError, RenderUpdate};
@@ -96,11 +97,18 @@ impl JobOptions {
             slot
         });
         shared.clear_poison();
+        // The natural surfaces' reflectances from the photo, as the CLI's render.
+        let photo = PhotoView {
+            camera: &job.camera,
+            photo_linear: &job.photo_linear,
+            lighting: &job.lighting,
+        };
         let (light, report) = SiteTransfers::update(
             &mut slot,
             doc,
             &job.scene.scene,
             photo_id,
+            doc.site.render.photo_reflectance.then_some(&photo),
             progress.cancel_flag(),
         )
         .map_err(|e| RenderPanelError::Prepare {

@@ -68,7 +68,9 @@ impl Mesh {
                 )
             };
             let first = own(kids[0]);
-            per_node[n] = Some(if kids.iter().all(|&k| own(k) == first) {
+            // Equal values are kept exactly (module doc), so the comparison is bitwise too.
+            let same = |r: Rgb| (0..3).all(|c| r[c].to_bits() == first[c].to_bits());
+            per_node[n] = Some(if kids.iter().all(|&k| same(own(k))) {
                 first
             } else {
                 let mut sum = [0.0; 3];
@@ -102,6 +104,7 @@ impl Mesh {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // values stored and read back: compared bit for bit
 mod tests {
     use std::sync::atomic::AtomicBool;
 

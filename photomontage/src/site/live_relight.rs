@@ -32,9 +32,10 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
+use super::photo_reflectance::{PhotoSamples, PhotoView, REFIT_ROUNDS, mean_change_rel};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
-use super::render_radiosity::{RadiosityReport, natural_part, site_solve_params};
+use super::render_radiosity::{RadiosityReport, natural_part, same_elements, site_solve_params};
 use crate::bvh::BuildQuality;
 use crate::radiosity::{
     LightingChange, RadiosityError, Solution, Transfer, TransferLighting, TransferParams,
@@ -263,7 +264,8 @@ fn scene_inputs(
 
 impl SiteTransfers {
     /// Builds both transfers for the site scene `scene` (natural and artificial objects, as
-    /// rendered) lit for photo `view`; their solutions are [`super::render_radiosity`]'s.
+    /// rendered) lit for photo `view`, with the reflectances `photo` shows where given; their
+    /// solutions are [`super::render_radiosity`]'s.
     ///
     /// # Errors
     /// The lighting's errors; a transfer error (a bad source, cancelled) as
@@ -272,11 +274,12 @@ impl SiteTransfers {
         doc: &SiteDocument,
         scene: &Scene,
         view: &str,
+        photo: Option<&PhotoView<'_>>,
         cancel: &AtomicBool,
     ) -> Result<Self, SiteRenderError> {
         let start = Instant::now();
         let inputs = inputs(doc, scene, view)?;
-        Self::from_inputs(inputs, cancel, start)
+        Self::from_inputs(inputs, photo, cancel, start)
     }
 
     /// [`SiteTransfers::build`] for a scene and lighting given directly (benches, tests):
@@ -292,7 +295,7 @@ impl SiteTransfers {
         cancel: &AtomicBool,
     ) -> Result<Self, SiteRenderError> {
         let start = Instant::now();
-        Self::from_inputs(scene_inputs(scene, lighting, params)?, cancel, start)
+        Self::from_inputs(scene_inputs(scene, lighting, params)?, None, cancel, start)
     }
 
     /// The relight step of [`SiteTransfers::update`] for a scene and lighting given directly
@@ -312,6 +315,7 @@ impl SiteTransfers {
 
     fn from_inputs(
         inputs: Inputs,
+        photo: Option<&PhotoView<'_>>,
         cancel: &AtomicBool,
         start: Instant,
     ) -> Result<Self, SiteRenderError> {
@@ -341,8 +345,41 @@ impl SiteTransfers {
             })
             .map_err(|e| radiosity_error(&e))
         };
-        let with_artificial = build(0)?;
-        let without_artificial = build(1)?;
+        let mut with_artificial = build(0)?;
+        let mut without_artificial = build(1)?;
+        // As `site_radiosity_light`: the natural elements the photo sees take its ρ_d, refitted
+        // on the photographed state, then carried to the same elements with the objects.
+        let mut photo_reflectance = None;
+        if let Some(view) = photo {
+            let samples = PhotoSamples::new(
+                &without_artificial.transfer.solution().mesh,
+                &natural_tracer,
+                view,
+            );
+            let mut previous: Option<Vec<Option<Rgb>>> = None;
+            for _ in 0..REFIT_ROUNDS {
+                let (rho, mut count) = samples.reflectances(without_artificial.transfer.solution());
+                if let Some(before) = &previous {
+                    count.mean_change_rel = mean_change_rel(before, &rho);
+                }
+                without_artificial
+                    .transfer
+                    .set_element_reflectances(&rho)
+                    .map_err(|e| radiosity_error(&e))?;
+                previous = Some(rho);
+                photo_reflectance = Some(count);
+            }
+            if photo_reflectance.is_some_and(|c| c.from_photo > 0) {
+                let rho = same_elements(
+                    &without_artificial.transfer.solution().mesh,
+                    &with_artificial.transfer.solution().mesh,
+                );
+                with_artificial
+                    .transfer
+                    .set_element_reflectances(&rho)
+                    .map_err(|e| radiosity_error(&e))?;
+            }
+        }
         let light = Arc::new(
             RadiosityLight::new(
                 with_artificial.transfer.solution(),
@@ -359,6 +396,7 @@ impl SiteTransfers {
             ],
             seconds: start.elapsed().as_secs_f64(),
             notes,
+            photo_reflectance,
         };
         Ok(Self {
             fingerprint: [
@@ -401,7 +439,9 @@ impl SiteTransfers {
 
     /// Relights both transfers to the lighting and materials of `doc`, `scene` and `view`
     /// (module doc), or builds them again when that cannot be expressed as a relight; `slot`
-    /// holds the transfers between calls (`None` builds).
+    /// holds the transfers between calls (`None` builds). A build with `photo` gives the
+    /// natural elements it sees their ρ_d from it, as [`super::render_radiosity`] does; a relight
+    /// keeps them.
     ///
     /// # Errors
     /// As [`SiteTransfers::build`]; a relight error. On error `slot` is emptied (the next call
@@ -411,6 +451,7 @@ impl SiteTransfers {
         doc: &SiteDocument,
         scene: &Scene,
         view: &str,
+        photo: Option<&PhotoView<'_>>,
         cancel: &AtomicBool,
     ) -> Result<(Arc<RadiosityLight>, RelightReport), SiteRenderError> {
         let start = Instant::now();
@@ -434,7 +475,7 @@ impl SiteTransfers {
             }
         }
         *slot = None;
-        let built = Self::from_inputs(inputs, cancel, start)?;
+        let built = Self::from_inputs(inputs, photo, cancel, start)?;
         let light = built.light();
         *slot = Some(built);
         Ok((

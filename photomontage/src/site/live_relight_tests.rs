@@ -126,17 +126,18 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
     let cancel = AtomicBool::new(false);
     let mut slot = None;
     let scene = site_scene(&doc).unwrap().scene;
-    let (light, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    let (light, report) =
+        SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Built);
     // The build's solutions are the render's own solves, bit for bit.
-    let (fresh, _) = site_radiosity_light(&doc, &scene, "p1", &cancel).unwrap();
+    let (fresh, _) = site_radiosity_light(&doc, &scene, "p1", None, &cancel).unwrap();
     assert_eq!(light.with_artificial.groups, fresh.with_artificial.groups);
     assert_eq!(
         light.without_artificial.groups,
         fresh.without_artificial.groups
     );
     let built = light;
-    let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Unchanged);
 
     // The sky type (Site & light tab) and a material colour (Materials tab).
@@ -146,9 +147,10 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
         colour: None,
     });
     let scene = site_scene(&doc).unwrap().scene;
-    let (light, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    let (light, report) =
+        SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Relit);
-    let (fresh, _) = site_radiosity_light(&doc, &scene, "p1", &cancel).unwrap();
+    let (fresh, _) = site_radiosity_light(&doc, &scene, "p1", None, &cancel).unwrap();
     assert_matches_fresh_solve("with", &light.with_artificial, &fresh.with_artificial);
     assert_matches_fresh_solve(
         "without",
@@ -171,7 +173,57 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
     // Moving the model changes the geometry: a build, with new gathers.
     doc.site.models[0].placement.translation[0] += 2.0;
     let scene = site_scene(&doc).unwrap().scene;
-    let (moved, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", &cancel).unwrap();
+    let (moved, report) =
+        SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Built);
     assert!(!Arc::ptr_eq(built.gathers()[0], moved.gathers()[0]));
+}
+
+#[test]
+fn a_build_with_the_photo_takes_its_reflectances_as_the_render_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = fixture(dir.path());
+    doc.site.render.radiosity = true;
+    let cancel = AtomicBool::new(false);
+    let job = crate::site::render::prepare_view(&doc, "p1").unwrap();
+    let photo = crate::site::photo_reflectance::PhotoView {
+        camera: &job.camera,
+        photo_linear: &job.photo_linear,
+        lighting: &job.lighting,
+    };
+    let scene = &job.scene.scene;
+    let mut slot = None;
+    let (light, _) =
+        SiteTransfers::update(&mut slot, &doc, scene, "p1", Some(&photo), &cancel).unwrap();
+    let report = &slot.as_ref().unwrap().report;
+    let count = report.photo_reflectance.unwrap();
+    assert!(count.from_photo > 10, "{count:?}");
+    let (fresh, fresh_report) =
+        site_radiosity_light(&doc, scene, "p1", Some(&photo), &cancel).unwrap();
+    assert_eq!(
+        fresh_report.photo_reflectance.unwrap().from_photo,
+        count.from_photo
+    );
+    // The transfers refit by relights (warm starts), the render's solve by cold solves on the
+    // same links: the same fixed points within the relight tolerances.
+    assert_matches_fresh_solve("with", &light.with_artificial, &fresh.with_artificial);
+    assert_matches_fresh_solve(
+        "without",
+        &light.without_artificial,
+        &fresh.without_artificial,
+    );
+    // The photographed state's values reach the same natural elements with the objects.
+    for solution in [&light.with_artificial, &fresh.with_artificial] {
+        let carried = solution
+            .mesh
+            .element_reflectance_overrides()
+            .iter()
+            .filter(|r| r.is_some())
+            .count();
+        assert!(carried > 0 && carried <= count.from_photo, "{carried}");
+    }
+    // Without the photo the library's values stay.
+    let (plain, plain_report) = site_radiosity_light(&doc, scene, "p1", None, &cancel).unwrap();
+    assert!(plain_report.photo_reflectance.is_none());
+    assert!(plain.without_artificial.mesh.node_reflectance_rgb.is_none());
 }

@@ -22,6 +22,9 @@ pub mod material_pick;
 pub mod models;
 pub mod new;
 pub mod photo_points;
+pub mod photo_reflectance;
+#[cfg(test)]
+mod photo_reflectance_tests;
 pub mod radiosity_lighting;
 pub mod render;
 pub mod render_error;

@@ -344,10 +344,17 @@ impl RenderPlan {
         if !self.radiosity || prepared.photo_only {
             return Ok(None);
         }
+        let job = &prepared.job;
+        let photo = super::photo_reflectance::PhotoView {
+            camera: &job.camera,
+            photo_linear: &job.photo_linear,
+            lighting: &job.lighting,
+        };
         let (light, report) = super::render_radiosity::site_radiosity_arc(
             doc,
-            &prepared.job.scene.scene,
+            &job.scene.scene,
             &self.request.view,
+            doc.site.render.photo_reflectance.then_some(&photo),
             cancel,
         )?;
         prepared.job.lighting.radiosity = Some(light);

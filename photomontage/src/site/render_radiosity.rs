@@ -23,10 +23,15 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
+use super::photo_reflectance::{
+    PhotoReflectanceCount, PhotoSamples, PhotoView, REFIT_ROUNDS, mean_change_rel,
+};
 use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
 use super::render_error::SiteRenderError;
 use crate::bvh::BuildQuality;
-use crate::radiosity::{Mesh, MeshParams, SolveParams, solve_on_mesh, sun_directions};
+use crate::radiosity::{
+    Mesh, MeshParams, Rgb, SolveParams, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
+};
 use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::scene::{ObjectKind, Scene, SceneError, SceneTracer};
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
@@ -54,6 +59,9 @@ pub struct RadiosityReport {
     pub seconds: f64,
     /// Notes for the user (terms the solve ignores).
     pub notes: Vec<String>,
+    /// Natural elements whose ρ_d came from the photo ([`super::photo_reflectance`]); `None`
+    /// when no photo was read.
+    pub photo_reflectance: Option<PhotoReflectanceCount>,
 }
 
 /// The natural objects of `scene` alone (materials, names and triangle order kept).
@@ -123,7 +131,9 @@ pub fn site_solve_params(
 }
 
 /// Solves the site scene `scene` (natural and artificial objects, as rendered) with and without
-/// its artificial objects under the lighting of photo `view` (module doc).
+/// its artificial objects under the lighting of photo `view` (module doc). With `photo`, the
+/// natural elements it sees take their ρ_d from it ([`super::photo_reflectance`]), in both
+/// solves.
 ///
 /// # Errors
 /// The lighting's errors; a solve error (a scene too large, a bad source) as
@@ -132,6 +142,7 @@ pub fn site_radiosity_light(
     doc: &SiteDocument,
     scene: &Scene,
     view: &str,
+    photo: Option<&PhotoView<'_>>,
     cancel: &AtomicBool,
 ) -> Result<(RadiosityLight, RadiosityReport), SiteRenderError> {
     let start = Instant::now();
@@ -152,32 +163,75 @@ pub fn site_radiosity_light(
         Mesh::build_lit(s, &params.mesh, &dirs_to_sun, &[&tracer, &natural_tracer])
             .map_err(|e| radiosity_error(&e))
     };
-    let with = solve_on_mesh(mesh(scene)?, &tracer, &groups, &params, cancel, &|_| {})
-        .map_err(|e| radiosity_error(&e))?;
     // The photographed state has none of the project's luminaires.
     let natural_groups: Vec<_> = groups
         .iter()
         .filter(|g| !g.name.starts_with("luminaire"))
         .cloned()
         .collect();
-    let without = solve_on_mesh(
-        mesh(&natural)?,
+    let natural_mesh = mesh(&natural)?;
+    let samples = photo.map(|p| PhotoSamples::new(&natural_mesh, &natural_tracer, p));
+    let mut count = None;
+    let mut previous: Option<Vec<Option<Rgb>>> = None;
+    let mut refit = |solution: &crate::radiosity::Solution| {
+        let samples = samples.as_ref()?;
+        let (rho, mut n) = samples.reflectances(solution);
+        if let Some(before) = &previous {
+            n.mean_change_rel = mean_change_rel(before, &rho);
+        }
+        previous = Some(rho.clone());
+        count = Some(n);
+        Some(rho)
+    };
+    let without = solve_on_mesh_refitting(
+        natural_mesh,
         &natural_tracer,
         &natural_groups,
         &params,
         cancel,
         &|_| {},
+        &mut refit,
+        if samples.is_some() { REFIT_ROUNDS } else { 0 },
     )
     .map_err(|e| radiosity_error(&e))?;
+    let mut with_mesh = mesh(scene)?;
+    if without.mesh.node_reflectance_rgb.is_some() {
+        let rho = same_elements(&without.mesh, &with_mesh);
+        with_mesh
+            .set_element_reflectances(&rho)
+            .map_err(|e| radiosity_error(&e))?;
+    }
+    let with = solve_on_mesh(with_mesh, &tracer, &groups, &params, cancel, &|_| {})
+        .map_err(|e| radiosity_error(&e))?;
     let report = RadiosityReport {
         element_edge_m,
         elements: [with.mesh.elements.len(), without.mesh.elements.len()],
         seconds: start.elapsed().as_secs_f64(),
         notes,
+        photo_reflectance: count,
     };
     let light = RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly)
         .map_err(|e| radiosity_error(&e))?;
     Ok((light, report))
+}
+
+/// The per-element reflectances of `from` carried to the elements of `to` with the same
+/// vertices (the natural surfaces, meshed alike in both: module doc); `None` elsewhere.
+#[must_use]
+pub fn same_elements(from: &Mesh, to: &Mesh) -> Vec<Option<Rgb>> {
+    let key = |mesh: &Mesh, e: usize| -> [u64; 9] {
+        let v = &mesh.element_node(e).vertices_in_world_m;
+        std::array::from_fn(|k| v[k / 3][k % 3].to_bits())
+    };
+    let by_vertices: std::collections::HashMap<[u64; 9], Rgb> = from
+        .element_reflectance_overrides()
+        .into_iter()
+        .enumerate()
+        .filter_map(|(e, r)| r.map(|r| (key(from, e), r)))
+        .collect();
+    (0..to.elements.len())
+        .map(|e| by_vertices.get(&key(to, e)).copied())
+        .collect()
 }
 
 /// [`site_radiosity_light`] shared behind an [`Arc`] for [`crate::render::Lighting::radiosity`].
@@ -188,7 +242,8 @@ pub fn site_radiosity_arc(
     doc: &SiteDocument,
     scene: &Scene,
     view: &str,
+    photo: Option<&PhotoView<'_>>,
     cancel: &AtomicBool,
 ) -> Result<(Arc<RadiosityLight>, RadiosityReport), SiteRenderError> {
-    site_radiosity_light(doc, scene, view, cancel).map(|(l, r)| (Arc::new(l), r))
+    site_radiosity_light(doc, scene, view, photo, cancel).map(|(l, r)| (Arc::new(l), r))
 }

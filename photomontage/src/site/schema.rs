@@ -499,6 +499,12 @@ pub struct RenderSettings {
     /// site with and without the planned objects (docs/methodology.md).
     #[serde(default, skip_serializing_if = "is_false")]
     pub radiosity: bool,
+    /// In the radiosity mode, the natural surfaces the rendered photo sees take their diffuse
+    /// reflectance from it (`site::photo_reflectance`); `false` keeps the material library's
+    /// (a photo with much the model lacks in front of its surfaces, or lighting studies under
+    /// another sky than the photo's).
+    #[serde(default = "default_true", skip_serializing_if = "is_true")]
+    pub photo_reflectance: bool,
     /// Exposure multiplier applied before 8-bit output.
     pub exposure: f64,
 }
@@ -512,6 +518,7 @@ impl Default for RenderSettings {
             spectral: false,
             max_depth: 4,
             radiosity: false,
+            photo_reflectance: true,
             exposure: 1.0,
         }
     }

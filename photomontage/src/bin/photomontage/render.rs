@@ -339,6 +339,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
              planned objects, {:.2} m element edge",
             r.seconds, r.elements[0], r.elements[1], r.element_edge_m
         );
+        if let Some(p) = &r.photo_reflectance {
+            println!(
+                "  reflectance from the photo on {} of {} natural elements ({} clamped to 1; last \
+                 refit moved them by {:.2} % on average), the others from the material library",
+                p.from_photo,
+                p.elements,
+                p.clamped,
+                100.0 * p.mean_change_rel
+            );
+        }
         for note in &r.notes {
             println!("  radiosity note: {note}");
         }

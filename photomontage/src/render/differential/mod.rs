@@ -62,6 +62,7 @@ pub mod glass;
 mod interreflection;
 pub mod radiosity_light;
 mod shading;
+pub use shading::true_colour_rgb;
 pub mod specular;
 mod visibility;
 

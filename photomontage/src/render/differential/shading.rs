@@ -90,13 +90,21 @@ impl DifferentialTracer<'_> {
     /// Eq. 8: true colour from an apparent colour seen over `distance_m` (unchanged when there
     /// is no atmosphere or the inversion is refused).
     pub(super) fn true_colour(&self, apparent_rgb: Rgb, distance_m: f64) -> Rgb {
-        let Some(a) = &self.lighting.atmosphere else {
-            return apparent_rgb;
-        };
-        #[allow(clippy::cast_possible_truncation)]
-        let c = Colour::from_slice(&apparent_rgb.map(|x| x as f32));
-        a.true_colour(&c, distance_m).map_or(apparent_rgb, |t| {
-            [0, 1, 2].map(|k| f64::from(t.channels[k]))
-        })
+        true_colour_rgb(self.lighting, apparent_rgb, distance_m)
     }
+}
+
+/// Eq. 8 with the atmosphere of `lighting`: the true colour of an apparent colour seen over
+/// `distance_m` (unchanged when there is no atmosphere or the inversion is refused). The
+/// renderer's case D and the site's photo reflectances (`site::photo_reflectance`) use it.
+#[must_use]
+pub fn true_colour_rgb(lighting: &super::Lighting, apparent_rgb: Rgb, distance_m: f64) -> Rgb {
+    let Some(a) = &lighting.atmosphere else {
+        return apparent_rgb;
+    };
+    #[allow(clippy::cast_possible_truncation)]
+    let c = Colour::from_slice(&apparent_rgb.map(|x| x as f32));
+    a.true_colour(&c, distance_m).map_or(apparent_rgb, |t| {
+        [0, 1, 2].map(|k| f64::from(t.channels[k]))
+    })
 }
