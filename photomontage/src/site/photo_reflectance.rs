@@ -46,10 +46,10 @@ type Rgb = [f64; 3];
 
 /// Sample points per element along each axis of the unit square (Shirley's warp onto the
 /// triangle).
-pub const SAMPLES_PER_AXIS: usize = 4;
+pub const SAMPLES_PER_AXIS: usize = 3;
 /// An element takes its ρ_d from the photo when at least this many of its samples are seen:
 /// more than half, so that an element mostly hidden or out of frame keeps the library's.
-pub const MIN_SEEN_SAMPLES: usize = 9;
+pub const MIN_SEEN_SAMPLES: usize = 5;
 /// A sample is seen when the camera's ray to it first meets the natural geometry no nearer than
 /// this (plus 10⁻⁴ of the distance: the `f32` hit) before it, metres.
 pub const SEEN_TOLERANCE_M: f64 = 0.02;
@@ -225,15 +225,19 @@ impl PhotoSamples {
                 if values.len() < MIN_SEEN_SAMPLES {
                     return None;
                 }
+                // The median per channel: robust to the samples whose pixel shows another
+                // surface (at a silhouette) or the other side of a shadow edge (module doc).
                 let mut clamped = false;
-                #[allow(clippy::cast_precision_loss)]
-                let n = values.len() as f64;
-                let mean = std::array::from_fn(|c| {
-                    let m = values.iter().map(|v| v[c]).sum::<f64>() / n;
+                let mut column: Vec<f64> = Vec::with_capacity(values.len());
+                let median = std::array::from_fn(|c| {
+                    column.clear();
+                    column.extend(values.iter().map(|v| v[c]));
+                    column.sort_by(f64::total_cmp);
+                    let m = column[column.len() / 2];
                     clamped |= m > 1.0;
                     m.clamp(0.0, 1.0)
                 });
-                Some((mean, clamped))
+                Some((median, clamped))
             })
             .collect();
         let count = PhotoReflectanceCount {
