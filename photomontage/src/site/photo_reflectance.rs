@@ -196,12 +196,7 @@ impl PhotoSamples {
     /// reaches it.
     #[must_use]
     pub fn reflectances(&self, solution: &Solution) -> (Vec<Option<Rgb>>, PhotoReflectanceCount) {
-        let rest = solution.without_direct_of(&RadiosityLight::traced_exactly);
-        let per_group: Vec<Vec<Rgb>> = rest
-            .groups
-            .iter()
-            .map(|g| g.irradiance_rgb(&rest.mesh, false))
-            .collect();
+        let sky_and_bounce = sky_and_bounce_per_element(solution);
         let rho: Vec<Option<(Rgb, bool)>> = (0..self.per_element.len())
             .into_par_iter()
             .map(|e| {
@@ -209,12 +204,7 @@ impl PhotoSamples {
                 if samples.is_empty() {
                     return None;
                 }
-                let mut e_rad = [0.0; 3];
-                for g in &per_group {
-                    for c in 0..3 {
-                        e_rad[c] += g[e][c];
-                    }
-                }
+                let e_rad = sky_and_bounce[e];
                 let values: Vec<Rgb> = samples
                     .iter()
                     .filter_map(|s| {
@@ -248,6 +238,23 @@ impl PhotoSamples {
         };
         (rho.into_iter().map(|r| r.map(|(v, _)| v)).collect(), count)
     }
+}
+
+/// The sky and interreflected irradiance per element of `solution`: every group's irradiance
+/// with the direct light of the groups the renderer traces itself (the sun, the luminaires)
+/// taken out, as case D's E_rad,without.
+#[must_use]
+pub fn sky_and_bounce_per_element(solution: &Solution) -> Vec<Rgb> {
+    let rest = solution.without_direct_of(&RadiosityLight::traced_exactly);
+    let mut sum = vec![[0.0; 3]; rest.mesh.elements.len()];
+    for g in &rest.groups {
+        for (s, v) in sum.iter_mut().zip(g.irradiance_rgb(&rest.mesh, false)) {
+            for c in 0..3 {
+                s[c] += v[c];
+            }
+        }
+    }
+    sum
 }
 
 /// The photo's linear colour at continuous pixel position `pixel` (pixel (x, y) covers

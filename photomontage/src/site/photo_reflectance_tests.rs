@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 use image::Rgb32FImage;
 use nalgebra::Point2;
 
-use super::photo_reflectance::{PhotoSamples, PhotoView, REFIT_ROUNDS};
+use super::photo_reflectance::{PhotoSamples, PhotoView, REFIT_ROUNDS, sky_and_bounce_per_element};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render::prepare_view;
 use super::render::tests::fixture;
@@ -20,7 +20,6 @@ use crate::camera::{Camera, Intrinsics};
 use crate::radiosity::{
     Mesh, Rgb, Solution, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
 };
-use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::render::illumination::natural_irradiance_rgb;
 use crate::scene::SceneTracer;
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
@@ -79,7 +78,7 @@ fn reflectances_read_off_a_photo_made_with_known_ones_come_back() {
         .set_element_reflectances(&rho_true.iter().copied().map(Some).collect::<Vec<_>>())
         .unwrap();
     let truth = solve_on_mesh(truth_mesh, &tracer, &groups, &params, &cancel, &|_| {}).unwrap();
-    let e_rad = element_sky_and_bounce(&truth);
+    let e_rad = sky_and_bounce_per_element(&truth);
 
     // The photo: each pixel centre's natural hit, L = ρ_true/π · E_nat.
     let daylight = &job.lighting.daylight;
@@ -180,19 +179,4 @@ fn reflectances_read_off_a_photo_made_with_known_ones_come_back() {
         })
         .count();
     assert!(library_off > seen / 2, "{library_off} of {seen}");
-}
-
-/// The sky and interreflected irradiance per element (the sun's direct light out), as the
-/// estimate reads it.
-fn element_sky_and_bounce(solution: &Solution) -> Vec<Rgb> {
-    let rest = solution.without_direct_of(&RadiosityLight::traced_exactly);
-    let mut sum = vec![[0.0; 3]; rest.mesh.elements.len()];
-    for g in &rest.groups {
-        for (s, v) in sum.iter_mut().zip(g.irradiance_rgb(&rest.mesh, false)) {
-            for c in 0..3 {
-                s[c] += v[c];
-            }
-        }
-    }
-    sum
 }
