@@ -466,16 +466,19 @@ pub fn solve_on_mesh_refitting(
             interactions = matrix.len() as u64;
         }
     }
-    let assemble = |mesh: Mesh, solved: Vec<(Vec<Rgb>, Vec<ConvergenceRow>)>| Solution {
+    // The direct terms move into the returned solution; only a refit's probes copy them.
+    let assemble = |mesh: Mesh,
+                    solved: Vec<(Vec<Rgb>, Vec<ConvergenceRow>)>,
+                    directs: Vec<Vec<Rgb>>| Solution {
         mesh: Arc::new(mesh),
         groups: groups
             .iter()
-            .zip(&directs)
+            .zip(directs)
             .zip(solved)
             .map(
                 |((group, direct), (radiosity, convergence))| GroupSolution {
                     name: group.name.clone(),
-                    direct_irradiance_rgb: direct.clone(),
+                    direct_irradiance_rgb: direct,
                     radiosity_rgb: radiosity,
                     convergence,
                 },
@@ -486,21 +489,21 @@ pub fn solve_on_mesh_refitting(
         warnings: warnings.clone(),
         locator: std::sync::OnceLock::new(),
     };
-    let mut solution = assemble(mesh, solved);
+    let (mut mesh, mut solved) = (mesh, solved);
     for _ in 0..rounds {
-        let (Some(rho), Some(hierarchy)) = (refit(&solution), hierarchy.as_ref()) else {
-            break;
+        let probe = assemble(mesh, solved, directs.clone());
+        let (Some(rho), Some(hierarchy)) = (refit(&probe), hierarchy.as_ref()) else {
+            return Ok(probe);
         };
-        let mut mesh = Arc::unwrap_or_clone(solution.mesh);
+        mesh = Arc::unwrap_or_clone(probe.mesh);
         mesh.set_element_reflectances(&rho)?;
-        let mut solved = Vec::with_capacity(groups.len());
+        solved = Vec::with_capacity(groups.len());
         for (group, direct) in groups.iter().zip(&directs) {
             let b0 = initial_exitance(&mesh, direct, group.emission);
             solved.push(hierarchy.solve(&mesh, &b0, &group.name, &params.stop, cancel, on_pass)?);
         }
-        solution = assemble(mesh, solved);
     }
-    Ok(solution)
+    Ok(assemble(mesh, solved, directs))
 }
 
 /// The ground below the horizon, ready to apply: its unit-radiance transfer per element.

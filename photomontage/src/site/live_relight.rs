@@ -32,7 +32,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
-use super::photo_reflectance::{PhotoSamples, PhotoView, REFIT_ROUNDS, mean_change_rel};
+use super::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
 use super::render_radiosity::{RadiosityReport, natural_part, same_elements, site_solve_params};
@@ -351,24 +351,19 @@ impl SiteTransfers {
         // on the photographed state, then carried to the same elements with the objects.
         let mut photo_reflectance = None;
         if let Some(view) = photo {
-            let samples = PhotoSamples::new(
+            let mut refit = PhotoRefit::new(PhotoSamples::new(
                 &without_artificial.transfer.solution().mesh,
                 &natural_tracer,
                 view,
-            );
-            let mut previous: Option<Vec<Option<Rgb>>> = None;
+            ));
             for _ in 0..REFIT_ROUNDS {
-                let (rho, mut count) = samples.reflectances(without_artificial.transfer.solution());
-                if let Some(before) = &previous {
-                    count.mean_change_rel = mean_change_rel(before, &rho);
-                }
+                let rho = refit.next_round(without_artificial.transfer.solution());
                 without_artificial
                     .transfer
                     .set_element_reflectances(&rho)
                     .map_err(|e| radiosity_error(&e))?;
-                previous = Some(rho);
-                photo_reflectance = Some(count);
             }
+            photo_reflectance = refit.count();
             if photo_reflectance.is_some_and(|c| c.from_photo > 0) {
                 let rho = same_elements(
                     &without_artificial.transfer.solution().mesh,

@@ -97,10 +97,48 @@ pub struct PhotoReflectanceCount {
     pub mean_change_rel: f64,
 }
 
+/// The refit's rounds (module doc) for the render's solve and the studio's transfers alike: each
+/// round reads ρ_d off the samples against the latest solution and keeps the count to report,
+/// with the change since the round before.
+#[derive(Debug, Clone)]
+pub struct PhotoRefit {
+    samples: PhotoSamples,
+    previous: Option<Vec<Option<Rgb>>>,
+    count: Option<PhotoReflectanceCount>,
+}
+
+impl PhotoRefit {
+    /// Rounds over `samples`.
+    #[must_use]
+    pub fn new(samples: PhotoSamples) -> Self {
+        Self {
+            samples,
+            previous: None,
+            count: None,
+        }
+    }
+
+    /// ρ_d per element from `solution` ([`PhotoSamples::reflectances`]).
+    pub fn next_round(&mut self, solution: &Solution) -> Vec<Option<Rgb>> {
+        let (rho, mut count) = self.samples.reflectances(solution);
+        if let Some(before) = &self.previous {
+            count.mean_change_rel = mean_change_rel(before, &rho);
+        }
+        self.previous = Some(rho.clone());
+        self.count = Some(count);
+        rho
+    }
+
+    /// The last round's count; `None` before the first.
+    #[must_use]
+    pub fn count(&self) -> Option<PhotoReflectanceCount> {
+        self.count
+    }
+}
+
 /// The mean over elements valued in both of the largest relative change of a channel from
 /// `before` to `after`; 0 when none is.
-#[must_use]
-pub fn mean_change_rel(before: &[Option<Rgb>], after: &[Option<Rgb>]) -> f64 {
+fn mean_change_rel(before: &[Option<Rgb>], after: &[Option<Rgb>]) -> f64 {
     let changes: Vec<f64> = before
         .iter()
         .zip(after)

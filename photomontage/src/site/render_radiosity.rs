@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use super::SiteDocument;
 use super::photo_reflectance::{
-    PhotoReflectanceCount, PhotoSamples, PhotoView, REFIT_ROUNDS, mean_change_rel,
+    PhotoRefit, PhotoReflectanceCount, PhotoSamples, PhotoView, REFIT_ROUNDS,
 };
 use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
 use super::render_error::SiteRenderError;
@@ -170,19 +170,9 @@ pub fn site_radiosity_light(
         .cloned()
         .collect();
     let natural_mesh = mesh(&natural)?;
-    let samples = photo.map(|p| PhotoSamples::new(&natural_mesh, &natural_tracer, p));
-    let mut count = None;
-    let mut previous: Option<Vec<Option<Rgb>>> = None;
-    let mut refit = |solution: &crate::radiosity::Solution| {
-        let samples = samples.as_ref()?;
-        let (rho, mut n) = samples.reflectances(solution);
-        if let Some(before) = &previous {
-            n.mean_change_rel = mean_change_rel(before, &rho);
-        }
-        previous = Some(rho.clone());
-        count = Some(n);
-        Some(rho)
-    };
+    let mut refit =
+        photo.map(|p| PhotoRefit::new(PhotoSamples::new(&natural_mesh, &natural_tracer, p)));
+    let rounds = if refit.is_some() { REFIT_ROUNDS } else { 0 };
     let without = solve_on_mesh_refitting(
         natural_mesh,
         &natural_tracer,
@@ -190,8 +180,8 @@ pub fn site_radiosity_light(
         &params,
         cancel,
         &|_| {},
-        &mut refit,
-        if samples.is_some() { REFIT_ROUNDS } else { 0 },
+        &mut |solution: &crate::radiosity::Solution| refit.as_mut().map(|r| r.next_round(solution)),
+        rounds,
     )
     .map_err(|e| radiosity_error(&e))?;
     let mut with_mesh = mesh(scene)?;
@@ -208,7 +198,7 @@ pub fn site_radiosity_light(
         elements: [with.mesh.elements.len(), without.mesh.elements.len()],
         seconds: start.elapsed().as_secs_f64(),
         notes,
-        photo_reflectance: count,
+        photo_reflectance: refit.as_ref().and_then(PhotoRefit::count),
     };
     let light = RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly)
         .map_err(|e| radiosity_error(&e))?;
