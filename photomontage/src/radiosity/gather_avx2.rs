@@ -33,9 +33,14 @@ impl Token {
     }
 
     /// For each link `(receiver, factor)` of `links`: `acc[(receiver − base)·S ..][..S] +=
-    /// factor · src`, in link order.
+    /// factor · src`, in link order. Panics when the first or the last receiver lies outside
+    /// `acc` (checked once per run, not per link).
+    ///
+    /// # Safety
+    /// `receivers` must be sorted ascending (as every run of [`super::source_rows::SourceRows`]
+    /// is): the kernel indexes `acc` unchecked between the first and the last receiver.
     #[inline]
-    pub fn gather_run<const S: usize>(
+    pub unsafe fn gather_run<const S: usize>(
         self,
         src: &[f32; S],
         receivers: &[u32],
@@ -43,7 +48,8 @@ impl Token {
         base: usize,
         acc: &mut [f32],
     ) {
-        // SAFETY: a `Token` exists only if the CPU has AVX2 (`Token::new`).
+        // SAFETY: a `Token` exists only if the CPU has AVX2 (`Token::new`); the receivers are
+        // sorted (this function's contract).
         unsafe { gather_run_impl::<S>(src, receivers, factors, base, acc) }
     }
 
@@ -78,8 +84,10 @@ fn escaped_lanes_impl(hits: &[u8], weights: &[[f32; 8]]) -> [f32; 8] {
     lanes
 }
 
+/// # Safety
+/// As [`Token::gather_run`]: `receivers` sorted ascending.
 #[target_feature(enable = "avx2")]
-fn gather_run_impl<const S: usize>(
+unsafe fn gather_run_impl<const S: usize>(
     src: &[f32; S],
     receivers: &[u32],
     factors: &[f32],
@@ -92,15 +100,28 @@ fn gather_run_impl<const S: usize>(
     let quad_at = if S >= 8 { 8 } else { 0 };
     let s4 = (quad_at + 4 <= S).then(|| unsafe { _mm_loadu_ps(src.as_ptr().add(quad_at)) });
     let single = quad_at + if s4.is_some() { 4 } else { 0 };
-    for (rcv, &f) in receivers.iter().zip(factors) {
-        let at = (*rcv as usize - base) * S;
-        let dst: &mut [f32; S] = (&mut acc[at..at + S])
-            .try_into()
-            .unwrap_or_else(|_| unreachable!("S values per node"));
+    // One check per run instead of one per link: a run's receivers are sorted (SourceRows), so
+    // the first and the last bound them all.
+    let (Some(&first), Some(&last)) = (receivers.first(), receivers.last()) else {
+        return;
+    };
+    assert!(
+        first as usize >= base && (last as usize - base + 1) * S <= acc.len(),
+        "a run's receivers lie in its range"
+    );
+    debug_assert!(receivers.is_sorted(), "a run's receivers are sorted");
+    let n = receivers.len().min(factors.len());
+    let acc = acc.as_mut_ptr();
+    for i in 0..n {
+        // SAFETY: i < n ≤ both lengths; every receiver lies in first..=last (sorted, the
+        // caller's contract), so `at + S` ≤ `acc.len()` by the check above.
+        let (rcv, f) = unsafe { (*receivers.get_unchecked(i), *factors.get_unchecked(i)) };
+        let at = (rcv as usize - base) * S;
+        // SAFETY: `at + S` ≤ `acc.len()` (above): `p` points at S values of `acc`.
+        let p = unsafe { acc.add(at) };
         if let Some(v) = s8 {
-            // SAFETY: `dst` holds S ≥ 8 values; loads and stores are unaligned.
+            // SAFETY: `p` holds S ≥ 8 values; loads and stores are unaligned.
             unsafe {
-                let p = dst.as_mut_ptr();
                 _mm256_storeu_ps(
                     p,
                     _mm256_add_ps(_mm256_loadu_ps(p), _mm256_mul_ps(_mm256_set1_ps(f), v)),
@@ -108,17 +129,18 @@ fn gather_run_impl<const S: usize>(
             }
         }
         if let Some(v) = s4 {
-            // SAFETY: `dst` holds S ≥ quad_at + 4 values.
+            // SAFETY: `p` holds S ≥ quad_at + 4 values.
             unsafe {
-                let p = dst.as_mut_ptr().add(quad_at);
+                let q = p.add(quad_at);
                 _mm_storeu_ps(
-                    p,
-                    _mm_add_ps(_mm_loadu_ps(p), _mm_mul_ps(_mm_set1_ps(f), v)),
+                    q,
+                    _mm_add_ps(_mm_loadu_ps(q), _mm_mul_ps(_mm_set1_ps(f), v)),
                 );
             }
         }
-        for j in single..S {
-            dst[j] += f * src[j];
+        for (j, s) in src.iter().enumerate().skip(single) {
+            // SAFETY: j < S values at `p`.
+            unsafe { *p.add(j) += f * s };
         }
     }
 }

@@ -255,6 +255,15 @@ impl Solution {
     #[must_use]
     pub fn without_direct_of(&self, exact: &(dyn Fn(&str) -> bool + Sync)) -> Self {
         let mesh = &self.mesh;
+        // ρ per element once for all the exact groups (reading a mesh node per element).
+        let rho: Vec<Rgb> = if self.groups.iter().any(|g| exact(&g.name)) {
+            (0..mesh.elements.len())
+                .into_par_iter()
+                .map(|e| mesh.element_reflectance_rgb(e))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let groups = self
             .groups
             .iter()
@@ -266,9 +275,8 @@ impl Solution {
                 let radiosity_rgb = (0..mesh.elements.len())
                     .into_par_iter()
                     .map(|e| {
-                        let rho = mesh.element_reflectance_rgb(e);
                         std::array::from_fn(|c| {
-                            g.radiosity_rgb[e][c] - rho[c] * g.direct_irradiance_rgb[e][c]
+                            g.radiosity_rgb[e][c] - rho[e][c] * g.direct_irradiance_rgb[e][c]
                         })
                     })
                     .collect();
@@ -617,20 +625,29 @@ pub(crate) fn group_direct(
 
 /// B₀ = ρ·E_direct (+ the emission when the group owns it), per element.
 pub(crate) fn initial_exitance(mesh: &Mesh, direct: &[Rgb], emission: bool) -> Vec<Rgb> {
+    let n = mesh.elements.len();
+    let rho: Vec<Rgb> = (0..n).map(|e| mesh.element_reflectance_rgb(e)).collect();
+    let emitted: Option<Vec<Rgb>> = emission.then(|| {
+        (0..n)
+            .map(|e| mesh.surfaces[mesh.element_node(e).surface as usize].emission_rgb)
+            .collect()
+    });
+    initial_exitance_from(&rho, direct, emitted.as_deref())
+}
+
+/// B₀ = ρ·E_direct + emission, per element, from ρ per element and (when the group owns it)
+/// the emission per element.
+pub(crate) fn initial_exitance_from(
+    rho: &[Rgb],
+    direct: &[Rgb],
+    emission: Option<&[Rgb]>,
+) -> Vec<Rgb> {
     // Each element on its own: the same values on any number of threads.
-    (0..mesh.elements.len())
+    (0..rho.len())
         .into_par_iter()
         .map(|e| {
-            let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
-            let rho = mesh.element_reflectance_rgb(e);
-            std::array::from_fn(|c| {
-                let emitted = if emission {
-                    surface.emission_rgb[c]
-                } else {
-                    0.0
-                };
-                rho[c] * direct[e][c] + emitted
-            })
+            let emitted = emission.map_or([0.0; 3], |m| m[e]);
+            std::array::from_fn(|c| rho[e][c] * direct[e][c] + emitted[c])
         })
         .collect()
 }

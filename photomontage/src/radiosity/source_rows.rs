@@ -159,7 +159,12 @@ pub(super) fn gather_range<const S: usize>(
         let (receivers, factors) = (&rows.receiver[links.clone()], &rows.form_factor[links]);
         #[cfg(target_arch = "x86_64")]
         if let Some(token) = token {
-            token.gather_run::<S>(src, receivers, factors, base, acc);
+            // SAFETY: each source's run is sorted by receiver (`SourceRows::new`, and nothing
+            // else writes the rows).
+            #[allow(unsafe_code)] // the vector kernel's contract (gather_avx2.rs)
+            unsafe {
+                token.gather_run::<S>(src, receivers, factors, base, acc)
+            };
             continue;
         }
         #[cfg(not(target_arch = "x86_64"))]

@@ -2,6 +2,7 @@
 //! fraction, each patch's subtree range and the element areas (used by the relights of
 //! [`super::transfer`] and [`super::shooting`]).
 
+use super::Rgb;
 use super::mesh::Mesh;
 
 /// Node topology for iterative push–pull (nodes are in pre-order per scene triangle).
@@ -23,6 +24,9 @@ pub(super) struct Topology {
     /// Per patch, its elements' range: the mesh numbers elements depth first, so each patch's
     /// elements are contiguous and the patches' ranges follow one another in patch order.
     pub(super) patch_elements: Vec<(usize, usize)>,
+    /// Per element, its mesh surface (the reflectance and emission it takes when no
+    /// per-element value is set), so that a relight reads 4 bytes per element, not a mesh node.
+    pub(super) element_surface: Vec<u32>,
 }
 
 impl Topology {
@@ -89,6 +93,32 @@ impl Topology {
             element: mesh.nodes.iter().map(|node| node.element).collect(),
             children: mesh.nodes.iter().map(|node| node.children).collect(),
             patch_elements,
+            element_surface: (0..mesh.elements.len())
+                .map(|e| mesh.element_node(e).surface)
+                .collect(),
         }
+    }
+
+    /// ρ_d per element of `mesh` (which has this topology's geometry): a per-element value
+    /// where one is set ([`Mesh::set_element_reflectances`]), else its surface's — the same
+    /// values as [`Mesh::element_reflectance_rgb`], without reading the mesh nodes.
+    pub(super) fn element_reflectances(&self, mesh: &Mesh) -> Vec<Rgb> {
+        let own = mesh.node_reflectance_rgb.as_deref();
+        self.element_surface
+            .iter()
+            .zip(&mesh.elements)
+            .map(|(&s, &n)| {
+                own.and_then(|r| r[n as usize])
+                    .unwrap_or(mesh.surfaces[s as usize].reflectance_rgb)
+            })
+            .collect()
+    }
+
+    /// Emitted exitance π·L_e per element of `mesh` (its surface's).
+    pub(super) fn element_emissions(&self, mesh: &Mesh) -> Vec<Rgb> {
+        self.element_surface
+            .iter()
+            .map(|&s| mesh.surfaces[s as usize].emission_rgb)
+            .collect()
     }
 }

@@ -54,7 +54,9 @@ use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
 use super::shooting::{ShootScratch, ShotGroup, shoot};
 use super::sky_transfer::SkyTransfer;
-use super::solve::{GroundTerm, group_direct, initial_exitance, sun_directions};
+use super::solve::{
+    GroundTerm, group_direct, initial_exitance, initial_exitance_from, sun_directions,
+};
 use super::source_rows::SourceRows;
 use super::sources::{self, DirectSamples, LightWarning};
 pub use super::sweeps::Sweep;
@@ -142,6 +144,8 @@ pub struct Transfer {
     /// The shooting's buffers, kept between relights.
     scratch: ShootScratch,
     topology: Topology,
+    /// ρ_d per element of the solution's mesh, kept current by every relight that changes it.
+    element_rho: Vec<Rgb>,
     ground: Option<GroundTerm>,
     /// Material index per mesh surface, and the material names.
     surface_material: Vec<usize>,
@@ -304,6 +308,7 @@ impl Transfer {
         let source_rows = SourceRows::new(mesh.nodes.len(), &hierarchy.links);
         let topology = Topology::new(&mesh);
         let patch_links = source_rows.patch_links(&topology.patch_ranges);
+        let element_rho = topology.element_reflectances(&mesh);
         Ok(Self {
             tracer,
             params: params.clone(),
@@ -312,6 +317,7 @@ impl Transfer {
             patch_links,
             scratch: ShootScratch::default(),
             topology,
+            element_rho,
             ground,
             surface_material,
             material_names,
@@ -542,8 +548,7 @@ impl Transfer {
             }
         }
         // Nothing fails past this point: commit.
-        let old_rho: Option<Vec<Rgb>> =
-            (reflectance.is_some() || element_mesh.is_some()).then(|| self.element_reflectance());
+        let material_changed = reflectance.is_some() || element_mesh.is_some();
         if let Some(mesh) = element_mesh {
             self.solution.mesh = Arc::new(mesh);
         }
@@ -553,8 +558,11 @@ impl Transfer {
                 s.reflectance_rgb = r;
             }
         }
-        let material_changed = old_rho.is_some();
-        let new_rho = self.element_reflectance();
+        let old_rho: Option<Vec<Rgb>> = material_changed.then(|| {
+            let new = self.topology.element_reflectances(&self.solution.mesh);
+            std::mem::replace(&mut self.element_rho, new)
+        });
+        let new_rho = &self.element_rho;
         let mut solution_warnings: Vec<LightWarning> = self
             .solution
             .warnings
@@ -596,8 +604,9 @@ impl Transfer {
                 group.convergence.clear();
                 continue;
             }
-            let mesh = &self.solution.mesh;
-            let b0_new = initial_exitance(mesh, &group.direct_irradiance_rgb, emission);
+            let emitted = emission.then(|| self.topology.element_emissions(&self.solution.mesh));
+            let b0_new =
+                initial_exitance_from(new_rho, &group.direct_irradiance_rgb, emitted.as_deref());
             if b0_new.iter().flatten().all(|&v| v == 0.0) {
                 // A dark group (sun down, sky off, light off): B = 0 exactly.
                 group.radiosity_rgb.clone_from(&b0_new);
@@ -641,7 +650,7 @@ impl Transfer {
             let results = shoot(
                 &self.topology,
                 &self.source_rows,
-                &new_rho,
+                new_rho,
                 shot,
                 &self.params.solve.stop,
                 &self.patch_links,
@@ -660,7 +669,7 @@ impl Transfer {
                     &self.solution.mesh,
                     &self.rows,
                     &self.topology,
-                    &new_rho,
+                    new_rho,
                     &b0_new,
                     &start,
                     &group.name,
@@ -687,12 +696,5 @@ impl Transfer {
             .filter(|&n| mesh.object_name(n) == object)
             .map(|n| self.source_rows.row_len(n))
             .sum()
-    }
-
-    fn element_reflectance(&self) -> Vec<Rgb> {
-        let mesh = &self.solution.mesh;
-        (0..mesh.elements.len())
-            .map(|e| mesh.element_reflectance_rgb(e))
-            .collect()
     }
 }
