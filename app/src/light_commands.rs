@@ -28,6 +28,13 @@ pub enum LightCommand {
     SetLighting(Box<Lighting>),
     /// Sets `[render] exposure`.
     SetExposure(f64),
+    /// Sets `[render] radiosity` (sky and interreflected light from the site's radiosity
+    /// solutions) and `[render] photo_reflectance` (the photographed surfaces' ρ_d read off the
+    /// photo in that mode).
+    SetRadiosity {
+        radiosity: bool,
+        photo_reflectance: bool,
+    },
     /// Sets (or clears) a photo's capture time `taken_at`.
     SetTakenAt {
         photo: String,
@@ -51,6 +58,14 @@ impl LightCommand {
             Self::SetLocation(_) => "site location".into(),
             Self::SetLighting(_) => "lighting".into(),
             Self::SetExposure(e) => format!("exposure {e}"),
+            Self::SetRadiosity {
+                radiosity,
+                photo_reflectance,
+            } => match (radiosity, photo_reflectance) {
+                (false, _) => "radiosity off".into(),
+                (true, true) => "radiosity on, reflectance from the photo".into(),
+                (true, false) => "radiosity on, library reflectance".into(),
+            },
             Self::SetTakenAt { photo, .. } => format!("capture time of {photo}"),
             Self::PutLuminaire { luminaire, .. } => format!("luminaire {}", luminaire.id),
             Self::RemoveLuminaire { id } => format!("remove luminaire {id}"),
@@ -73,6 +88,16 @@ pub fn apply(site: &mut Site, command: LightCommand) -> Result<LightCommand, Lig
         LightCommand::SetExposure(e) => {
             LightCommand::SetExposure(std::mem::replace(&mut site.render.exposure, e))
         }
+        LightCommand::SetRadiosity {
+            radiosity,
+            photo_reflectance,
+        } => LightCommand::SetRadiosity {
+            radiosity: std::mem::replace(&mut site.render.radiosity, radiosity),
+            photo_reflectance: std::mem::replace(
+                &mut site.render.photo_reflectance,
+                photo_reflectance,
+            ),
+        },
         LightCommand::SetTakenAt { photo, taken_at } => {
             let p = site
                 .photos
@@ -173,6 +198,10 @@ mod tests {
             }))),
             LightCommand::SetLighting(Box::new(lighting)),
             LightCommand::SetExposure(2.0),
+            LightCommand::SetRadiosity {
+                radiosity: !original.render.radiosity,
+                photo_reflectance: !original.render.photo_reflectance,
+            },
             LightCommand::SetTakenAt {
                 photo: "P1".into(),
                 taken_at: Some("2024-06-21T15:00".into()),
@@ -192,6 +221,11 @@ mod tests {
             inverses.push(apply(&mut s, c).expect("applies"));
         }
         assert_eq!(s.render.exposure, 2.0);
+        assert_eq!(s.render.radiosity, !original.render.radiosity);
+        assert_eq!(
+            s.render.photo_reflectance,
+            !original.render.photo_reflectance
+        );
         assert_eq!(
             s.luminaires
                 .iter()

@@ -4,7 +4,8 @@
 //! edits survive a kill (autosave) and undo restores the site; bad input (unknown zone,
 //! latitude out of range, non-finite number, unreadable photometric file) shows a message in
 //! the panel and changes nothing; a drag of the time slider is one undo step; a luminaire is
-//! added, placed by a click on the photo, dimmed, and saved as expected.
+//! added, placed by a click on the photo, dimmed, and saved as expected; the radiosity switches
+//! are undoable edits of the render settings.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -420,4 +421,44 @@ fn a_luminaire_is_added_placed_by_a_click_dimmed_and_saved() {
     }
     assert_eq!(site_of(&h).luminaires, solved.luminaires);
     assert_eq!(site_of(&h), solved);
+}
+
+/// The radiosity switches of the tab set `[render] radiosity` and `[render] photo_reflectance`
+/// (what `photomontage render` reads) as undoable edits; the photo's reflectance can only be
+/// switched while the radiosity mode is on.
+#[test]
+fn the_radiosity_switches_are_undoable_edits_of_the_render_settings() {
+    let (_dir, site) = copy_sample();
+    let original = SiteDocument::load(&site).unwrap().site;
+    let mut h = open_tab(&site);
+    let (radiosity, photo) = (original.render.radiosity, original.render.photo_reflectance);
+    if radiosity {
+        click(&mut h, "radiosity");
+        assert!(!site_of(&h).render.radiosity, "switched off");
+    }
+    // Off: the photo's reflectance is greyed out, a click changes nothing.
+    let before = site_of(&h);
+    click(&mut h, "reflectance from the photo");
+    assert_eq!(
+        site_of(&h),
+        before,
+        "disabled while the radiosity mode is off"
+    );
+    click(&mut h, "radiosity");
+    let s = site_of(&h);
+    assert!(s.render.radiosity);
+    assert_eq!(
+        s.render.photo_reflectance, photo,
+        "unchanged by the mode switch"
+    );
+    click(&mut h, "reflectance from the photo");
+    let s = site_of(&h);
+    assert!(s.render.radiosity);
+    assert_eq!(s.render.photo_reflectance, !photo);
+    assert!(h.state().autosave_pending(), "an edit to save");
+    // Every switch is one undo step.
+    for _ in 0..if radiosity { 3 } else { 2 } {
+        undo(&mut h);
+    }
+    assert_eq!(site_of(&h), original);
 }

@@ -514,6 +514,30 @@ impl LightPanel {
                 }
             }
         });
+        let render = &doc.site.render;
+        let (mut radiosity, mut photo_reflectance) = (render.radiosity, render.photo_reflectance);
+        ui.horizontal(|ui| {
+            let r = ui
+                .checkbox(&mut radiosity, "radiosity")
+                .on_hover_text("sky and interreflected light from radiosity solutions of the site with and without the planned objects (CLI: render --radiosity)");
+            name_widget(ui, &r, "radiosity");
+            let r = ui
+                .add_enabled(
+                    radiosity,
+                    egui::Checkbox::new(&mut photo_reflectance, "reflectance from the photo"),
+                )
+                .on_hover_text("the photographed surfaces take their diffuse reflectance from the photo's pixels where it sees them, else from the material library");
+            name_widget(ui, &r, "reflectance from the photo");
+        });
+        if (radiosity, photo_reflectance) != (render.radiosity, render.photo_reflectance) {
+            out.push(edit(
+                LightCommand::SetRadiosity {
+                    radiosity,
+                    photo_reflectance,
+                },
+                None,
+            ));
+        }
     }
 }
 

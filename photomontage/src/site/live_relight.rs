@@ -206,6 +206,8 @@ pub struct SiteTransfers {
     without_artificial: Kept,
     /// Fingerprints of the two scenes with their parameters.
     fingerprint: [u64; 2],
+    /// The view whose photo gave the natural elements their ρ_d (`None`: the library's).
+    photo_view: Option<String>,
     light: Arc<RadiosityLight>,
     /// The build's report (element size, element counts, notes).
     pub report: RadiosityReport,
@@ -279,7 +281,9 @@ impl SiteTransfers {
     ) -> Result<Self, SiteRenderError> {
         let start = Instant::now();
         let inputs = inputs(doc, scene, view)?;
-        Self::from_inputs(inputs, photo, cancel, start)
+        let mut built = Self::from_inputs(inputs, photo, cancel, start)?;
+        built.photo_view = photo.map(|_| view.to_owned());
+        Ok(built)
     }
 
     /// [`SiteTransfers::build`] for a scene and lighting given directly (benches, tests):
@@ -398,6 +402,7 @@ impl SiteTransfers {
                 scene_fingerprint(&scenes[0], &params),
                 scene_fingerprint(&scenes[1], &params),
             ],
+            photo_view: None,
             with_artificial,
             without_artificial,
             light,
@@ -436,7 +441,8 @@ impl SiteTransfers {
     /// (module doc), or builds them again when that cannot be expressed as a relight; `slot`
     /// holds the transfers between calls (`None` builds). A build with `photo` gives the
     /// natural elements it sees their ρ_d from it, as [`super::render_radiosity`] does; a relight
-    /// keeps them.
+    /// keeps them. Switching the photo's reflectances on or off, or to another view's photo,
+    /// builds again.
     ///
     /// # Errors
     /// As [`SiteTransfers::build`]; a relight error. On error `slot` is emptied (the next call
@@ -451,7 +457,10 @@ impl SiteTransfers {
     ) -> Result<(Arc<RadiosityLight>, RelightReport), SiteRenderError> {
         let start = Instant::now();
         let inputs = inputs(doc, scene, view)?;
-        if let Some(kept) = slot.as_mut() {
+        // Reflectances read off another photo (or none where the photo's are wanted, or the
+        // other way round) are not a relight: build again.
+        let photo_view = photo.map(|_| view.to_owned());
+        if let Some(kept) = slot.as_mut().filter(|k| k.photo_view == photo_view) {
             match kept.relight(&inputs) {
                 Ok(Some(update)) => {
                     return Ok((
@@ -470,7 +479,8 @@ impl SiteTransfers {
             }
         }
         *slot = None;
-        let built = Self::from_inputs(inputs, photo, cancel, start)?;
+        let mut built = Self::from_inputs(inputs, photo, cancel, start)?;
+        built.photo_view = photo_view;
         let light = built.light();
         *slot = Some(built);
         Ok((

@@ -226,4 +226,25 @@ fn a_build_with_the_photo_takes_its_reflectances_as_the_render_does() {
     let (plain, plain_report) = site_radiosity_light(&doc, scene, "p1", None, &cancel).unwrap();
     assert!(plain_report.photo_reflectance.is_none());
     assert!(plain.without_artificial.mesh.node_reflectance_rgb.is_none());
+    // The kept transfers follow a switch of the photo's reflectances (a build each way), and
+    // the same photo again is no change.
+    let update = |slot: &mut Option<SiteTransfers>, photo| {
+        SiteTransfers::update(slot, &doc, scene, "p1", photo, &cancel)
+            .unwrap()
+            .1
+            .update
+    };
+    assert_eq!(update(&mut slot, Some(&photo)), TransferUpdate::Unchanged);
+    assert_eq!(update(&mut slot, None), TransferUpdate::Built);
+    let kept = slot.as_ref().unwrap();
+    assert!(kept.report.photo_reflectance.is_none());
+    assert!(
+        kept.without_artificial()
+            .mesh
+            .node_reflectance_rgb
+            .is_none()
+    );
+    assert_eq!(update(&mut slot, None), TransferUpdate::Unchanged);
+    assert_eq!(update(&mut slot, Some(&photo)), TransferUpdate::Built);
+    assert!(slot.as_ref().unwrap().report.photo_reflectance.is_some());
 }
