@@ -404,7 +404,7 @@ fn choose_patches(
             })
             .collect();
         let mut order: Vec<usize> = (0..n).filter(|&p| worth[p] > 0.0).collect();
-        order.sort_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
+        order.sort_unstable_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
         for p in order {
             if need.iter().all(|&v| v <= 0.0) {
                 break;
@@ -426,7 +426,9 @@ fn choose_patches(
         .map(|p| score[p] / patch_links[p].max(1) as f64)
         .collect();
     let mut order: Vec<usize> = (0..n).filter(|&p| score[p] > 0.0).collect();
-    order.sort_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
+    // Ties are broken by the patch index, a strict total order: the unstable sort gives the one
+    // order a stable sort would.
+    order.sort_unstable_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
     for p in order {
         if left <= keep {
             break;
