@@ -685,6 +685,17 @@ impl Transfer {
         self.lighting = lighting;
         self.solution.warnings = solution_warnings;
         self.solution.locator = std::sync::OnceLock::new();
+        // The kept ρ is derived state: in test builds, check it bit for bit against the mesh's
+        // own lookup.
+        debug_assert!(
+            (0..self.element_rho.len()).all(|e| self.element_rho[e].map(f64::to_bits)
+                == self
+                    .solution
+                    .mesh
+                    .element_reflectance_rgb(e)
+                    .map(f64::to_bits)),
+            "the transfer's ρ per element follows its mesh"
+        );
         Ok(())
     }
 
