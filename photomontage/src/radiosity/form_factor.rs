@@ -188,6 +188,8 @@ pub struct FormFactorEngine<'a> {
     mesh: &'a Mesh,
     tracer: &'a SceneTracer,
     params: FormFactorParams,
+    /// Per element, the random stream of its direct-light sample points (`None`: its index).
+    direct_streams: Option<&'a [u64]>,
 }
 
 impl<'a> FormFactorEngine<'a> {
@@ -205,7 +207,29 @@ impl<'a> FormFactorEngine<'a> {
             mesh,
             tracer,
             params,
+            direct_streams: None,
         })
+    }
+
+    /// The same engine drawing element e's direct-light sample points
+    /// ([`super::sources::DirectSamples`]) from stream `streams[e]` instead of e, so that
+    /// elements of two meshes trace the same rays ([`super::twin`]).
+    ///
+    /// # Panics
+    /// When `streams` does not have one entry per element.
+    #[must_use]
+    pub fn with_direct_streams(mut self, streams: Option<&'a [u64]>) -> Self {
+        if let Some(s) = streams {
+            assert_eq!(s.len(), self.mesh.elements.len(), "one stream per element");
+        }
+        self.direct_streams = streams;
+        self
+    }
+
+    /// The random stream of element `e`'s direct-light sample points.
+    #[must_use]
+    pub fn direct_stream(&self, e: usize) -> u64 {
+        self.direct_streams.map_or(e as u64, |s| s[e])
     }
 
     /// The mesh.

@@ -52,6 +52,14 @@ use super::form_factor::{FormFactorEngine, in_front};
 use super::mesh::Mesh;
 use super::{RadiosityError, Rgb, luminance};
 
+/// An upper bound of an unoccluded point-to-triangle factor with round-off: the exact factor is
+/// at most 1 (the clipped triangle's gnomonic image is a convex spherical polygon, whose
+/// projected solid angle is at most π); its computed value errs by ~1e-15.
+const ESTIMATE_BOUND: f64 = 1.0 + 1e-6;
+
+/// A link's estimate not yet computed (factors are ≥ 0).
+const UNKNOWN: f64 = -1.0;
+
 /// Hierarchical-solver tunables.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HierarchicalParams {
@@ -236,6 +244,9 @@ impl Hierarchy {
             refinement: Vec::new(),
         };
         hierarchy.sort();
+        // Per link, its unoccluded estimate once computed (`UNKNOWN` before): a pure function of
+        // the link's nodes, kept between the refinement passes.
+        let mut estimates = vec![UNKNOWN; hierarchy.links.len()];
         let mut state = State {
             b: initial_node_b(mesh, b0_all),
         };
@@ -249,7 +260,7 @@ impl Hierarchy {
             previous_mean = Some(mean);
             on_pass(&row);
             let refined = if hierarchy.links.len() < params.max_links {
-                hierarchy.refine_bf(engine, params, &state, mean)
+                hierarchy.refine_bf(engine, params, &state, mean, &mut estimates)
             } else {
                 0
             };
@@ -280,39 +291,66 @@ impl Hierarchy {
     }
 
     /// Replaces links failing the BF test by links to the children of the larger node; returns
-    /// how many were replaced.
+    /// how many were replaced. The test of each link reads that link alone, so the links are
+    /// tested in parallel and then rebuilt in their order: the same links on any number of
+    /// threads.
     fn refine_bf(
         &mut self,
         engine: &FormFactorEngine<'_>,
         params: &HierarchicalParams,
         state: &State,
         mean: f64,
+        estimates: &mut Vec<f64>,
     ) -> usize {
         let mesh = engine.mesh();
         let threshold = params.bf_tolerance * mean;
+        let tests: Vec<(Option<bool>, f64)> = self
+            .links
+            .par_iter()
+            .zip(estimates.par_iter())
+            .map(|(link, &known)| {
+                let rho = mesh.reflectance_rgb(link.receiver as usize);
+                let bs = &state.b[link.source as usize];
+                let rho_b = (0..3).map(|c| rho[c] * bs[c]).fold(0.0, f64::max);
+                // The transport ρ·B·max(F, estimate) > threshold, as max(ρ·B·F, ρ·B·estimate)
+                // (a product of non-negative factors is monotone, so the two are equal bit for
+                // bit). A link whose samples were all occluded may still be partly visible from
+                // its children: the test uses the unoccluded centroid estimate as well (on a
+                // mesh refined at corners, the largest point factor over the receiver: module
+                // doc). The estimate, the costly part, is computed only when ρ·B·F alone does
+                // not decide and a point factor (≤ 1; [`ESTIMATE_BOUND`] with round-off) could,
+                // and only once per link.
+                let over = |f: f64| rho_b * f > threshold;
+                let mut estimate = known;
+                let split_needed = over(link.form_factor)
+                    || (over(ESTIMATE_BOUND) && {
+                        if estimate == UNKNOWN {
+                            estimate = if mesh.corner_refined {
+                                engine.largest_estimate(link.receiver, link.source)
+                            } else {
+                                engine.centroid_estimate(link.receiver, link.source)
+                            };
+                        }
+                        over(estimate)
+                    });
+                let split = if split_needed {
+                    split_receiver(mesh, link.receiver, link.source)
+                } else {
+                    None
+                };
+                (split, estimate)
+            })
+            .collect();
         let mut keep = Vec::with_capacity(self.links.len());
+        let mut kept_estimates = Vec::with_capacity(self.links.len());
         let mut new_pairs = Vec::new();
         let mut refined = 0;
-        for link in &self.links {
-            let rho = mesh.reflectance_rgb(link.receiver as usize);
-            let bs = &state.b[link.source as usize];
-            // A link whose samples were all occluded may still be partly visible from its
-            // children: the test uses the unoccluded centroid estimate as well (on a mesh
-            // refined at corners, the largest point factor over the receiver: module doc).
-            let estimate = if mesh.corner_refined {
-                engine.largest_estimate(link.receiver, link.source)
-            } else {
-                engine.centroid_estimate(link.receiver, link.source)
-            };
-            let form_factor = link.form_factor.max(estimate);
-            let transport = (0..3).map(|c| rho[c] * bs[c]).fold(0.0, f64::max) * form_factor;
-            let split = if transport > threshold {
-                split_receiver(mesh, link.receiver, link.source)
-            } else {
-                None
-            };
+        for (link, (split, estimate)) in self.links.iter().zip(tests) {
             match split {
-                None => keep.push(*link),
+                None => {
+                    keep.push(*link);
+                    kept_estimates.push(estimate);
+                }
                 Some(true) => {
                     refined += 1;
                     for c in children(mesh, link.receiver) {
@@ -333,8 +371,14 @@ impl Hierarchy {
         }
         if refined > 0 {
             keep.extend(accurate_links(engine, &new_pairs));
-            self.links = keep;
-            self.sort();
+            kept_estimates.resize(keep.len(), UNKNOWN);
+            // By receiver, as `sort`, with each link's estimate beside it (a stable sort: the
+            // same order as `sort`).
+            let mut paired: Vec<(Link, f64)> = keep.into_iter().zip(kept_estimates).collect();
+            paired.sort_by_key(|(l, _)| l.receiver);
+            (self.links, *estimates) = paired.into_iter().unzip();
+        } else {
+            *estimates = kept_estimates;
         }
         refined
     }
@@ -551,5 +595,56 @@ mod tests {
         h.drop_occluded();
         let expected: Vec<Link> = links.into_iter().filter(|l| l.source % 5 != 0).collect();
         assert_eq!(h.links, expected);
+    }
+
+    /// The refinement test skips the estimate when even a factor of [`ESTIMATE_BOUND`] could
+    /// not pass it: every computed point factor stays under that bound, here for seeded random
+    /// triangles seen from points near and far, at grazing angles and next to a contact
+    /// (the point on an edge's extension, a hemisphere nearly filled).
+    #[test]
+    fn point_factors_stay_under_the_refinement_bound() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        let mut largest = 0.0_f64;
+        for i in 0..200_000 {
+            let scale = [1e-3, 1.0, 1e3][i % 3];
+            let mut p = || Point3::new(rng.random::<f64>(), rng.random(), rng.random()) * scale;
+            let tri = [p(), p(), p()];
+            let tri_normal = (tri[1] - tri[0]).cross(&(tri[2] - tri[0]));
+            if tri_normal.norm() < 1e-12 * scale * scale {
+                continue;
+            }
+            let tri_normal = tri_normal.normalize();
+            // A point just in front of the triangle (a nearly filled hemisphere) or anywhere.
+            let x = if i % 2 == 0 {
+                let w = [rng.random::<f64>(), rng.random::<f64>()];
+                let (u, v) = if w[0] + w[1] > 1.0 {
+                    (1.0 - w[0], 1.0 - w[1])
+                } else {
+                    (w[0], w[1])
+                };
+                tri[0]
+                    + (tri[1] - tri[0]) * u
+                    + (tri[2] - tri[0]) * v
+                    + tri_normal * (scale * 10f64.powf(-6.0 * rng.random::<f64>()))
+            } else {
+                Point3::new(rng.random::<f64>(), rng.random(), rng.random()) * (2.0 * scale)
+            };
+            let n = Vector3::new(
+                rng.random::<f64>() - 0.5,
+                rng.random::<f64>() - 0.5,
+                rng.random::<f64>() - 0.5,
+            );
+            let n = if i % 4 == 0 {
+                -tri_normal
+            } else {
+                n.normalize()
+            };
+            let f = super::super::form_factor::point_to_triangle(&x, &n, &tri, &tri_normal);
+            largest = largest.max(f);
+        }
+        assert!(largest <= ESTIMATE_BOUND, "largest point factor {largest}");
+        // The configurations do reach factors near 1 (the bound is tested where it matters).
+        assert!(largest > 0.99, "largest point factor {largest}");
     }
 }

@@ -64,6 +64,7 @@ mod sweeps;
 mod topology;
 pub mod transfer;
 pub mod transfer_lighting;
+pub mod twin;
 pub mod vertex_gather;
 
 #[cfg(test)]
@@ -82,14 +83,17 @@ mod solver_tests;
 pub(crate) mod test_scenes;
 #[cfg(test)]
 mod transfer_tests;
+#[cfg(test)]
+mod twin_tests;
 
 pub use convergence::{ConvergenceRow, StopRule};
 pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning, Refinement};
 pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
+pub use sky_transfer::SkyRays;
 pub use solve::{
     GroupSolution, LightGroup, RadiosityDifference, Refit, SkyLight, Solution, SolveParams, Solver,
-    solve, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
+    solve, solve_on_mesh, solve_on_mesh_refitting, solve_on_mesh_twinned, sun_directions,
 };
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 pub use transfer::{

@@ -28,9 +28,19 @@ use rayon::prelude::*;
 use super::form_factor::FormFactorEngine;
 use super::source_rows::{Simd, simd_token};
 use super::sources::{DIRECT_RAY_LENGTH_M, DIRECT_RAY_OFFSET_M, DirectSamples, sky_leaf_flux};
+use super::twin::Twin;
 use super::{RadiosityError, Rgb};
 use crate::sky::SkyModel;
 use crate::sky_dome::icosahedral::IcosahedralDome;
+
+/// The sky transfer a natural solve traced, kept for the solve of the scene with the planned
+/// objects ([`super::twin`]).
+#[derive(Debug, Clone)]
+pub struct SkyRays {
+    /// The light group it was traced for (its sample points' random streams).
+    pub(super) group: usize,
+    pub(super) transfer: SkyTransfer,
+}
 
 /// The sky's visibility transfer of one mesh (module doc).
 #[derive(Debug, Clone)]
@@ -43,7 +53,7 @@ pub(crate) struct SkyTransfer {
     inv_rays: Vec<f64>,
     /// Per element and facet (element-major, padded with zeros to whole [`LANES`]), the rays
     /// that escaped.
-    escaped: Vec<u8>,
+    pub(super) escaped: Vec<u8>,
     /// Per element, its unit normal.
     normals: Vec<Vector3<f64>>,
 }
@@ -57,6 +67,23 @@ impl SkyTransfer {
         engine: &FormFactorEngine<'_>,
         samples: &DirectSamples,
         dome: &IcosahedralDome,
+    ) -> Self {
+        Self::beside(engine, samples, dome, None)
+    }
+
+    /// [`SkyTransfer::new`] of group `group` for the mesh with the planned objects, reading the
+    /// escaped counts of each element's twin in the natural transfer `natural` where `twin`
+    /// gives one ([`super::twin`]): the same counts as tracing every ray in the whole scene.
+    /// `engine` must draw its sample points from the twins' streams ([`Twin::new`]). A natural
+    /// transfer traced for another group, dome or sample count is not used.
+    ///
+    /// # Panics
+    /// As [`SkyTransfer::new`].
+    pub(crate) fn beside(
+        engine: &FormFactorEngine<'_>,
+        samples: &DirectSamples,
+        dome: &IcosahedralDome,
+        twin: Option<(&Twin<'_>, &SkyRays, usize)>,
     ) -> Self {
         let mesh = engine.mesh();
         let tracer = engine.tracer();
@@ -102,11 +129,38 @@ impl SkyTransfer {
                     .min(usize::from(u8::MAX))
             })
             .collect();
+        #[allow(clippy::cast_precision_loss)]
+        let inv_rays: Vec<f64> = rays.iter().map(|&r| 1.0 / r as f64).collect();
+        // The twin's transfer, where it was traced for this group on the same dome with the
+        // same rays per facet.
+        let twin = twin.filter(|(t, natural, group)| {
+            natural.group == *group
+                && t.twin_of.len() == mesh.elements.len()
+                && natural.transfer.dome.nodes.len() == dome.nodes.len()
+                && natural.transfer.inv_rays == inv_rays
+        });
         let escaped: Vec<u8> = (0..mesh.elements.len())
             .into_par_iter()
             .flat_map_iter(|e| {
                 let node = mesh.element_node(e);
                 let points_of_e = samples.of_element(e);
+                // The twin's escaped counts per facet, and the planned objects' tracer.
+                let twin_counts = twin.and_then(|(t, natural, _)| {
+                    t.twin_of[e].map(|w| {
+                        let w = w as usize;
+                        let centre = node.centroid_in_world_m();
+                        let radius = node
+                            .vertices_in_world_m
+                            .iter()
+                            .map(|v| (v - centre).norm())
+                            .fold(0.0, f64::max);
+                        (
+                            &natural.transfer.escaped[w * padded..w * padded + f_count],
+                            t,
+                            t.cone_towards_artificial(&centre, radius),
+                        )
+                    })
+                });
                 facets
                     .iter()
                     .enumerate()
@@ -115,8 +169,27 @@ impl SkyTransfer {
                         if node.normal_in_world.dot(&dir) <= reach[f] {
                             return 0;
                         }
+                        // None escaped the natural scene: none escapes with more in it; all
+                        // escaped: only the planned objects can stop them (module doc of
+                        // `twin`); else every ray in the whole scene.
+                        let (blockers, twin) = match twin_counts {
+                            Some((counts, _, _)) if counts[f] == 0 => return 0,
+                            Some((counts, t, cone)) if usize::from(counts[f]) == rays[f] => {
+                                // All escaped the natural scene; outside the cone towards the
+                                // planned objects they escape the whole scene too.
+                                if cone.is_some_and(|(axis, cos)| axis.dot(&dir) < cos) {
+                                    return counts[f];
+                                }
+                                (t.artificial, Some(t))
+                            }
+                            _ => (tracer, None),
+                        };
                         let mut hits = 0u8;
                         for k in (f % points..points).step_by(f_count).take(rays[f]) {
+                            if twin.is_some_and(|t| !t.may_meet_artificial(&points_of_e[k], &dir)) {
+                                hits += 1;
+                                continue;
+                            }
                             #[allow(clippy::cast_possible_truncation)]
                             let ray = tracer.ray_from_world(
                                 &points_of_e[k],
@@ -124,7 +197,7 @@ impl SkyTransfer {
                                 DIRECT_RAY_OFFSET_M as f32,
                                 DIRECT_RAY_LENGTH_M,
                             );
-                            if !visibility || !tracer.any_hit(&ray) {
+                            if !visibility || !blockers.any_hit(&ray) {
                                 hits += 1;
                             }
                         }
@@ -134,8 +207,6 @@ impl SkyTransfer {
                     .collect::<Vec<u8>>()
             })
             .collect();
-        #[allow(clippy::cast_precision_loss)]
-        let inv_rays = rays.iter().map(|&r| 1.0 / r as f64).collect();
         Self {
             dome: dome.clone(),
             leaves: facets
@@ -266,7 +337,7 @@ fn escaped_lanes(hits: &[u8], weights: &[[f32; LANES]]) -> [f32; LANES] {
 }
 
 /// Partial sums per element in the facet sum.
-const LANES: usize = 8;
+pub(super) const LANES: usize = 8;
 
 #[cfg(test)]
 mod tests {

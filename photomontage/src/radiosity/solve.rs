@@ -10,8 +10,10 @@ use super::form_factor::{FormFactorEngine, FormFactorParams};
 use super::hierarchical::{HierarchicalParams, Hierarchy};
 use super::mesh::{Mesh, MeshParams};
 use super::progressive::RowCache;
+use super::sky_transfer::SkyRays;
 use super::sky_transfer::SkyTransfer;
 use super::sources::{self, DistantSource, GroundBelowHorizon, LightWarning, PointSource};
+use super::twin::Twin;
 use super::{RadiosityError, Rgb, direct, progressive};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
@@ -386,7 +388,7 @@ pub type Refit<'a> = dyn FnMut(&Solution) -> Option<Vec<Option<Rgb>>> + 'a;
 /// the hierarchical one; [`RadiosityError::ElementReflectance`] for a refit value out of range.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_on_mesh_refitting(
-    mut mesh: Mesh,
+    mesh: Mesh,
     tracer: &SceneTracer,
     groups: &[LightGroup],
     params: &SolveParams,
@@ -395,6 +397,34 @@ pub fn solve_on_mesh_refitting(
     refit: &mut Refit<'_>,
     rounds: usize,
 ) -> Result<Solution, RadiosityError> {
+    solve_on_mesh_twinned(
+        mesh, tracer, groups, params, cancel, on_pass, refit, rounds, None,
+    )
+    .map(|(solution, _)| solution)
+}
+
+/// [`solve_on_mesh_refitting`] keeping the sky rays it traced ([`SkyRays`], for a later solve
+/// of the scene with planned objects added), and with `twin`, reading those of the natural
+/// scene's solve for the elements it shares with it ([`super::twin`]: the same rays, traced
+/// once). Without a twin the solution is [`solve_on_mesh_refitting`]'s, bit for bit.
+///
+/// # Errors
+/// As [`solve_on_mesh_refitting`].
+///
+/// # Panics
+/// When `twin` was made for another mesh (another element count).
+#[allow(clippy::too_many_arguments)]
+pub fn solve_on_mesh_twinned(
+    mut mesh: Mesh,
+    tracer: &SceneTracer,
+    groups: &[LightGroup],
+    params: &SolveParams,
+    cancel: &AtomicBool,
+    on_pass: &dyn Fn(&ConvergenceRow),
+    refit: &mut Refit<'_>,
+    rounds: usize,
+    twin: Option<(&Twin<'_>, &SkyRays)>,
+) -> Result<(Solution, Option<SkyRays>), RadiosityError> {
     if rounds > 0 && !matches!(params.solver, Solver::Hierarchical(_)) {
         return Err(RadiosityError::InvalidParameter {
             name: "refit rounds",
@@ -405,12 +435,14 @@ pub fn solve_on_mesh_refitting(
     if params.form_factors.visibility {
         super::covered::mark_covered(&mut mesh, tracer, &params.form_factors);
     }
-    let engine = FormFactorEngine::new(&mesh, tracer, params.form_factors)?;
+    let engine = FormFactorEngine::new(&mesh, tracer, params.form_factors)?
+        .with_direct_streams(twin.map(|(t, _)| t.streams.as_slice()));
     let n = mesh.elements.len();
     let ground = GroundTerm::new(&engine, params.ground.as_ref())?;
     let mut directs = Vec::with_capacity(groups.len());
     let mut b0s = Vec::with_capacity(groups.len());
     let mut warnings = Vec::new();
+    let mut sky_rays: Option<SkyRays> = None;
     for (g, group) in groups.iter().enumerate() {
         warnings.extend(sources::check_point_sources(
             tracer,
@@ -418,7 +450,27 @@ pub fn solve_on_mesh_refitting(
             &group.points,
             &mesh.object_names,
         ));
-        let direct = group_direct(&engine, group, g as u64, ground.as_ref(), None, None)?;
+        let direct = if group.sky.is_some() && !group.sources.is_empty() && sky_rays.is_none() {
+            // The first sky's transfer, traced here as `group_direct` would trace it, to be
+            // kept (and, with a twin, from the twin's rays).
+            sources::validate(&group.name, &group.sources)?;
+            let samples = sources::DirectSamples::new(&engine, g as u64);
+            let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
+            let transfer =
+                SkyTransfer::beside(&engine, &samples, &dome, twin.map(|(t, sky)| (t, sky, g)));
+            let direct = group_direct(
+                &engine,
+                group,
+                g as u64,
+                ground.as_ref(),
+                Some(&samples),
+                Some(&transfer),
+            )?;
+            sky_rays = Some(SkyRays { group: g, transfer });
+            direct
+        } else {
+            group_direct(&engine, group, g as u64, ground.as_ref(), None, None)?
+        };
         b0s.push(initial_exitance(&mesh, &direct, group.emission));
         directs.push(direct);
     }
@@ -501,7 +553,7 @@ pub fn solve_on_mesh_refitting(
     for _ in 0..rounds {
         let probe = assemble(mesh, solved, directs.clone());
         let (Some(rho), Some(hierarchy)) = (refit(&probe), hierarchy.as_ref()) else {
-            return Ok(probe);
+            return Ok((probe, sky_rays));
         };
         mesh = Arc::unwrap_or_clone(probe.mesh);
         mesh.set_element_reflectances(&rho)?;
@@ -511,7 +563,7 @@ pub fn solve_on_mesh_refitting(
             solved.push(hierarchy.solve(&mesh, &b0, &group.name, &params.stop, cancel, on_pass)?);
         }
     }
-    Ok(assemble(mesh, solved, directs))
+    Ok((assemble(mesh, solved, directs), sky_rays))
 }
 
 /// The ground below the horizon, ready to apply: its unit-radiance transfer per element.

@@ -114,7 +114,7 @@ impl DirectSamples {
                 let node = mesh.element_node(e);
                 let mut rng =
                     ChaCha8Rng::seed_from_u64(params.seed ^ DIRECT_SEED_SALT ^ group_index);
-                rng.set_stream(e as u64);
+                rng.set_stream(engine.direct_stream(e));
                 #[allow(clippy::cast_precision_loss)]
                 (0..n * n)
                     .map(|k| {
@@ -602,7 +602,7 @@ pub fn point_irradiance(
         .map(|e| {
             let node = mesh.element_node(e);
             let mut rng = ChaCha8Rng::seed_from_u64(params.seed ^ DIRECT_SEED_SALT ^ group_index);
-            rng.set_stream(e as u64);
+            rng.set_stream(engine.direct_stream(e));
             let mut e_rgb = [0.0; 3];
             #[allow(clippy::cast_precision_loss)]
             for k in 0..n * n {

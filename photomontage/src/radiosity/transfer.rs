@@ -53,7 +53,7 @@ use super::form_factor::FormFactorEngine;
 use super::hierarchical::Hierarchy;
 use super::mesh::Mesh;
 use super::shooting::{ShootScratch, ShotGroup, shoot};
-use super::sky_transfer::SkyTransfer;
+use super::sky_transfer::{SkyRays, SkyTransfer};
 use super::solve::{
     GroundTerm, group_direct, initial_exitance, initial_exitance_from, sun_directions,
 };
@@ -64,6 +64,7 @@ use super::sweeps::{LinkRows, iterate};
 use super::topology::Topology;
 use super::transfer_lighting::check_rgb;
 pub use super::transfer_lighting::{LightingChange, NamedLuminaire, Sky, Sun, TransferLighting};
+use super::twin::{Twin, twin_elements};
 use super::{GroupSolution, LightGroup, RadiosityError, Rgb, Solution, SolveParams, Solver};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
@@ -160,7 +161,8 @@ pub struct Transfer {
     /// points, drawn once.
     direct_samples: Vec<Option<Arc<DirectSamples>>>,
     /// The sky's visibility per element and dome facet: a sky change is a sum, not a trace.
-    sky_transfer: SkyTransfer,
+    /// The sky group's transfer (group 1), lent to a twin build ([`super::twin`]).
+    sky_rays: SkyRays,
     solution: Solution,
 }
 
@@ -214,6 +216,26 @@ impl Transfer {
         cancel: &AtomicBool,
         on_pass: &dyn Fn(&ConvergenceRow),
     ) -> Result<Self, RadiosityError> {
+        Self::build_beside(scene, occluders, lighting, params, cancel, on_pass, None)
+    }
+
+    /// [`Transfer::build_shadowed_by`] for a scene that is `natural`'s scene plus the planned
+    /// objects `artificial` ([`super::twin`]): the elements it shares with `natural`'s mesh
+    /// draw their direct-light points from their twins' streams and read the twins' sky rays
+    /// (tracing only the planned objects' own). The twin is not used when the two tracers'
+    /// local frames differ or there is nothing planned.
+    ///
+    /// # Errors
+    /// As [`Transfer::build`].
+    pub fn build_beside(
+        scene: &Scene,
+        occluders: &[&SceneTracer],
+        lighting: &TransferLighting,
+        params: &TransferParams,
+        cancel: &AtomicBool,
+        on_pass: &dyn Fn(&ConvergenceRow),
+        natural: Option<(&Transfer, &Scene)>,
+    ) -> Result<Self, RadiosityError> {
         params.solve.stop.validate()?;
         let Solver::Hierarchical(h) = params.solve.solver else {
             return Err(RadiosityError::InvalidParameter {
@@ -236,7 +258,36 @@ impl Transfer {
         if params.solve.form_factors.visibility {
             super::covered::mark_covered(&mut mesh, &tracer, &params.solve.form_factors);
         }
-        let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?;
+        // The planned objects alone, in this tracer's frame, and each element's twin.
+        let artificial = match natural {
+            Some((t, artificial))
+                if t.tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m() =>
+            {
+                match artificial.bounding_box_in_world_m() {
+                    Some(bounds) => Some((
+                        t,
+                        SceneTracer::new_in_frame_of(artificial, BuildQuality::Medium, &tracer)?,
+                        bounds,
+                    )),
+                    None => None,
+                }
+            }
+            _ => None,
+        };
+        let twin = artificial.as_ref().map(|(t, a, bounds)| {
+            let natural_mesh = &t.solution.mesh;
+            (
+                Twin::new(
+                    twin_elements(natural_mesh, &mesh),
+                    natural_mesh.elements.len(),
+                    a,
+                    *bounds,
+                ),
+                &t.sky_rays,
+            )
+        });
+        let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?
+            .with_direct_streams(twin.as_ref().map(|(t, _)| t.streams.as_slice()));
         let ground = GroundTerm::new(&engine, params.solve.ground.as_ref())?;
         let n = mesh.elements.len();
         let mut directs = Vec::with_capacity(groups.len());
@@ -246,12 +297,13 @@ impl Transfer {
             .map(|g| (g < 2).then(|| Arc::new(DirectSamples::new(&engine, g as u64))))
             .collect();
         // Group 1's sample points (the sky's) are where the sky transfer looks from.
-        let sky_transfer = SkyTransfer::new(
+        let sky_transfer = SkyTransfer::beside(
             &engine,
             direct_samples[1]
                 .as_deref()
                 .unwrap_or_else(|| unreachable!("the sky group has sample points")),
             &dome,
+            twin.as_ref().map(|(t, sky)| (t, *sky, 1)),
         );
         for (g, group) in groups.iter().enumerate() {
             warnings.extend(sources::check_point_sources(
@@ -326,7 +378,10 @@ impl Transfer {
             groups,
             b0s,
             direct_samples,
-            sky_transfer,
+            sky_rays: SkyRays {
+                group: 1,
+                transfer: sky_transfer,
+            },
             solution: Solution {
                 mesh: Arc::new(mesh),
                 groups: solved,
@@ -524,7 +579,7 @@ impl Transfer {
             None => None,
         };
         let (new_groups, warnings) =
-            lighting.light_groups(self.sky_transfer.dome(), self.params.sky_tolerance)?;
+            lighting.light_groups(self.sky_rays.transfer.dome(), self.params.sky_tolerance)?;
         let actions = self.actions(&lighting);
         // Re-trace what needs it (only the changed groups' rays; never a form factor).
         let mut retraced: Vec<Option<Vec<Rgb>>> = vec![None; actions.len()];
@@ -542,7 +597,7 @@ impl Transfer {
                         g as u64,
                         self.ground.as_ref(),
                         self.direct_samples.get(g).and_then(Option::as_deref),
-                        Some(&self.sky_transfer),
+                        Some(&self.sky_rays.transfer),
                     )?);
                 }
             }

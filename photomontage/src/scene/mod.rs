@@ -157,6 +157,32 @@ impl Scene {
         &self.materials
     }
 
+    /// The objects of `kind` alone (every material, object names and triangle order kept): the
+    /// photographed state ([`ObjectKind::Natural`]) or the planned objects.
+    ///
+    /// # Errors
+    /// Id overflow (not reachable from a valid scene).
+    pub fn part_of_kind(&self, kind: ObjectKind) -> Result<Scene, SceneError> {
+        let mut out = Scene::new();
+        for m in &self.materials {
+            out.add_material(m.clone())?;
+        }
+        let mut ids = Vec::with_capacity(self.objects.len());
+        for o in &self.objects {
+            ids.push(if o.kind == kind {
+                Some(out.add_object(o.clone())?)
+            } else {
+                None
+            });
+        }
+        for t in &self.triangles {
+            if let Some(Some(id)) = ids.get(t.object.0 as usize) {
+                out.add_polygon(&t.vertices_in_world_m, t.material, *id)?;
+            }
+        }
+        Ok(out)
+    }
+
     /// Adds an object and returns its id.
     ///
     /// # Errors

@@ -72,6 +72,29 @@ impl SceneTracer {
                 0.0
             }
         });
+        Self::in_frame(scene, quality, local_origin_in_world_m)
+    }
+
+    /// [`SceneTracer::new`] in the local frame of `frame`: a ray made by either tracer from the
+    /// same world origin and direction is the same `f32` ray, and their triangles' `f32`
+    /// vertices are the same where the scenes share triangles (a part of a scene traced beside
+    /// the whole, `radiosity::twin`).
+    ///
+    /// # Errors
+    /// As [`SceneTracer::new`].
+    pub fn new_in_frame_of(
+        scene: &Scene,
+        quality: BuildQuality,
+        frame: &SceneTracer,
+    ) -> Result<Self, SceneError> {
+        Self::in_frame(scene, quality, frame.local_origin_in_world_m)
+    }
+
+    fn in_frame(
+        scene: &Scene,
+        quality: BuildQuality,
+        local_origin_in_world_m: Point3<f64>,
+    ) -> Result<Self, SceneError> {
         let to_local = |p: &Point3<f64>| local_from_world(&local_origin_in_world_m, p);
         let triangles: Vec<[Vec3A; 3]> = scene
             .triangles()

@@ -35,8 +35,11 @@ use super::SiteDocument;
 use super::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
-use super::render_radiosity::{RadiosityReport, natural_part, same_elements, site_solve_params};
+use super::render_radiosity::{
+    RadiosityReport, artificial_part, natural_part, same_elements, site_solve_params,
+};
 use crate::bvh::BuildQuality;
+use crate::radiosity::twin::twin_elements;
 use crate::radiosity::{
     LightingChange, RadiosityError, Solution, Transfer, TransferLighting, TransferParams,
 };
@@ -334,14 +337,18 @@ impl SiteTransfers {
         // without the artificial objects.
         let with_tracer = SceneTracer::new(&scenes[0], BuildQuality::Medium)?;
         let natural_tracer = SceneTracer::new(&scenes[1], BuildQuality::Medium)?;
-        let build = |k: usize| {
-            Transfer::build_shadowed_by(
+        // The photographed state first: the build with the planned objects reads its sky rays
+        // (`radiosity::twin`), as `site_radiosity_light` does.
+        let artificial = artificial_part(&scenes[0])?;
+        let build = |k: usize, natural: Option<&Transfer>| {
+            Transfer::build_beside(
                 &scenes[k],
                 &[&with_tracer, &natural_tracer],
                 &lighting[k],
                 &params,
                 cancel,
                 &|_| {},
+                natural.map(|t| (t, &artificial)),
             )
             .map(|transfer| Kept {
                 transfer,
@@ -349,8 +356,8 @@ impl SiteTransfers {
             })
             .map_err(|e| radiosity_error(&e))
         };
-        let mut with_artificial = build(0)?;
-        let mut without_artificial = build(1)?;
+        let mut without_artificial = build(1, None)?;
+        let mut with_artificial = build(0, Some(&without_artificial.transfer))?;
         // As `site_radiosity_light`: the natural elements the photo sees take its ρ_d, refitted
         // on the photographed state, then carried to the same elements with the objects.
         let mut photo_reflectance = None;
@@ -371,7 +378,10 @@ impl SiteTransfers {
             if photo_reflectance.is_some_and(|c| c.from_photo > 0) {
                 let rho = same_elements(
                     &without_artificial.transfer.solution().mesh,
-                    &with_artificial.transfer.solution().mesh,
+                    &twin_elements(
+                        &without_artificial.transfer.solution().mesh,
+                        &with_artificial.transfer.solution().mesh,
+                    ),
                 );
                 with_artificial
                     .transfer

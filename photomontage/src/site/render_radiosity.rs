@@ -29,9 +29,8 @@ use super::photo_reflectance::{
 use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
 use super::render_error::SiteRenderError;
 use crate::bvh::BuildQuality;
-use crate::radiosity::{
-    Mesh, MeshParams, Rgb, SolveParams, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
-};
+use crate::radiosity::twin::{Twin, twin_elements};
+use crate::radiosity::{Mesh, MeshParams, Rgb, SolveParams, solve_on_mesh_twinned, sun_directions};
 use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::scene::{ObjectKind, Scene, SceneError, SceneTracer};
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
@@ -69,24 +68,15 @@ pub struct RadiosityReport {
 /// # Errors
 /// Scene id overflow (not reachable from a valid scene).
 pub fn natural_part(scene: &Scene) -> Result<Scene, SceneError> {
-    let mut out = Scene::new();
-    for m in scene.materials() {
-        out.add_material(m.clone())?;
-    }
-    let mut ids = Vec::with_capacity(scene.objects().len());
-    for o in scene.objects() {
-        ids.push(if o.kind == ObjectKind::Natural {
-            Some(out.add_object(o.clone())?)
-        } else {
-            None
-        });
-    }
-    for t in scene.triangles() {
-        if let Some(Some(id)) = ids.get(t.object.0 as usize) {
-            out.add_polygon(&t.vertices_in_world_m, t.material, *id)?;
-        }
-    }
-    Ok(out)
+    scene.part_of_kind(ObjectKind::Natural)
+}
+
+/// The artificial objects of `scene` alone (the planned ones), as [`natural_part`].
+///
+/// # Errors
+/// As [`natural_part`].
+pub fn artificial_part(scene: &Scene) -> Result<Scene, SceneError> {
+    scene.part_of_kind(ObjectKind::Artificial)
 }
 
 fn area_m2(scene: &Scene) -> f64 {
@@ -158,6 +148,21 @@ pub fn site_radiosity_light(
     // (an old shadow edge inside a new shadow shows in the photographed state only).
     let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
     let natural_tracer = SceneTracer::new(&natural, BuildQuality::Medium)?;
+    // The planned objects alone in the same local frame, so that the solve with them can reuse
+    // the natural solve's sky rays (`radiosity::twin`; as `Transfer::build_beside`, only where
+    // both tracers share their frame).
+    let artificial = artificial_part(scene)?;
+    let artificial_tracer = match artificial.bounding_box_in_world_m() {
+        Some(bounds)
+            if natural_tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m() =>
+        {
+            Some((
+                SceneTracer::new_in_frame_of(&artificial, BuildQuality::Medium, &tracer)?,
+                bounds,
+            ))
+        }
+        _ => None,
+    };
     let dirs_to_sun = sun_directions(&groups);
     let mesh = |s: &Scene| {
         Mesh::build_lit(s, &params.mesh, &dirs_to_sun, &[&tracer, &natural_tracer])
@@ -173,7 +178,7 @@ pub fn site_radiosity_light(
     let mut refit =
         photo.map(|p| PhotoRefit::new(PhotoSamples::new(&natural_mesh, &natural_tracer, p)));
     let rounds = if refit.is_some() { REFIT_ROUNDS } else { 0 };
-    let without = solve_on_mesh_refitting(
+    let (without, natural_sky) = solve_on_mesh_twinned(
         natural_mesh,
         &natural_tracer,
         &natural_groups,
@@ -182,17 +187,32 @@ pub fn site_radiosity_light(
         &|_| {},
         &mut |solution: &crate::radiosity::Solution| refit.as_mut().map(|r| r.next_round(solution)),
         rounds,
+        None,
     )
     .map_err(|e| radiosity_error(&e))?;
     let mut with_mesh = mesh(scene)?;
+    let twin_of = twin_elements(&without.mesh, &with_mesh);
     if without.mesh.node_reflectance_rgb.is_some() {
-        let rho = same_elements(&without.mesh, &with_mesh);
+        let rho = same_elements(&without.mesh, &twin_of);
         with_mesh
             .set_element_reflectances(&rho)
             .map_err(|e| radiosity_error(&e))?;
     }
-    let with = solve_on_mesh(with_mesh, &tracer, &groups, &params, cancel, &|_| {})
-        .map_err(|e| radiosity_error(&e))?;
+    let twin = artificial_tracer
+        .as_ref()
+        .map(|(a, bounds)| Twin::new(twin_of, without.mesh.elements.len(), a, *bounds));
+    let (with, _) = solve_on_mesh_twinned(
+        with_mesh,
+        &tracer,
+        &groups,
+        &params,
+        cancel,
+        &|_| {},
+        &mut |_| None,
+        0,
+        twin.as_ref().zip(natural_sky.as_ref()),
+    )
+    .map_err(|e| radiosity_error(&e))?;
     let report = RadiosityReport {
         element_edge_m,
         elements: [with.mesh.elements.len(), without.mesh.elements.len()],
@@ -205,22 +225,15 @@ pub fn site_radiosity_light(
     Ok((light, report))
 }
 
-/// The per-element reflectances of `from` carried to the elements of `to` with the same
-/// vertices (the natural surfaces, meshed alike in both: module doc); `None` elsewhere.
+/// The per-element reflectances of `from` carried to the elements of another mesh whose twins
+/// in `from` are `twin_of` ([`twin_elements`]: the same vertices, the natural surfaces meshed
+/// alike in both, module doc); `None` elsewhere.
 #[must_use]
-pub fn same_elements(from: &Mesh, to: &Mesh) -> Vec<Option<Rgb>> {
-    let key = |mesh: &Mesh, e: usize| -> [u64; 9] {
-        let v = &mesh.element_node(e).vertices_in_world_m;
-        std::array::from_fn(|k| v[k / 3][k % 3].to_bits())
-    };
-    let by_vertices: std::collections::HashMap<[u64; 9], Rgb> = from
-        .element_reflectance_overrides()
-        .into_iter()
-        .enumerate()
-        .filter_map(|(e, r)| r.map(|r| (key(from, e), r)))
-        .collect();
-    (0..to.elements.len())
-        .map(|e| by_vertices.get(&key(to, e)).copied())
+pub fn same_elements(from: &Mesh, twin_of: &[Option<u32>]) -> Vec<Option<Rgb>> {
+    let overrides = from.element_reflectance_overrides();
+    twin_of
+        .iter()
+        .map(|t| t.and_then(|w| overrides[w as usize]))
         .collect()
 }
 
