@@ -83,7 +83,7 @@ impl SkyTransfer {
         engine: &FormFactorEngine<'_>,
         samples: &DirectSamples,
         dome: &IcosahedralDome,
-        twin: Option<(&Twin<'_>, &SkyRays, usize)>,
+        twin: Option<(&Twin, &SkyRays, usize)>,
     ) -> Self {
         let mesh = engine.mesh();
         let tracer = engine.tracer();
@@ -180,7 +180,7 @@ impl SkyTransfer {
                                 if cone.is_some_and(|(axis, cos)| axis.dot(&dir) < cos) {
                                     return counts[f];
                                 }
-                                (t.artificial, Some(t))
+                                (&t.artificial, Some(t))
                             }
                             _ => (tracer, None),
                         };

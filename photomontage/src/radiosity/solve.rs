@@ -423,7 +423,7 @@ pub fn solve_on_mesh_twinned(
     on_pass: &dyn Fn(&ConvergenceRow),
     refit: &mut Refit<'_>,
     rounds: usize,
-    twin: Option<(&Twin<'_>, &SkyRays)>,
+    twin: Option<(&Twin, &SkyRays)>,
 ) -> Result<(Solution, Option<SkyRays>), RadiosityError> {
     if rounds > 0 && !matches!(params.solver, Solver::Hierarchical(_)) {
         return Err(RadiosityError::InvalidParameter {

@@ -8,7 +8,8 @@
 //! from which a ray towards d escapes the scene. With S sources and N points per element, each
 //! source uses the points k ≡ s (mod S) (all N points for the sun, one point per cluster for a
 //! many-cluster sky), so an element costs max(N, S) rays. Each element draws from its own
-//! ChaCha8 stream (seed and group, stream = element index): thread-count independent.
+//! ChaCha8 stream (seed and group, stream = element index, or its twin's in the natural mesh:
+//! [`super::twin`]): thread-count independent.
 //!
 //! A point source (a luminaire, [`PointSource`]) of intensity I(ω) gives E = I(ω)·cos θ/d² at
 //! each of the element's N points, with a shadow ray to the source, averaged over the points.

@@ -259,33 +259,22 @@ impl Transfer {
             super::covered::mark_covered(&mut mesh, &tracer, &params.solve.form_factors);
         }
         // The planned objects alone, in this tracer's frame, and each element's twin.
-        let artificial = match natural {
-            Some((t, artificial))
-                if t.tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m() =>
-            {
-                match artificial.bounding_box_in_world_m() {
-                    Some(bounds) => Some((
-                        t,
-                        SceneTracer::new_in_frame_of(artificial, BuildQuality::Medium, &tracer)?,
-                        bounds,
-                    )),
-                    None => None,
-                }
-            }
-            _ => None,
-        };
-        let twin = artificial.as_ref().map(|(t, a, bounds)| {
+        let mut twin = None;
+        if let Some((t, artificial)) = natural
+            && let Some(bounds) = artificial.bounding_box_in_world_m()
+            && t.tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m()
+        {
             let natural_mesh = &t.solution.mesh;
-            (
+            twin = Some((
                 Twin::new(
                     twin_elements(natural_mesh, &mesh),
                     natural_mesh.elements.len(),
-                    a,
-                    *bounds,
+                    SceneTracer::new_in_frame_of(artificial, BuildQuality::Medium, &tracer)?,
+                    bounds,
                 ),
-                &t.sky_rays,
-            )
-        });
+                t,
+            ));
+        }
         let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?
             .with_direct_streams(twin.as_ref().map(|(t, _)| t.streams.as_slice()));
         let ground = GroundTerm::new(&engine, params.solve.ground.as_ref())?;
@@ -303,7 +292,7 @@ impl Transfer {
                 .as_deref()
                 .unwrap_or_else(|| unreachable!("the sky group has sample points")),
             &dome,
-            twin.as_ref().map(|(t, sky)| (t, *sky, 1)),
+            twin.as_ref().map(|(t, natural)| (t, &natural.sky_rays, 1)),
         );
         for (g, group) in groups.iter().enumerate() {
             warnings.extend(sources::check_point_sources(

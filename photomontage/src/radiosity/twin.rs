@@ -31,13 +31,13 @@ use crate::scene::SceneTracer;
 
 /// What the solve with the planned objects borrows from the natural one (module doc).
 #[derive(Debug)]
-pub struct Twin<'a> {
+pub struct Twin {
     /// Per element of the mesh with the planned objects, its twin in the natural mesh.
     pub(super) twin_of: Vec<Option<u32>>,
     /// Per element of the mesh with the planned objects, its direct-light random stream.
     pub(super) streams: Vec<u64>,
     /// The planned objects alone, in the local frame of the whole scene's tracer.
-    pub(super) artificial: &'a SceneTracer,
+    pub(super) artificial: SceneTracer,
     /// Their bounding box, world metres, widened by [`BOX_MARGIN_M`].
     artificial_box_in_world_m: [Point3<f64>; 2],
     /// The centre and radius of the widened box's bounding sphere, world metres.
@@ -53,7 +53,7 @@ const CONE_SLACK: f64 = 1.0 + 1e-6;
 /// The cone's cosine is lowered by this much (a wider cone) against round-off.
 const CONE_COS_SLACK: f64 = 1e-9;
 
-impl<'a> Twin<'a> {
+impl Twin {
     /// The twins `twin_of` ([`twin_elements`]) of the elements of the mesh with the planned
     /// objects in the natural mesh of `natural_elements` elements; `artificial` traces the
     /// planned objects alone, in the whole scene's tracer's local frame, and
@@ -62,7 +62,7 @@ impl<'a> Twin<'a> {
     pub fn new(
         twin_of: Vec<Option<u32>>,
         natural_elements: usize,
-        artificial: &'a SceneTracer,
+        artificial: SceneTracer,
         artificial_box_in_world_m: [Point3<f64>; 2],
     ) -> Self {
         let after = natural_elements as u64;

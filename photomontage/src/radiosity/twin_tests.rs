@@ -58,7 +58,7 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
     let twin = Twin::new(
         twin_elements(&natural_mesh, &mesh),
         natural_mesh.elements.len(),
-        &artificial_tracer,
+        artificial_tracer,
         artificial.bounding_box_in_world_m().unwrap(),
     );
     // Every natural element has its twin; the building's elements have none.

@@ -152,17 +152,9 @@ pub fn site_radiosity_light(
     // the natural solve's sky rays (`radiosity::twin`; as `Transfer::build_beside`, only where
     // both tracers share their frame).
     let artificial = artificial_part(scene)?;
-    let artificial_tracer = match artificial.bounding_box_in_world_m() {
-        Some(bounds)
-            if natural_tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m() =>
-        {
-            Some((
-                SceneTracer::new_in_frame_of(&artificial, BuildQuality::Medium, &tracer)?,
-                bounds,
-            ))
-        }
-        _ => None,
-    };
+    let artificial_bounds = artificial
+        .bounding_box_in_world_m()
+        .filter(|_| natural_tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m());
     let dirs_to_sun = sun_directions(&groups);
     let mesh = |s: &Scene| {
         Mesh::build_lit(s, &params.mesh, &dirs_to_sun, &[&tracer, &natural_tracer])
@@ -198,9 +190,15 @@ pub fn site_radiosity_light(
             .set_element_reflectances(&rho)
             .map_err(|e| radiosity_error(&e))?;
     }
-    let twin = artificial_tracer
-        .as_ref()
-        .map(|(a, bounds)| Twin::new(twin_of, without.mesh.elements.len(), a, *bounds));
+    let twin = match artificial_bounds {
+        Some(bounds) => Some(Twin::new(
+            twin_of,
+            without.mesh.elements.len(),
+            SceneTracer::new_in_frame_of(&artificial, BuildQuality::Medium, &tracer)?,
+            bounds,
+        )),
+        None => None,
+    };
     let (with, _) = solve_on_mesh_twinned(
         with_mesh,
         &tracer,
