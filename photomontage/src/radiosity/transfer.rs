@@ -259,22 +259,17 @@ impl Transfer {
             super::covered::mark_covered(&mut mesh, &tracer, &params.solve.form_factors);
         }
         // The planned objects alone, in this tracer's frame, and each element's twin.
-        let mut twin = None;
-        if let Some((t, artificial)) = natural
-            && let Some(bounds) = artificial.bounding_box_in_world_m()
-            && t.tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m()
-        {
-            let natural_mesh = &t.solution.mesh;
-            twin = Some((
-                Twin::new(
-                    twin_elements(natural_mesh, &mesh),
-                    natural_mesh.elements.len(),
-                    SceneTracer::new_in_frame_of(artificial, BuildQuality::Medium, &tracer)?,
-                    bounds,
-                ),
-                t,
-            ));
-        }
+        let twin = match natural {
+            Some((t, artificial)) => Twin::new(
+                twin_elements(&t.solution.mesh, &mesh),
+                t.solution.mesh.elements.len(),
+                &t.tracer,
+                &tracer,
+                artificial,
+            )?
+            .map(|twin| (twin, t)),
+            None => None,
+        };
         let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?
             .with_direct_streams(twin.as_ref().map(|(t, _)| t.streams.as_slice()));
         let ground = GroundTerm::new(&engine, params.solve.ground.as_ref())?;

@@ -27,7 +27,8 @@ use std::collections::HashMap;
 use nalgebra::{Point3, Vector3};
 
 use super::mesh::Mesh;
-use crate::scene::SceneTracer;
+use crate::bvh::BuildQuality;
+use crate::scene::{Scene, SceneError, SceneTracer};
 
 /// What the solve with the planned objects borrows from the natural one (module doc).
 #[derive(Debug)]
@@ -55,16 +56,27 @@ const CONE_COS_SLACK: f64 = 1e-9;
 
 impl Twin {
     /// The twins `twin_of` ([`twin_elements`]) of the elements of the mesh with the planned
-    /// objects in the natural mesh of `natural_elements` elements; `artificial` traces the
-    /// planned objects alone, in the whole scene's tracer's local frame, and
-    /// `artificial_box_in_world_m` bounds them.
-    #[must_use]
+    /// objects (traced by `tracer`) in the natural mesh of `natural_elements` elements (traced by
+    /// `natural_tracer`), with `artificial`, the planned objects alone, traced in `tracer`'s
+    /// local frame. `None` when there is nothing planned or the two tracers' frames differ (the
+    /// same rays would then not be the same `f32` rays).
+    ///
+    /// # Errors
+    /// The planned objects' tracer cannot be built.
     pub fn new(
         twin_of: Vec<Option<u32>>,
         natural_elements: usize,
-        artificial: SceneTracer,
-        artificial_box_in_world_m: [Point3<f64>; 2],
-    ) -> Self {
+        natural_tracer: &SceneTracer,
+        tracer: &SceneTracer,
+        artificial: &Scene,
+    ) -> Result<Option<Self>, SceneError> {
+        let Some(artificial_box_in_world_m) = artificial.bounding_box_in_world_m() else {
+            return Ok(None);
+        };
+        if natural_tracer.local_origin_in_world_m() != tracer.local_origin_in_world_m() {
+            return Ok(None);
+        }
+        let artificial = SceneTracer::new_in_frame_of(artificial, BuildQuality::Medium, tracer)?;
         let after = natural_elements as u64;
         let streams = twin_of
             .iter()
@@ -74,13 +86,13 @@ impl Twin {
         let [lo, hi] = artificial_box_in_world_m;
         let margin = Vector3::repeat(BOX_MARGIN_M);
         let (lo, hi) = (lo - margin, hi + margin);
-        Self {
+        Ok(Some(Self {
             twin_of,
             streams,
             artificial,
             artificial_box_in_world_m: [lo, hi],
             artificial_sphere_in_world_m: (nalgebra::center(&lo, &hi), (hi - lo).norm() / 2.0),
-        }
+        }))
     }
 
     /// The directions in which a ray from within `radius_m` of `centre_in_world_m` can meet the

@@ -28,8 +28,6 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
     let tracer = SceneTracer::new(&scene, BuildQuality::Medium).unwrap();
     let natural_tracer =
         SceneTracer::new_in_frame_of(&natural, BuildQuality::Medium, &tracer).unwrap();
-    let artificial_tracer =
-        SceneTracer::new_in_frame_of(&artificial, BuildQuality::Medium, &tracer).unwrap();
     let mut object_element_edge_m = BTreeMap::new();
     object_element_edge_m.insert("ground".to_owned(), 16.0);
     let params = MeshParams {
@@ -58,9 +56,12 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
     let twin = Twin::new(
         twin_elements(&natural_mesh, &mesh),
         natural_mesh.elements.len(),
-        artificial_tracer,
-        artificial.bounding_box_in_world_m().unwrap(),
-    );
+        &natural_tracer,
+        &tracer,
+        &artificial,
+    )
+    .unwrap()
+    .unwrap();
     // Every natural element has its twin; the building's elements have none.
     assert_eq!(twin.twins(), natural_mesh.elements.len());
     assert!(twin.twins() < mesh.elements.len());

@@ -148,13 +148,6 @@ pub fn site_radiosity_light(
     // (an old shadow edge inside a new shadow shows in the photographed state only).
     let tracer = SceneTracer::new(scene, BuildQuality::Medium)?;
     let natural_tracer = SceneTracer::new(&natural, BuildQuality::Medium)?;
-    // The planned objects alone in the same local frame, so that the solve with them can reuse
-    // the natural solve's sky rays (`radiosity::twin`; as `Transfer::build_beside`, only where
-    // both tracers share their frame).
-    let artificial = artificial_part(scene)?;
-    let artificial_bounds = artificial
-        .bounding_box_in_world_m()
-        .filter(|_| natural_tracer.local_origin_in_world_m() == tracer.local_origin_in_world_m());
     let dirs_to_sun = sun_directions(&groups);
     let mesh = |s: &Scene| {
         Mesh::build_lit(s, &params.mesh, &dirs_to_sun, &[&tracer, &natural_tracer])
@@ -190,15 +183,15 @@ pub fn site_radiosity_light(
             .set_element_reflectances(&rho)
             .map_err(|e| radiosity_error(&e))?;
     }
-    let twin = match artificial_bounds {
-        Some(bounds) => Some(Twin::new(
-            twin_of,
-            without.mesh.elements.len(),
-            SceneTracer::new_in_frame_of(&artificial, BuildQuality::Medium, &tracer)?,
-            bounds,
-        )),
-        None => None,
-    };
+    // The solve with the planned objects reuses the natural solve's sky rays
+    // (`radiosity::twin`, as `Transfer::build_beside` does).
+    let twin = Twin::new(
+        twin_of,
+        without.mesh.elements.len(),
+        &natural_tracer,
+        &tracer,
+        &artificial_part(scene)?,
+    )?;
     let (with, _) = solve_on_mesh_twinned(
         with_mesh,
         &tracer,
