@@ -72,6 +72,8 @@ mod corner_refinement_tests;
 #[cfg(test)]
 mod form_factor_tests;
 #[cfg(test)]
+mod material_table_tests;
+#[cfg(test)]
 mod peer_tests;
 #[cfg(test)]
 mod radiance_tests;
@@ -97,8 +99,8 @@ pub use solve::{
 };
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 pub use transfer::{
-    LightingChange, NamedLuminaire, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, RelightStrategy, Sky,
-    Sun, Sweep, Transfer, TransferLighting, TransferParams,
+    LightingChange, MaterialTableReport, NamedLuminaire, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL,
+    RelightStrategy, Sky, Sun, Sweep, Transfer, TransferLighting, TransferParams,
 };
 pub use vertex_gather::{GatheredExitance, VertexGather};
 

@@ -164,7 +164,17 @@ pub struct Transfer {
     /// The sky group's transfer (group 1), lent to a twin build ([`super::twin`]).
     sky_rays: SkyRays,
     solution: Solution,
+    /// The table of the material being edited ([`Transfer::relight_material`]); any other
+    /// change drops it.
+    material_table: Option<material_table::TableState>,
 }
+
+#[path = "material_table.rs"]
+mod material_table;
+pub use material_table::{
+    MaterialTableReport, NODE_STOP_FACTOR, TABLE_NODES, chebyshev_coefficients, chebyshev_value,
+    table_nodes,
+};
 
 fn sky_needs_sun(model: &SkyModel) -> bool {
     matches!(model, SkyModel::CieGeneral(_) | SkyModel::Perez(_))
@@ -374,6 +384,7 @@ impl Transfer {
                 warnings,
                 locator: std::sync::OnceLock::new(),
             },
+            material_table: None,
         })
     }
 
@@ -587,6 +598,7 @@ impl Transfer {
             }
         }
         // Nothing fails past this point: commit.
+        self.material_table = None;
         let material_changed = reflectance.is_some() || element_mesh.is_some();
         if let Some(mesh) = element_mesh {
             self.solution.mesh = Arc::new(mesh);
@@ -678,12 +690,34 @@ impl Transfer {
             pending.push((g, b0_new, start));
         }
         if self.params.sweep == Sweep::Shooting && !pending.is_empty() {
+            // Shooting passes on D = start − old, which holds only if the old solution's
+            // interreflected part scales with ρ. Where a channel's ρ was 0 and is not now, the
+            // old solution kept nothing of the light that element gathers: those groups are
+            // shot cold, from B₀′ with nothing old (the old solution of a dark scene, B = 0).
+            let lit_from_zero = old_rho.as_ref().is_some_and(|old| {
+                old.par_iter()
+                    .zip(new_rho.par_iter())
+                    .any(|(o, n)| (0..3).any(|c| o[c] == 0.0 && n[c] != 0.0))
+            });
+            let zeros: Vec<Rgb> = if lit_from_zero {
+                vec![[0.0; 3]; new_rho.len()]
+            } else {
+                Vec::new()
+            };
             let shot: Vec<ShotGroup<'_>> = pending
                 .iter_mut()
-                .map(|(g, _, start)| ShotGroup {
+                .map(|(g, b0_new, start)| ShotGroup {
                     name: &self.solution.groups[*g].name,
-                    old: &self.solution.groups[*g].radiosity_rgb,
-                    start: std::mem::take(start),
+                    old: if lit_from_zero {
+                        &zeros
+                    } else {
+                        &self.solution.groups[*g].radiosity_rgb
+                    },
+                    start: if lit_from_zero {
+                        b0_new.clone()
+                    } else {
+                        std::mem::take(start)
+                    },
                 })
                 .collect();
             let results = shoot(

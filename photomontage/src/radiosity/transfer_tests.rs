@@ -26,7 +26,7 @@ use crate::sky::{SkyModel, direction_from_elevation_azimuth};
 
 /// The stop rule of the relights and of the re-solves they are compared with: the seed's 1 %
 /// mean change, with a residual tight enough that iteration error stays below the comparison.
-const STOP: StopRule = StopRule {
+pub(super) const STOP: StopRule = StopRule {
     mean_change: 0.01,
     residual: 1e-4,
     max_passes: 200,
@@ -34,7 +34,7 @@ const STOP: StopRule = StopRule {
 
 /// Relight against a re-solve on the same links: both stop within the residual 1e-4 of the same
 /// fixed point, amplified by 1/(1 − ρF) < 2 here; the f32 link factors add 1e-7. 1e-3 bounds it.
-const SAME_LINKS_L1_REL_TOL: f64 = 1e-3;
+pub(super) const SAME_LINKS_L1_REL_TOL: f64 = 1e-3;
 /// Ground and sky clusters keep irradiance vectors exactly; a vertical plane cuts clusters, each
 /// erring by at most τ·Φ_cluster (icosahedral.rs); at τ = 0.02 the observed error is below 0.3 %.
 const CLUSTER_REL_TOL: f64 = 0.005;
@@ -42,7 +42,7 @@ const CLUSTER_REL_TOL: f64 = 0.005;
 /// rounding; the final gather's direct term is exact to rounding.
 const CLOSED_FORM_REL_TOL: f64 = 1e-9;
 
-fn params(strategy: RelightStrategy, sweep: Sweep) -> TransferParams {
+pub(super) fn params(strategy: RelightStrategy, sweep: Sweep) -> TransferParams {
     TransferParams {
         solve: SolveParams {
             mesh: MeshParams {
@@ -62,7 +62,7 @@ fn params(strategy: RelightStrategy, sweep: Sweep) -> TransferParams {
 }
 
 /// A 6 m ground square with a 1 m block and a 2 m wall on it; `render` is the block's material.
-fn yard(render_rho: Rgb) -> Scene {
+pub(super) fn yard(render_rho: Rgb) -> Scene {
     let p = Point3::new;
     let mut scene = Scene::new();
     test_scenes::add(
@@ -91,7 +91,7 @@ fn yard(render_rho: Rgb) -> Scene {
     scene
 }
 
-fn sun_at(elevation: f64, azimuth: f64) -> Sun {
+pub(super) fn sun_at(elevation: f64, azimuth: f64) -> Sun {
     Sun {
         dir_in_world: direction_from_elevation_azimuth(elevation, azimuth),
         normal_irradiance_rgb: [2.0, 1.9, 1.7],
@@ -110,7 +110,7 @@ fn lamp() -> NamedLuminaire {
     }
 }
 
-fn lighting() -> TransferLighting {
+pub(super) fn lighting() -> TransferLighting {
     TransferLighting {
         sun: Some(sun_at(0.6, 2.3)),
         sky: Some(Sky {
@@ -122,7 +122,7 @@ fn lighting() -> TransferLighting {
     }
 }
 
-fn build(scene: &Scene, lighting: &TransferLighting, p: &TransferParams) -> Transfer {
+pub(super) fn build(scene: &Scene, lighting: &TransferLighting, p: &TransferParams) -> Transfer {
     Transfer::build(scene, lighting, p, &AtomicBool::new(false), &|_| {}).unwrap()
 }
 
