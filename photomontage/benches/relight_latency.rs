@@ -15,7 +15,8 @@
 //! ([`photomontage::radiosity::city_block::city_block_with_proposal`], as a design imported from
 //! CAD brings its own), so only the transfer with the planned building relights. 2 threads;
 //! criterion medians, then medians of 8 alternating steps (wall and CPU time, with the load
-//! average).
+//! average). A colour step after the first edit of that material reads the material's table
+//! (`Transfer::relight_material`); the first edit, which builds the table, is timed on its own.
 //!
 //! `cargo bench -p photomontage --bench relight_latency` (release profile).
 #![allow(clippy::unwrap_used)]
@@ -58,6 +59,13 @@ fn sun_lighting(flip: bool) -> TransferLighting {
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// Wall time of one call of `f`, milliseconds.
+fn once(f: &mut dyn FnMut()) -> f64 {
+    let t = Instant::now();
+    f();
+    t.elapsed().as_secs_f64() * 1e3
 }
 
 /// Median wall and median CPU time (both threads) of 8 calls of `f(i)`, milliseconds.
@@ -147,9 +155,11 @@ fn bench_relight_latency(c: &mut Criterion) {
             studio.step(&scenes[0], &sun_lighting(flip));
         });
     });
-    // Back to the base sun, then colour steps.
+    // Back to the base sun, then colour steps: the first edit of the material builds its table
+    // (`Transfer::relight_material`), the steps read it.
     studio.step(&scenes[0], &sun_lighting(false));
-    let mut k = 0;
+    studio.step(&scenes[1], &sun_lighting(false));
+    let mut k = 1;
     group.bench_function("material_colour_step", |b| {
         b.iter(|| {
             k = 1 - k;
@@ -164,8 +174,9 @@ fn bench_relight_latency(c: &mut Criterion) {
         studio.step(&scenes[0], &sun_lighting(i % 2 == 0));
     });
     studio.step(&scenes[0], &sun_lighting(false));
+    let colour_first_ms = once(&mut || studio.step(&scenes[1], &sun_lighting(false)));
     let (colour_ms, colour_cpu_ms) = timed(&mut |i| {
-        studio.step(&scenes[(i + 1) % 2], &sun_lighting(false));
+        studio.step(&scenes[i % 2], &sun_lighting(false));
     });
     drop(studio);
     // The planned building in its own material.
@@ -174,7 +185,8 @@ fn bench_relight_latency(c: &mut Criterion) {
         city_block_with_proposal([RENDER_ALBEDO; 3], PROPOSAL_COLOUR).unwrap(),
     ];
     let mut studio = StudioTransfers::build(&pool, &params, &proposal[0], &city_block_lighting());
-    let mut k = 0;
+    let proposal_first_ms = once(&mut || studio.step(&proposal[1], &sun_lighting(false)));
+    let mut k = 1;
     group.bench_function("proposal_colour_step", |b| {
         b.iter(|| {
             k = 1 - k;
@@ -188,6 +200,9 @@ fn bench_relight_latency(c: &mut Criterion) {
     let (proposal_ms, proposal_cpu_ms) = timed(&mut |i| {
         studio.step(&proposal[(i + 1) % 2], &sun_lighting(false));
     });
+    // A sun step drops the tables; the first colour edit after it builds one again.
+    studio.step(&proposal[0], &sun_lighting(true));
+    let proposal_after_sun_ms = once(&mut || studio.step(&proposal[1], &sun_lighting(true)));
     drop(studio);
     // The sun step again under a CIE clear sky (type 12), which follows the sun: its direct
     // light is summed again from the sky transfer's facets at every step (report only, no
@@ -213,6 +228,11 @@ fn bench_relight_latency(c: &mut Criterion) {
     println!(
         "proposal colour step (the planned building's own material): {proposal_ms:.1} ms / \
          {proposal_cpu_ms:.1} ms CPU"
+    );
+    println!(
+        "first colour edit of a material (builds its table, one step): shared material \
+         {colour_first_ms:.0} ms, proposal {proposal_first_ms:.0} ms, proposal after a sun step \
+         {proposal_after_sun_ms:.0} ms"
     );
     println!(
         "sun slider step under a CIE clear sky (type 12, which follows the sun): \

@@ -12,7 +12,10 @@
 //! - finds nothing changed for the radiosity (the solutions are kept);
 //! - expresses the change as a [`LightingChange`] ([`lighting_change`]: a new sun, a new sky, a
 //!   luminaire's dimming, a material's diffuse reflectance) and applies it with
-//!   [`Transfer::relight`] on both transfers at once (never a form factor);
+//!   [`Transfer::relight`] on both transfers at once (never a form factor); a change of one
+//!   material's reflectance and nothing else, the colour designer's edit, goes through
+//!   [`Transfer::relight_material`]: its first edit tabulates the solution in that material's
+//!   reflectance, and the edits after it read the table (no link is read);
 //! - or, when the geometry, the solve parameters or anything a relight cannot express changed (a
 //!   model moved, a luminaire added, moved or re-aimed, an emitting material), builds both
 //!   transfers again.
@@ -194,6 +197,21 @@ pub fn lighting_change(
 #[must_use]
 pub fn is_empty(change: &LightingChange) -> bool {
     *change == LightingChange::default()
+}
+
+/// The material and its new reflectance when `change` changes one material's reflectance and
+/// nothing else (the edit [`Transfer::relight_material`] tabulates).
+fn single_material(change: &LightingChange) -> Option<(&str, Rgb)> {
+    match change.material_reflectance.as_slice() {
+        [(name, value)]
+            if change.sun.is_none()
+                && change.sky.is_none()
+                && change.luminaire_dimming.is_empty() =>
+        {
+            Some((name.as_str(), *value))
+        }
+        _ => None,
+    }
 }
 
 /// One of the two transfers with what it was last solved for.
@@ -530,8 +548,13 @@ impl SiteTransfers {
         }
         let (with, without) = (&mut self.with_artificial, &mut self.without_artificial);
         let relight = |kept: &mut Kept, change: &LightingChange| -> Result<(), RadiosityError> {
-            if !is_empty(change) {
-                kept.transfer.relight_in_place(change)?;
+            match single_material(change) {
+                // A colour edit: through the material's table (built on its first edit).
+                Some((name, value)) => {
+                    kept.transfer.relight_material(name, value)?;
+                }
+                None if !is_empty(change) => kept.transfer.relight_in_place(change)?,
+                None => {}
             }
             Ok(())
         };
