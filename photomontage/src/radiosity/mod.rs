@@ -59,6 +59,7 @@ mod sky_transfer;
 mod solve;
 mod source_rows;
 pub mod sources;
+pub mod sun_rays;
 mod surface_point;
 mod sweeps;
 mod topology;
@@ -99,8 +100,9 @@ pub use solve::{
 };
 pub use sources::{DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 pub use transfer::{
-    LightingChange, MaterialTableReport, NamedLuminaire, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL,
-    RelightStrategy, Sky, Sun, Sweep, Transfer, TransferLighting, TransferParams,
+    LightingChange, MaterialTableReport, NamedLuminaire, PreparedRelight, RELIGHT_L1_REL_TOL,
+    RELIGHT_MEAN_REL_TOL, RelightStrategy, Sky, Sun, Sweep, Transfer, TransferLighting,
+    TransferParams,
 };
 pub use vertex_gather::{GatheredExitance, VertexGather};
 

@@ -256,15 +256,31 @@ impl Solution {
     /// groups' direct light itself with exact shadow rays (the sun, the luminaires).
     #[must_use]
     pub fn without_direct_of(&self, exact: &(dyn Fn(&str) -> bool + Sync)) -> Self {
+        self.without_direct_of_given(exact, None)
+    }
+
+    /// [`Solution::without_direct_of`] with ρ per element given (as a transfer keeps it: the
+    /// values [`Mesh::element_reflectance_rgb`] gives, without reading a mesh node per element);
+    /// `None`, or a slice of another length, reads the mesh.
+    #[must_use]
+    pub fn without_direct_of_given(
+        &self,
+        exact: &(dyn Fn(&str) -> bool + Sync),
+        element_rho: Option<&[Rgb]>,
+    ) -> Self {
         let mesh = &self.mesh;
-        // ρ per element once for all the exact groups (reading a mesh node per element).
-        let rho: Vec<Rgb> = if self.groups.iter().any(|g| exact(&g.name)) {
-            (0..mesh.elements.len())
-                .into_par_iter()
-                .map(|e| mesh.element_reflectance_rgb(e))
-                .collect()
-        } else {
-            Vec::new()
+        // ρ per element once for all the exact groups.
+        let read;
+        let rho: &[Rgb] = match element_rho {
+            Some(r) if r.len() == mesh.elements.len() => r,
+            _ if self.groups.iter().any(|g| exact(&g.name)) => {
+                read = (0..mesh.elements.len())
+                    .into_par_iter()
+                    .map(|e| mesh.element_reflectance_rgb(e))
+                    .collect::<Vec<Rgb>>();
+                &read
+            }
+            _ => &[],
         };
         let groups = self
             .groups

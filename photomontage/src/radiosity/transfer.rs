@@ -59,6 +59,7 @@ use super::solve::{
 };
 use super::source_rows::SourceRows;
 use super::sources::{self, DirectSamples, LightWarning};
+use super::sun_rays::{SunCounts, sun_counts as sun_counts_of, sun_direct};
 pub use super::sweeps::Sweep;
 use super::sweeps::{LinkRows, iterate};
 use super::topology::Topology;
@@ -167,6 +168,32 @@ pub struct Transfer {
     /// The table of the material being edited ([`Transfer::relight_material`]); any other
     /// change drops it.
     material_table: Option<material_table::TableState>,
+    /// The twins of this transfer's elements in the natural transfer it was built beside
+    /// ([`super::twin`]): a relight reads the natural sun counts through them.
+    twin: Option<Arc<Twin>>,
+}
+
+/// What a relight traced ([`Transfer::prepare_relight`]), before [`Transfer::commit_relight`]
+/// applies it; nothing of the transfer has changed yet.
+#[derive(Debug)]
+pub struct PreparedRelight {
+    lighting: TransferLighting,
+    reflectance: Option<Vec<Rgb>>,
+    element_mesh: Option<Mesh>,
+    new_groups: Vec<LightGroup>,
+    warnings: Vec<LightWarning>,
+    actions: Vec<Action>,
+    retraced: Vec<Option<Vec<Rgb>>>,
+    sun_counts: Option<SunCounts>,
+}
+
+impl PreparedRelight {
+    /// The sun's visible-ray counts this relight traced, if it moved the sun (for the transfer
+    /// built beside this one, [`super::sun_rays`]).
+    #[must_use]
+    pub fn sun_counts(&self) -> Option<&SunCounts> {
+        self.sun_counts.as_ref()
+    }
 }
 
 #[path = "material_table.rs"]
@@ -385,6 +412,7 @@ impl Transfer {
                 locator: std::sync::OnceLock::new(),
             },
             material_table: None,
+            twin: twin.map(|(t, _)| Arc::new(t)),
         })
     }
 
@@ -412,6 +440,20 @@ impl Transfer {
     #[must_use]
     pub fn light_groups(&self) -> &[LightGroup] {
         &self.groups
+    }
+
+    /// ρ_d per element of the current solution's mesh (the values
+    /// [`Mesh::element_reflectance_rgb`] gives, kept by every relight).
+    #[must_use]
+    pub fn element_reflectances(&self) -> &[Rgb] {
+        &self.element_rho
+    }
+
+    /// How many elements have a twin in the natural transfer this one was built beside
+    /// ([`super::twin`]); `None` when it has no twins.
+    #[must_use]
+    pub fn twins(&self) -> Option<usize> {
+        self.twin.as_deref().map(Twin::twins)
     }
 
     /// The tracer of the scene.
@@ -564,6 +606,31 @@ impl Transfer {
         change: &LightingChange,
         element_rho: Option<&[Option<Rgb>]>,
     ) -> Result<(), RadiosityError> {
+        let prepared = self.prepare_with(change, element_rho, None)?;
+        self.commit_relight(prepared);
+        Ok(())
+    }
+
+    /// The traced part of [`Transfer::relight`] (rays only, never a form factor); with
+    /// `natural_sun`, the natural transfer's sun counts for the same sun, read through this
+    /// transfer's twins where it was built beside that transfer ([`super::sun_rays`]).
+    ///
+    /// # Errors
+    /// As [`Transfer::relight`]; nothing changes.
+    pub fn prepare_relight(
+        &self,
+        change: &LightingChange,
+        natural_sun: Option<&SunCounts>,
+    ) -> Result<PreparedRelight, RadiosityError> {
+        self.prepare_with(change, None, natural_sun)
+    }
+
+    fn prepare_with(
+        &self,
+        change: &LightingChange,
+        element_rho: Option<&[Option<Rgb>]>,
+        natural_sun: Option<&SunCounts>,
+    ) -> Result<PreparedRelight, RadiosityError> {
         let (lighting, reflectance) = self.apply_to_lighting(change)?;
         let element_mesh = match element_rho {
             Some(rho) => {
@@ -578,6 +645,7 @@ impl Transfer {
         let actions = self.actions(&lighting);
         // Re-trace what needs it (only the changed groups' rays; never a form factor).
         let mut retraced: Vec<Option<Vec<Rgb>>> = vec![None; actions.len()];
+        let mut sun_counts = None;
         {
             let engine = FormFactorEngine::new(
                 &self.solution.mesh,
@@ -585,19 +653,65 @@ impl Transfer {
                 self.params.solve.form_factors,
             )?;
             for (g, action) in actions.iter().enumerate() {
-                if *action == Action::Retrace {
-                    retraced[g] = Some(group_direct(
-                        &engine,
-                        &new_groups[g],
-                        g as u64,
-                        self.ground.as_ref(),
-                        self.direct_samples.get(g).and_then(Option::as_deref),
-                        Some(&self.sky_rays.transfer),
-                    )?);
+                if *action != Action::Retrace {
+                    continue;
                 }
+                let group = &new_groups[g];
+                let samples = self.direct_samples.get(g).and_then(Option::as_deref);
+                // The sun alone (one distant source, at every sample point): counted, so that
+                // the transfer built beside this one can read the counts (`sun_rays`).
+                if let (GroupKind::Sun, [source], None, true, Some(samples)) = (
+                    self.kinds[g],
+                    group.sources.as_slice(),
+                    &group.sky,
+                    group.points.is_empty(),
+                    samples,
+                ) {
+                    sources::validate(&group.name, &group.sources)?;
+                    let twin = self.twin.as_deref().zip(natural_sun);
+                    let counts = sun_counts_of(&engine, samples, source, twin);
+                    let mut direct = sun_direct(&engine, samples, source, &counts);
+                    if let Some(ground) = self.ground.as_ref() {
+                        ground.add(&group.sources, &mut direct);
+                    }
+                    retraced[g] = Some(direct);
+                    sun_counts = Some(counts);
+                    continue;
+                }
+                retraced[g] = Some(group_direct(
+                    &engine,
+                    group,
+                    g as u64,
+                    self.ground.as_ref(),
+                    samples,
+                    Some(&self.sky_rays.transfer),
+                )?);
             }
         }
-        // Nothing fails past this point: commit.
+        Ok(PreparedRelight {
+            lighting,
+            reflectance,
+            element_mesh,
+            new_groups,
+            warnings,
+            actions,
+            retraced,
+            sun_counts,
+        })
+    }
+
+    /// Applies a relight traced by [`Transfer::prepare_relight`] on this transfer (its solves).
+    pub fn commit_relight(&mut self, prepared: PreparedRelight) {
+        let PreparedRelight {
+            lighting,
+            reflectance,
+            element_mesh,
+            new_groups,
+            warnings,
+            actions,
+            mut retraced,
+            sun_counts: _,
+        } = prepared;
         self.material_table = None;
         let material_changed = reflectance.is_some() || element_mesh.is_some();
         if let Some(mesh) = element_mesh {
@@ -769,7 +883,6 @@ impl Transfer {
                     .map(f64::to_bits)),
             "the transfer's ρ per element follows its mesh"
         );
-        Ok(())
     }
 
     /// Links whose source node lies on scene object `object` (tests of the shooting relight).

@@ -10,18 +10,26 @@ use super::form_factor::{FormFactorEngine, FormFactorParams};
 use super::mesh::Mesh;
 use super::sky_transfer::LANES;
 use super::sky_transfer::{SkyRays, SkyTransfer};
-use super::sources::DirectSamples;
+use super::sources::{DirectSamples, DistantSource, direct_irradiance_at};
+use super::sun_rays::{sun_counts, sun_direct};
 use super::twin::{Twin, twin_elements};
 use crate::bvh::BuildQuality;
 use crate::scene::ObjectKind;
 use crate::scene::SceneTracer;
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
-/// The sky transfer of the block with its planned building, read from the natural block's
-/// transfer where elements have twins, equals the one traced through the whole scene ray by
-/// ray (the brute force), and the building does take sky from some natural elements.
-#[test]
-fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
+/// The city block with its planned building and without it, meshed alike, their tracers in one
+/// frame, and the twins.
+struct Pair {
+    natural_mesh: Mesh,
+    mesh: Mesh,
+    natural_tracer: SceneTracer,
+    tracer: SceneTracer,
+    twin: Twin,
+    ff: FormFactorParams,
+}
+
+fn block_pair() -> Pair {
     let scene = city_block(1, [0.5; 3]).unwrap();
     let natural = scene.part_of_kind(ObjectKind::Natural).unwrap();
     let artificial = scene.part_of_kind(ObjectKind::Artificial).unwrap();
@@ -46,13 +54,6 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
         seed: 3,
         visibility: true,
     };
-    let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
-    let natural_engine = FormFactorEngine::new(&natural_mesh, &natural_tracer, ff).unwrap();
-    let natural_samples = DirectSamples::new(&natural_engine, 1);
-    let natural_sky = SkyRays {
-        group: 1,
-        transfer: SkyTransfer::new(&natural_engine, &natural_samples, &dome),
-    };
     let twin = Twin::new(
         twin_elements(&natural_mesh, &mesh),
         natural_mesh.elements.len(),
@@ -62,6 +63,36 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
     )
     .unwrap()
     .unwrap();
+    Pair {
+        natural_mesh,
+        mesh,
+        natural_tracer,
+        tracer,
+        twin,
+        ff,
+    }
+}
+
+/// The sky transfer of the block with its planned building, read from the natural block's
+/// transfer where elements have twins, equals the one traced through the whole scene ray by
+/// ray (the brute force), and the building does take sky from some natural elements.
+#[test]
+fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
+    let Pair {
+        natural_mesh,
+        mesh,
+        natural_tracer,
+        tracer,
+        twin,
+        ff,
+    } = block_pair();
+    let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
+    let natural_engine = FormFactorEngine::new(&natural_mesh, &natural_tracer, ff).unwrap();
+    let natural_samples = DirectSamples::new(&natural_engine, 1);
+    let natural_sky = SkyRays {
+        group: 1,
+        transfer: SkyTransfer::new(&natural_engine, &natural_samples, &dome),
+    };
     // Every natural element has its twin; the building's elements have none.
     assert_eq!(twin.twins(), natural_mesh.elements.len());
     assert!(twin.twins() < mesh.elements.len());
@@ -100,4 +131,66 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
     // A twin traced for another group is not used (the brute force again).
     let other = SkyTransfer::beside(&engine, &samples, &dome, Some((&twin, &natural_sky, 0)));
     assert_eq!(other.escaped, brute.escaped);
+}
+
+/// The sun's counts of the block with its planned building, read from the natural block's
+/// counts where elements have twins, equal those traced through the whole scene ray by ray,
+/// and so does the direct irradiance made from them; the building shades some natural
+/// elements; counts for another sun direction are not read.
+#[test]
+fn sun_twin_counts_equal_tracing_every_ray() {
+    let pair = block_pair();
+    let natural_engine =
+        FormFactorEngine::new(&pair.natural_mesh, &pair.natural_tracer, pair.ff).unwrap();
+    let natural_samples = DirectSamples::new(&natural_engine, 0);
+    let engine = FormFactorEngine::new(&pair.mesh, &pair.tracer, pair.ff)
+        .unwrap()
+        .with_direct_streams(Some(&pair.twin.streams));
+    let samples = DirectSamples::new(&engine, 0);
+    for azimuth in [2.6, 2.62, 4.0] {
+        let sun = city_block_sun(0.5, azimuth);
+        let source = DistantSource {
+            dir_in_world: sun.dir_in_world,
+            normal_irradiance_rgb: sun.normal_irradiance_rgb,
+        };
+        let natural = sun_counts(&natural_engine, &natural_samples, &source, None);
+        let shared = sun_counts(&engine, &samples, &source, Some((&pair.twin, &natural)));
+        let brute = sun_counts(&engine, &samples, &source, None);
+        assert_eq!(shared.escaped, brute.escaped, "azimuth {azimuth}");
+        let direct = sun_direct(&engine, &samples, &source, &shared);
+        let traced = direct_irradiance_at(&engine, &samples, std::slice::from_ref(&source));
+        let bits =
+            |v: &[[f64; 3]]| -> Vec<u64> { v.iter().flat_map(|x| x.map(f64::to_bits)).collect() };
+        assert_eq!(bits(&direct), bits(&traced), "azimuth {azimuth}: direct");
+        // Natural elements the building shades (so the test can fail), and natural elements
+        // in full sun (so the twins' shortcut is taken).
+        let shaded = pair
+            .twin
+            .twin_of
+            .iter()
+            .enumerate()
+            .filter_map(|(e, t)| t.map(|w| (e, w as usize)))
+            .filter(|&(e, w)| shared.escaped[e] < natural.escaped[w])
+            .count();
+        assert!(
+            shaded > 20,
+            "azimuth {azimuth}: {shaded} shaded by the building"
+        );
+        assert!(natural.escaped.iter().filter(|&&n| n == 4).count() > 1000);
+        // Counts traced for another direction are not read: the brute force again.
+        let other = sun_counts(
+            &natural_engine,
+            &natural_samples,
+            &DistantSource {
+                dir_in_world: city_block_sun(0.5, azimuth + 0.3).dir_in_world,
+                ..source
+            },
+            None,
+        );
+        let guarded = sun_counts(&engine, &samples, &source, Some((&pair.twin, &other)));
+        assert_eq!(
+            guarded.escaped, brute.escaped,
+            "azimuth {azimuth}: other direction"
+        );
+    }
 }

@@ -44,7 +44,8 @@ use super::render_radiosity::{
 use crate::bvh::BuildQuality;
 use crate::radiosity::twin::twin_elements;
 use crate::radiosity::{
-    LightingChange, RadiosityError, Solution, Transfer, TransferLighting, TransferParams,
+    LightingChange, PreparedRelight, RadiosityError, Solution, Transfer, TransferLighting,
+    TransferParams,
 };
 use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::scene::{Scene, SceneTracer};
@@ -547,21 +548,50 @@ impl SiteTransfers {
             return Ok(Some(TransferUpdate::Unchanged));
         }
         let (with, without) = (&mut self.with_artificial, &mut self.without_artificial);
-        let relight = |kept: &mut Kept, change: &LightingChange| -> Result<(), RadiosityError> {
-            match single_material(change) {
-                // A colour edit: through the material's table (built on its first edit).
-                Some((name, value)) => {
-                    kept.transfer.relight_material(name, value)?;
-                }
-                None if !is_empty(change) => kept.transfer.relight_in_place(change)?,
-                None => {}
+        // Rays first: the natural transfer's (a sun move's rays over every thread), then the
+        // other's, which reads the natural sun counts through its twins (`radiosity::sun_rays`);
+        // nothing changes until both are traced. A colour edit of one material goes through the
+        // material's table instead (built on its first edit).
+        let general = |c: &LightingChange| !is_empty(c) && single_material(c).is_none();
+        let natural_traced = if general(&changes[1]) {
+            Some(
+                without
+                    .transfer
+                    .prepare_relight(&changes[1], None)
+                    .map_err(|e| radiosity_error(&e))?,
+            )
+        } else {
+            None
+        };
+        let traced = if general(&changes[0]) {
+            Some(
+                with.transfer
+                    .prepare_relight(
+                        &changes[0],
+                        natural_traced
+                            .as_ref()
+                            .and_then(PreparedRelight::sun_counts),
+                    )
+                    .map_err(|e| radiosity_error(&e))?,
+            )
+        } else {
+            None
+        };
+        let apply = |kept: &mut Kept,
+                     change: &LightingChange,
+                     traced: Option<PreparedRelight>|
+         -> Result<(), RadiosityError> {
+            if let Some(traced) = traced {
+                kept.transfer.commit_relight(traced);
+            } else if let Some((name, value)) = single_material(change) {
+                kept.transfer.relight_material(name, value)?;
             }
             Ok(())
         };
-        // The two relights are independent: run them side by side.
+        // The two solves are independent: run them side by side.
         let (a, b) = rayon::join(
-            || relight(with, &changes[0]),
-            || relight(without, &changes[1]),
+            || apply(with, &changes[0], traced),
+            || apply(without, &changes[1], natural_traced),
         );
         a.and(b).map_err(|e| radiosity_error(&e))?;
         let [t0, t1] = targets.try_into().unwrap_or_else(|_| unreachable!());
@@ -573,6 +603,10 @@ impl SiteTransfers {
                     self.with_artificial.transfer.solution(),
                     self.without_artificial.transfer.solution(),
                     &RadiosityLight::traced_exactly,
+                    [
+                        Some(self.with_artificial.transfer.element_reflectances()),
+                        Some(self.without_artificial.transfer.element_reflectances()),
+                    ],
                 )
                 .map_err(|e| radiosity_error(&e))?,
         );

@@ -248,3 +248,72 @@ fn a_build_with_the_photo_takes_its_reflectances_as_the_render_does() {
     assert_eq!(update(&mut slot, Some(&photo)), TransferUpdate::Built);
     assert!(slot.as_ref().unwrap().report.photo_reflectance.is_some());
 }
+
+/// A sun move in the studio (the natural transfer's rays first, the other reading them through
+/// its twins, then both solves side by side) gives both transfers' own relights bit for bit.
+#[test]
+fn a_studio_sun_move_is_each_transfers_own_relight_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = fixture(dir.path());
+    doc.site.render.radiosity = true;
+    let cancel = AtomicBool::new(false);
+    let mut slot = None;
+    let scene = site_scene(&doc).unwrap().scene;
+    SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
+    let kept = slot.as_ref().unwrap();
+    assert!(
+        kept.with_artificial.transfer.twins().is_some_and(|n| n > 0),
+        "the transfer with the model has twins"
+    );
+    let mut own = [
+        kept.with_artificial.transfer.clone(),
+        kept.without_artificial.transfer.clone(),
+    ];
+    for (azimuth_deg, elevation_deg) in [(150.0, 35.0), (151.0, 35.0), (230.0, 20.0)] {
+        doc.site.lighting.sun_manual = Some(SunManual {
+            azimuth_deg,
+            elevation_deg,
+        });
+        let inputs = inputs(&doc, &scene, "p1").unwrap();
+        for (k, t) in own.iter_mut().enumerate() {
+            let materials = material_state(&inputs.scenes[k]);
+            let change =
+                lighting_change(t.lighting(), &inputs.lighting[k], &materials, &materials).unwrap();
+            assert!(change.sun.is_some());
+            t.relight_in_place(&change).unwrap();
+        }
+        let (_, report) =
+            SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
+        assert_eq!(report.update, TransferUpdate::Relit);
+        let studio = slot.as_ref().unwrap();
+        // Per group, the elements whose direct term or radiosity differ in any bit.
+        let differing = |a: &Solution, b: &Solution| -> Vec<(usize, usize)> {
+            a.groups
+                .iter()
+                .zip(&b.groups)
+                .map(|(x, y)| {
+                    let differ = |u: &[Rgb], v: &[Rgb]| {
+                        u.iter()
+                            .zip(v)
+                            .filter(|(p, q)| p.map(f64::to_bits) != q.map(f64::to_bits))
+                            .count()
+                    };
+                    (
+                        differ(&x.direct_irradiance_rgb, &y.direct_irradiance_rgb),
+                        differ(&x.radiosity_rgb, &y.radiosity_rgb),
+                    )
+                })
+                .collect()
+        };
+        for (label, studio, alone) in [
+            ("with", studio.with_artificial(), own[0].solution()),
+            ("without", studio.without_artificial(), own[1].solution()),
+        ] {
+            let d = differing(studio, alone);
+            assert!(
+                d.iter().all(|&(a, b)| a == 0 && b == 0),
+                "{label} at {azimuth_deg}°: (direct, radiosity) elements differing per group {d:?}"
+            );
+        }
+    }
+}

@@ -106,6 +106,7 @@ impl RadiosityLight {
             without_artificial,
             traced_exactly,
             [with, without],
+            [None, None],
         )
     }
 
@@ -116,11 +117,14 @@ impl RadiosityLight {
     ///
     /// # Errors
     /// As [`RadiosityLight::new`].
+    /// `element_rho`: ρ per element of each solution where the caller keeps it (the studio's
+    /// transfers), so that it is not read again from the meshes.
     pub fn relit(
         &self,
         with_artificial: &Solution,
         without_artificial: &Solution,
         traced_exactly: &(dyn Fn(&str) -> bool + Sync),
+        element_rho: [Option<&[Rgb]>; 2],
     ) -> Result<Self, RadiosityError> {
         let kept = |k: usize, s: &Solution| {
             let g = self.gathered[k].gather();
@@ -142,7 +146,13 @@ impl RadiosityLight {
             )?),
         };
         let gathers = [with, without];
-        Self::with_gathers(with_artificial, without_artificial, traced_exactly, gathers)
+        Self::with_gathers(
+            with_artificial,
+            without_artificial,
+            traced_exactly,
+            gathers,
+            element_rho,
+        )
     }
 
     fn with_gathers(
@@ -150,18 +160,22 @@ impl RadiosityLight {
         without_artificial: &Solution,
         traced_exactly: &(dyn Fn(&str) -> bool + Sync),
         gathers: [Arc<VertexGather>; 2],
+        element_rho: [Option<&[Rgb]>; 2],
     ) -> Result<Self, RadiosityError> {
         // The two solutions are independent: side by side.
-        let side = |s: &Solution, gather: Arc<VertexGather>| -> Result<_, RadiosityError> {
+        let side = |s: &Solution,
+                    gather: Arc<VertexGather>,
+                    rho: Option<&[Rgb]>|
+         -> Result<_, RadiosityError> {
             Ok((
-                Arc::new(s.without_direct_of(traced_exactly)),
+                Arc::new(s.without_direct_of_given(traced_exactly, rho)),
                 GatheredExitance::new(gather, total_radiosity(s))?,
             ))
         };
         let [with_gather, without_gather] = gathers;
         let (with, without) = rayon::join(
-            || side(with_artificial, with_gather),
-            || side(without_artificial, without_gather),
+            || side(with_artificial, with_gather, element_rho[0]),
+            || side(without_artificial, without_gather, element_rho[1]),
         );
         let ((with, with_gathered), (without, without_gathered)) = (with?, without?);
         Ok(Self {

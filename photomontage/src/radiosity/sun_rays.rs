@@ -1,0 +1,144 @@
+//! The sun's shadow rays of a relight, counted per element, and the twin rays of the sun
+//! ([`super::twin`]): the transfer with the planned objects reads the natural transfer's counts.
+//!
+//! A sun move re-traces every element's sample rays towards the sun
+//! ([`super::sources::direct_irradiance_at`] with the sun as its one source: all N points). The
+//! scene with the planned objects is the natural scene plus those objects, so a ray escapes it iff
+//! it escapes the natural scene and misses the planned objects. An element with a twin in the
+//! natural mesh (same vertices, same sample points) therefore takes its count from its twin's:
+//! none of the N rays escaped → none escapes here; all escaped → only the planned objects' own
+//! BVH is tested, and not at all outside the cone towards them; a mixed count (an element on a
+//! shadow edge) traces its rays through the whole scene. The tracers share one local frame, so
+//! the counts are those of tracing every ray in the whole scene, bit for bit (test
+//! `sun_twin_counts_equal_tracing_every_ray`), and so is the direct irradiance made from them.
+//!
+//! The studio relights the natural transfer's sun first (its rays spread over every thread), then
+//! the twin counts, then both solves side by side (`site::live_relight`): the transfer with the
+//! planned objects no longer traces its natural elements' sun rays a second time.
+
+use rayon::prelude::*;
+
+use super::Rgb;
+use super::form_factor::FormFactorEngine;
+use super::sources::{DIRECT_RAY_LENGTH_M, DIRECT_RAY_OFFSET_M, DirectSamples, DistantSource};
+use super::twin::Twin;
+
+/// The sun's visible-ray counts of every element of a natural transfer, for one direction.
+#[derive(Debug, Clone)]
+pub struct SunCounts {
+    /// The direction the rays were traced towards (its bits are compared).
+    pub(super) dir_in_world: [u64; 3],
+    /// Per element, how many of its rays escaped (elements facing away: 0, not traced).
+    pub(super) escaped: Vec<u8>,
+}
+
+/// Per element of `engine`'s mesh, how many of its `samples` rays towards `source` escape the
+/// scene (0 for an element facing away); with `twin` = (the twins, the natural transfer's counts
+/// for the same direction), from the twins' counts where they decide (module doc).
+///
+/// # Panics
+/// When `samples` were drawn for another mesh, or an element has more than 255 points.
+#[must_use]
+pub(super) fn sun_counts(
+    engine: &FormFactorEngine<'_>,
+    samples: &DirectSamples,
+    source: &DistantSource,
+    twin: Option<(&Twin, &SunCounts)>,
+) -> SunCounts {
+    let mesh = engine.mesh();
+    let tracer = engine.tracer();
+    let visibility = engine.params().visibility;
+    let dir = source.dir_in_world;
+    let bits = dir.map(f64::to_bits);
+    let twin = twin.filter(|(t, natural)| {
+        t.twin_of.len() == mesh.elements.len() && natural.dir_in_world == [bits.x, bits.y, bits.z]
+    });
+    let escaped = (0..mesh.elements.len())
+        .into_par_iter()
+        .map(|e| {
+            let node = mesh.element_node(e);
+            if node.normal_in_world.dot(&dir) <= 0.0 {
+                return 0;
+            }
+            let points = samples.of_element(e);
+            let rays = u8::try_from(points.len()).unwrap_or_else(|_| unreachable!("≤ 255 points"));
+            let mut only_planned = None;
+            if let Some((t, natural)) = twin
+                && let Some(w) = t.twin_of[e]
+            {
+                let n = natural.escaped[w as usize];
+                if n == 0 {
+                    return 0;
+                }
+                if n == rays {
+                    let centre = node.centroid_in_world_m();
+                    let radius = node
+                        .vertices_in_world_m
+                        .iter()
+                        .map(|v| (v - centre).norm())
+                        .fold(0.0, f64::max);
+                    if t.cone_towards_artificial(&centre, radius)
+                        .is_some_and(|(axis, cos)| axis.dot(&dir) < cos)
+                    {
+                        return n;
+                    }
+                    only_planned = Some(t);
+                }
+            }
+            let mut hits = 0u8;
+            for p in points {
+                if only_planned.is_some_and(|t| !t.may_meet_artificial(p, &dir)) {
+                    hits += 1;
+                    continue;
+                }
+                #[allow(clippy::cast_possible_truncation)]
+                let ray =
+                    tracer.ray_from_world(p, &dir, DIRECT_RAY_OFFSET_M as f32, DIRECT_RAY_LENGTH_M);
+                let blocked = match only_planned {
+                    Some(t) => t.artificial.any_hit(&ray),
+                    None => tracer.any_hit(&ray),
+                };
+                if !visibility || !blocked {
+                    hits += 1;
+                }
+            }
+            hits
+        })
+        .collect();
+    SunCounts {
+        dir_in_world: [bits.x, bits.y, bits.z],
+        escaped,
+    }
+}
+
+/// The direct irradiance of the one distant `source` from its `counts` (out of each element's
+/// rays, one per point of `samples`): E_n·cos·(escaped / rays), the same operations in the same
+/// order as [`super::sources::direct_irradiance_at`], so the same bits.
+#[must_use]
+pub(super) fn sun_direct(
+    engine: &FormFactorEngine<'_>,
+    samples: &DirectSamples,
+    source: &DistantSource,
+    counts: &SunCounts,
+) -> Vec<Rgb> {
+    let mesh = engine.mesh();
+    (0..mesh.elements.len())
+        .into_par_iter()
+        .map(|e| {
+            let mut e_rgb = [0.0; 3];
+            let cos = mesh
+                .element_node(e)
+                .normal_in_world
+                .dot(&source.dir_in_world);
+            if cos <= 0.0 {
+                return e_rgb;
+            }
+            #[allow(clippy::cast_precision_loss)]
+            let visible = f64::from(counts.escaped[e]) / samples.of_element(e).len() as f64;
+            for c in 0..3 {
+                e_rgb[c] += source.normal_irradiance_rgb[c] * cos * visible;
+            }
+            e_rgb
+        })
+        .collect()
+}
