@@ -148,16 +148,10 @@ impl SkyTransfer {
                 let twin_counts = twin.and_then(|(t, natural, _)| {
                     t.twin_of[e].map(|w| {
                         let w = w as usize;
-                        let centre = node.centroid_in_world_m();
-                        let radius = node
-                            .vertices_in_world_m
-                            .iter()
-                            .map(|v| (v - centre).norm())
-                            .fold(0.0, f64::max);
                         (
                             &natural.transfer.escaped[w * padded..w * padded + f_count],
                             t,
-                            t.cone_towards_artificial(&centre, radius),
+                            t.cone_from_node(node),
                         )
                     })
                 });

@@ -71,13 +71,7 @@ pub(super) fn sun_counts(
                     return 0;
                 }
                 if n == rays {
-                    let centre = node.centroid_in_world_m();
-                    let radius = node
-                        .vertices_in_world_m
-                        .iter()
-                        .map(|v| (v - centre).norm())
-                        .fold(0.0, f64::max);
-                    if t.cone_towards_artificial(&centre, radius)
+                    if t.cone_from_node(node)
                         .is_some_and(|(axis, cos)| axis.dot(&dir) < cos)
                     {
                         return n;

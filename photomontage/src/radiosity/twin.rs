@@ -26,7 +26,7 @@ use std::collections::HashMap;
 
 use nalgebra::{Point3, Vector3};
 
-use super::mesh::Mesh;
+use super::mesh::{Mesh, MeshNode};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneError, SceneTracer};
 
@@ -116,6 +116,19 @@ impl Twin {
         let sin = r / distance;
         // A slightly wider cone than the exact one (round-off never excludes a direction).
         Some((v / distance, (1.0 - sin * sin).sqrt() - CONE_COS_SLACK))
+    }
+
+    /// [`Twin::cone_towards_artificial`] for rays from any point of the mesh node `node`: from
+    /// its centroid, widened by its farthest vertex.
+    #[must_use]
+    pub(super) fn cone_from_node(&self, node: &MeshNode) -> Option<(Vector3<f64>, f64)> {
+        let centre = node.centroid_in_world_m();
+        let radius = node
+            .vertices_in_world_m
+            .iter()
+            .map(|v| (v - centre).norm())
+            .fold(0.0, f64::max);
+        self.cone_towards_artificial(&centre, radius)
     }
 
     /// Whether the ray from `origin_in_world_m` along `dir_in_world` (t ≥ 0) meets the planned
