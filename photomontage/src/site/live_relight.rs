@@ -11,8 +11,11 @@
 //!
 //! - finds nothing changed for the radiosity (the solutions are kept);
 //! - expresses the change as a [`LightingChange`] ([`lighting_change`]: a new sun, a new sky, a
-//!   luminaire's dimming, a material's diffuse reflectance) and applies it with
-//!   [`Transfer::relight`] on both transfers at once (never a form factor); a change of one
+//!   luminaire's dimming, a material's diffuse reflectance) and relights both transfers
+//!   (never a form factor): the rays first ([`Transfer::prepare_relight`]: the natural
+//!   transfer's, then the other's, which reads the natural sun counts through its twins,
+//!   [`crate::radiosity::sun_rays`]), then both solves side by side
+//!   ([`Transfer::commit_relight`]), which is [`Transfer::relight`] of each, bit for bit; a change of one
 //!   material's reflectance and nothing else, the colour designer's edit, goes through
 //!   [`Transfer::relight_material`]: its first edit tabulates the solution in that material's
 //!   reflectance, and the edits after it read the table (no link is read);
