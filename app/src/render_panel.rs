@@ -165,7 +165,18 @@ fn render_job(
         image: display_photo(photo, &tone_map),
     });
     if job.plan.radiosity && !job.prepared.photo_only {
-        options.prepare_radiosity(doc, id, &mut job.prepared.job, progress)?;
+        if job.plan.spectral {
+            // The kept transfers are RGB: a spectral render solves each of its passes, as the
+            // CLI does.
+            job.plan
+                .solve_radiosity(doc, &mut job.prepared, progress.cancel_flag())
+                .map_err(|e| RenderPanelError::Prepare {
+                    photo: id.to_owned(),
+                    message: e.to_string(),
+                })?;
+        } else {
+            options.prepare_radiosity(doc, id, &mut job.prepared.job, progress)?;
+        }
     }
     let tiles = progress.clone();
     let on_tile = move |t: TileProgress| tiles.send(RenderUpdate::Tile(t));

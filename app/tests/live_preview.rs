@@ -20,6 +20,7 @@ use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::TransferUpdate;
 use photomontage::site::render::{prepare_view, site_scene};
+use photomontage::site::render_photo::{RenderPlan, RenderRequest};
 use photomontage::site::render_radiosity::site_radiosity_light;
 use photomontage_studio::Studio;
 use photomontage_studio::render_panel::{display_image, site_tone_map};
@@ -246,4 +247,51 @@ fn radiosity_mode_relights_the_kept_transfers() {
         &fresh.without_artificial,
     );
     assert_montage_is(&h, &library_render(&doc, Some(light)), "radiosity");
+}
+
+/// In spectral mode the Render panel solves the radiosity once per spectral pass (the kept
+/// transfers are RGB) and its montage equals the library's `RenderPlan` render of the same site
+/// (the CLI's entry point) bit for bit.
+#[test]
+fn a_spectral_radiosity_render_is_the_librarys() {
+    let (_dir, site) = copy_sample();
+    add_box_model(&site);
+    let mut text = std::fs::read_to_string(&site).unwrap();
+    text.push_str("\n[render]\nradiosity = true\nspectral = true\n");
+    std::fs::write(&site, text).unwrap();
+    let mut h = harness(&site, WINDOW);
+    h.get_by_label("Solve").click();
+    step_until(&mut h, "solve", |s| s.solution().is_some() && s.is_idle());
+    h.get_by_label("Render").click();
+    h.run();
+    {
+        let q = &mut h.state_mut().render_panel_mut().quality;
+        (q.spp_min, q.spp_max, q.seed) = (4, 4, SEED);
+    }
+    h.get_by_label("Start").click();
+    steps(&mut h);
+    wait(&mut h, "spectral radiosity render", |s| {
+        !s.render_panel().busy() && s.render_panel().montage().is_some()
+    });
+    let doc = h.state().document().unwrap().clone();
+    let request = RenderRequest {
+        spp_min: Some(4),
+        spp_max: Some(4),
+        seed: Some(SEED),
+        ..RenderRequest::view("P1")
+    };
+    let plan = RenderPlan::new(&doc, &request).unwrap();
+    assert!(plan.spectral && plan.radiosity);
+    let library = plan.render(&doc, &|_| {}, &AtomicBool::new(false)).unwrap();
+    let report = library.radiosity.as_ref().expect("solved");
+    assert!(
+        report.notes.iter().any(|n| n.contains("3 passes")),
+        "{report:?}"
+    );
+    let montage = &h.state().render_panel().montage().unwrap().image;
+    assert!(library.image.changed_pixels > 1000, "the box is in view");
+    assert!(
+        bits(montage) == bits(&library.image),
+        "the panel's spectral radiosity render differs from the library's"
+    );
 }

@@ -34,7 +34,8 @@
 //! ([`shadow_refinement`], when asked for); there is no discontinuity meshing, and otherwise the
 //! adaptivity is the hierarchical solver's (links at coarser levels where the transfer is small).
 //! The renderer uses the solution only in its opt-in radiosity lighting mode
-//! (`render::differential::radiosity_light`). No spectral mode (RGB only). Luminaires are point
+//! (`render::differential::radiosity_light`). The solver is RGB; a spectral render solves it once
+//! per spectral pass of three samples (`site::spectral_radiosity`). Luminaires are point
 //! sources. [`transfer`] relights on the links refined for the lighting it was built with.
 
 pub mod city_block;

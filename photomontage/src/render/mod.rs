@@ -61,7 +61,9 @@ pub use illumination::{Daylight, DistantLight, PointLight, Rgb};
 pub use irradiance_cache::IrradianceCacheSettings;
 pub use luminaire_light::{ArtificialLight, LuminaireLight};
 pub use output::{LayerSet, OutputError, OutputFormat, OutputLayers};
-pub use spectral::{SpectralError, render_band_spectral, render_view_spectral};
+pub use spectral::{
+    SpectralError, SpectralPasses, SpectralRadiosity, render_band_spectral, render_view_spectral,
+};
 pub use tiling::{Band, BandError};
 
 use tiling::{TileOut, drive_tiles};

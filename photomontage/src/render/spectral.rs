@@ -20,6 +20,10 @@
 //! ~1e-12, see [`crate::colour::spectrum`]); coloured materials differ from RGB mode, which is
 //! the point of the mode (products of spectra are not products of RGB triples).
 //!
+//! In the radiosity lighting mode each pass reads its own radiosity solutions, solved with the
+//! pass's reflectances and light colours ([`SpectralRadiosity`], built by
+//! `site::spectral_radiosity` through [`SpectralPasses`], which converts as the passes here do).
+//!
 //! # Known limitations
 //! The photo is taken to be linear sRGB. The atmosphere's transmittance is converted like a
 //! reflectance (ratio to white), its horizon colour like a light. Meyer's 4 samples cannot
@@ -29,6 +33,7 @@
 //! each pass holds its own f32 copy of the photo (the secondary rays look natural surfaces up in
 //! it): 3 extra photo-sized images for Durisch's 9.
 
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use image::Rgb32FImage;
@@ -36,6 +41,8 @@ use nalgebra::Point2;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+use super::differential::radiosity_light::RadiosityLight;
+pub use super::differential::radiosity_light::SpectralRadiosity;
 use super::differential::{DifferentialTracer, Lighting};
 use super::illumination::Rgb;
 use super::luminaire_light::ArtificialLight;
@@ -57,6 +64,9 @@ pub enum SpectralError {
     /// The Appendix A conversion could not be set up.
     #[error("spectral conversion: {0}")]
     Spectrum(#[from] SpectrumError),
+    /// The radiosity solutions do not belong to the render's passes.
+    #[error("spectral radiosity: {0}")]
+    Radiosity(String),
     /// The atmosphere could not be expressed on a pass's bands.
     #[error("atmosphere on spectral samples {bands:?}: {message}")]
     Atmosphere {
@@ -68,6 +78,7 @@ pub enum SpectralError {
 }
 
 /// Colour conversions of one sample set.
+#[derive(Debug)]
 struct Converter {
     rgb_to_spectrum: RgbToSpectrum,
     white: Vec<f64>,
@@ -135,6 +146,109 @@ fn pick(values: &[f64], bands: [usize; 3]) -> Rgb {
     bands.map(|b| values.get(b).copied().unwrap_or(0.0))
 }
 
+/// The spectral samples of a set, three at a time (the last pass padded with the last sample).
+fn band_sets(n: usize) -> Vec<[usize; 3]> {
+    (0..n.div_ceil(3))
+        .map(|p| [0, 1, 2].map(|k| (3 * p + k).min(n - 1)))
+        .collect()
+}
+
+/// The passes of a spectral render (three spectral samples each as the tracer's three
+/// channels) and the colour conversions the render applies to each pass's inputs (module doc),
+/// for what is computed before the render on the same passes: the radiosity solutions of the
+/// spectral radiosity mode ([`SpectralRadiosity`]).
+#[derive(Debug)]
+pub struct SpectralPasses {
+    conv: Converter,
+    bands: Vec<[usize; 3]>,
+}
+
+impl SpectralPasses {
+    /// The passes of `set` (Durisch's 9 samples: 3 passes; Meyer's 4: 2).
+    ///
+    /// # Errors
+    /// The Appendix A conversion could not be set up.
+    pub fn new(set: SampleSet) -> Result<Self, SpectrumError> {
+        let conv = Converter::new(set)?;
+        let bands = band_sets(conv.len());
+        Ok(Self { conv, bands })
+    }
+
+    /// The sample set.
+    #[must_use]
+    pub fn sample_set(&self) -> SampleSet {
+        self.conv.set
+    }
+
+    /// Number of passes.
+    #[must_use]
+    pub fn count(&self) -> usize {
+        self.bands.len()
+    }
+
+    /// The sample indices of pass `pass` (0-based; a pass past the last repeats the last).
+    #[must_use]
+    pub fn bands(&self, pass: usize) -> [usize; 3] {
+        self.bands[pass.min(self.bands.len() - 1)]
+    }
+
+    /// A light's colour (an irradiance, an intensity, a radiance) on pass `pass`: Appendix A.
+    #[must_use]
+    pub fn light(&self, pass: usize, rgb: Rgb) -> Rgb {
+        pick(&self.conv.light(rgb), self.bands(pass))
+    }
+
+    /// A reflectance or transmittance on pass `pass`: Appendix A relative to white, in [0, 1].
+    #[must_use]
+    pub fn reflectance(&self, pass: usize, rgb: Rgb) -> Rgb {
+        pick(&self.conv.reflectance(rgb), self.bands(pass))
+    }
+
+    /// A material on pass `pass`, as the render converts it (diffuse from its tabulated
+    /// spectrum where it has one, mirror, glass, emission).
+    #[must_use]
+    pub fn material(&self, pass: usize, material: &Material) -> Material {
+        pass_material(material, &self.conv, self.bands(pass))
+    }
+
+    /// A render's lighting on pass `pass`, as the render converts it; its radiosity solutions
+    /// are left out (a pass's own come from [`Lighting::radiosity_spectral`]).
+    ///
+    /// # Errors
+    /// [`SpectralError::Atmosphere`] when the atmosphere cannot be expressed on the pass.
+    pub fn lighting(&self, pass: usize, lighting: &Lighting) -> Result<Lighting, SpectralError> {
+        let mut out = pass_lighting(lighting, &self.conv, self.bands(pass))?;
+        out.radiosity_spectral = None;
+        Ok(out)
+    }
+
+    /// The photo on every pass (Appendix A per pixel).
+    #[must_use]
+    pub fn photos(&self, photo: &Rgb32FImage) -> Vec<Rgb32FImage> {
+        pass_photos(photo, &self.conv, &self.bands)
+    }
+}
+
+fn pass_photos(
+    photo: &Rgb32FImage,
+    conv: &Converter,
+    band_sets: &[[usize; 3]],
+) -> Vec<Rgb32FImage> {
+    let (w, h) = (photo.width(), photo.height());
+    let mut photos: Vec<Rgb32FImage> = band_sets.iter().map(|_| Rgb32FImage::new(w, h)).collect();
+    let mut samples = vec![0.0; conv.len()];
+    for (x, y, p) in photo.enumerate_pixels() {
+        conv.rgb_to_spectrum
+            .spectrum_into(p.0.map(f64::from), &mut samples);
+        for (img, bands) in photos.iter_mut().zip(band_sets) {
+            #[allow(clippy::cast_possible_truncation)]
+            let v = pick(&samples, *bands).map(|s| s as f32);
+            img.put_pixel(x, y, image::Rgb(v));
+        }
+    }
+    photos
+}
+
 /// The inputs of one pass (three spectral samples as the tracer's three channels).
 struct Pass {
     bands: [usize; 3],
@@ -150,7 +264,7 @@ fn pass_lighting(
 ) -> Result<Lighting, SpectralError> {
     let light = |rgb: Rgb| pick(&conv.light(rgb), bands);
     let mut out = lighting.clone();
-    // The radiosity solutions are RGB: the spectral passes use the facets.
+    // RGB solutions are not a pass's: the pass's own are set by the caller.
     out.radiosity = None;
     if let Some(sun) = &mut out.daylight.sun {
         sun.normal_irradiance_rgb = light(sun.normal_irradiance_rgb);
@@ -204,31 +318,48 @@ fn pass_material(m: &Material, conv: &Converter, bands: [usize; 3]) -> Material 
     out
 }
 
-fn passes(tracer: &DifferentialTracer<'_>, conv: &Converter) -> Result<Vec<Pass>, SpectralError> {
-    let n = conv.len();
-    let band_sets: Vec<[usize; 3]> = (0..n.div_ceil(3))
-        .map(|p| [0, 1, 2].map(|k| (3 * p + k).min(n - 1)))
-        .collect();
-    let photo = tracer.photo();
-    let (w, h) = (photo.width(), photo.height());
-    let mut photos: Vec<Rgb32FImage> = band_sets.iter().map(|_| Rgb32FImage::new(w, h)).collect();
-    let mut samples = vec![0.0; n];
-    for (x, y, p) in photo.enumerate_pixels() {
-        conv.rgb_to_spectrum
-            .spectrum_into(p.0.map(f64::from), &mut samples);
-        for (img, bands) in photos.iter_mut().zip(&band_sets) {
-            #[allow(clippy::cast_possible_truncation)]
-            let v = pick(&samples, *bands).map(|s| s as f32);
-            img.put_pixel(x, y, image::Rgb(v));
+/// Pass `pass`'s radiosity solutions: none in the facet mode; the pass's own in the radiosity
+/// mode (RGB solutions in a spectral render are refused, not read as samples).
+fn pass_radiosity(
+    lighting: &Lighting,
+    conv: &Converter,
+    pass: usize,
+    count: usize,
+) -> Result<Option<Arc<RadiosityLight>>, SpectralError> {
+    match (&lighting.radiosity_spectral, &lighting.radiosity) {
+        (None, None) => Ok(None),
+        (None, Some(_)) => Err(SpectralError::Radiosity(
+            "the lighting holds RGB radiosity solutions; a spectral render needs the \
+             solutions of each pass (SpectralRadiosity)"
+                .to_owned(),
+        )),
+        (Some(s), _) if s.sample_set != conv.set || s.passes.len() != count => {
+            Err(SpectralError::Radiosity(format!(
+                "radiosity solutions for {} passes of {:?}, the render has {count} of {:?}",
+                s.passes.len(),
+                s.sample_set,
+                conv.set
+            )))
         }
+        (Some(s), _) => Ok(Some(Arc::clone(&s.passes[pass]))),
     }
+}
+
+fn passes(tracer: &DifferentialTracer<'_>, conv: &Converter) -> Result<Vec<Pass>, SpectralError> {
+    let band_sets = band_sets(conv.len());
+    let photos = pass_photos(tracer.photo(), conv, &band_sets);
+    let count = band_sets.len();
     band_sets
         .into_iter()
         .zip(photos)
-        .map(|(bands, photo)| {
+        .enumerate()
+        .map(|(k, (bands, photo))| {
+            let mut lighting = pass_lighting(tracer.lighting(), conv, bands)?;
+            lighting.radiosity = pass_radiosity(tracer.lighting(), conv, k, count)?;
+            lighting.radiosity_spectral = None;
             Ok(Pass {
                 bands,
-                lighting: pass_lighting(tracer.lighting(), conv, bands)?,
+                lighting,
                 photo,
                 materials: tracer
                     .materials

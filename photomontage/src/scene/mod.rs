@@ -330,6 +330,16 @@ impl Scene {
         Ok(changed)
     }
 
+    /// Replaces every material by `f` of it, in place (ids and triangles kept), e.g. the
+    /// reflectances of one spectral pass; the name is kept whatever `f` returns.
+    pub fn map_materials(&mut self, f: &dyn Fn(&Material) -> Material) {
+        for m in &mut self.materials {
+            let mut mapped = f(m);
+            mapped.name = std::mem::take(&mut m.name);
+            *m = mapped;
+        }
+    }
+
     /// Replaces every scene material whose name appears in the library by the library's
     /// definition; returns how many were replaced.
     pub fn apply_material_library(&mut self, library: &MaterialLibrary) -> usize {

@@ -36,6 +36,7 @@ pub mod site_scene;
 pub mod site_time;
 pub mod solve;
 pub mod solve_options;
+pub mod spectral_radiosity;
 pub mod sun_path;
 #[cfg(feature = "opencv")]
 pub mod tie_matching;

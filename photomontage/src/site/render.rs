@@ -360,6 +360,7 @@ pub fn site_lighting(
             .transpose()?,
         horizon_rgb: l.atmosphere.horizon_colour,
         radiosity: None,
+        radiosity_spectral: None,
     };
     Ok((lighting, sun_up))
 }

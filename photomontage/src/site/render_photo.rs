@@ -170,12 +170,6 @@ impl RenderPlan {
             ));
         }
         let radiosity = request.radiosity || doc.site.render.radiosity;
-        if radiosity && spectral {
-            return Err(request_error(
-                "radiosity",
-                "the radiosity lighting mode is RGB only; render without spectral mode".to_owned(),
-            ));
-        }
         let exposure = request.exposure.unwrap_or(doc.site.render.exposure);
         if !(exposure.is_finite() && exposure > 0.0) {
             return Err(request_error(
@@ -350,11 +344,25 @@ impl RenderPlan {
             photo_linear: &job.photo_linear,
             lighting: &job.lighting,
         };
+        let photo = doc.site.render.photo_reflectance.then_some(&photo);
+        if self.spectral {
+            // One solve per spectral pass ([`super::spectral_radiosity`]).
+            let (light, report) = super::spectral_radiosity::site_spectral_radiosity(
+                doc,
+                &job.scene.scene,
+                &self.request.view,
+                photo,
+                SampleSet::Durisch9,
+                cancel,
+            )?;
+            prepared.job.lighting.radiosity_spectral = Some(std::sync::Arc::new(light));
+            return Ok(Some(report));
+        }
         let (light, report) = super::render_radiosity::site_radiosity_arc(
             doc,
             &job.scene.scene,
             &self.request.view,
-            doc.site.render.photo_reflectance.then_some(&photo),
+            photo,
             cancel,
         )?;
         prepared.job.lighting.radiosity = Some(light);
@@ -493,7 +501,7 @@ mod tests {
     }
 
     #[test]
-    fn radiosity_mode_is_in_the_identity_and_refused_with_spectral_mode() {
+    fn radiosity_mode_is_in_the_identity_with_or_without_spectral_mode() {
         let mut doc = street();
         let solution = crate::site::solve_site(&doc);
         crate::site::apply_solution(&mut doc.site, &solution);
@@ -514,15 +522,19 @@ mod tests {
                 .unwrap()
                 .radiosity
         );
-        let err = RenderPlan::new(
+        // With spectral mode: both, and both in the identity (a part of one is not a part of
+        // the other).
+        let both = RenderPlan::new(
             &doc,
             &RenderRequest {
                 spectral: true,
                 ..request
             },
         )
-        .unwrap_err();
-        assert!(err.to_string().contains("radiosity"), "{err}");
+        .unwrap();
+        assert!(both.radiosity && both.spectral);
+        assert_eq!(both.identity["lighting"], "radiosity");
+        assert_eq!(both.identity["mode"], "spectral Durisch9");
     }
 
     #[test]

@@ -30,7 +30,9 @@ use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lightin
 use super::render_error::SiteRenderError;
 use crate::bvh::BuildQuality;
 use crate::radiosity::twin::{Twin, twin_elements};
-use crate::radiosity::{Mesh, MeshParams, Rgb, SolveParams, solve_on_mesh_twinned, sun_directions};
+use crate::radiosity::{
+    Mesh, MeshParams, Rgb, SolveParams, TransferLighting, solve_on_mesh_twinned, sun_directions,
+};
 use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::scene::{ObjectKind, Scene, SceneError, SceneTracer};
 use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
@@ -137,12 +139,47 @@ pub fn site_radiosity_light(
 ) -> Result<(RadiosityLight, RadiosityReport), SiteRenderError> {
     let start = Instant::now();
     let (lighting, notes) = site_transfer_lighting(doc, scene, view)?;
+    let (params, element_edge_m) = site_solve_params(doc, scene)?;
+    let pair = solve_pair(scene, &lighting, &params, photo, cancel)?;
+    let report = RadiosityReport {
+        element_edge_m,
+        elements: [
+            pair.with.mesh.elements.len(),
+            pair.without.mesh.elements.len(),
+        ],
+        seconds: start.elapsed().as_secs_f64(),
+        notes,
+        photo_reflectance: pair.photo_reflectance,
+    };
+    let light = RadiosityLight::new(&pair.with, &pair.without, &RadiosityLight::traced_exactly)
+        .map_err(|e| radiosity_error(&e))?;
+    Ok((light, report))
+}
+
+/// The site's two solutions (with and without the artificial objects) and what the photo gave.
+pub(super) struct SolvedPair {
+    /// With the artificial objects.
+    pub with: crate::radiosity::Solution,
+    /// The photographed state.
+    pub without: crate::radiosity::Solution,
+    /// Natural elements whose ρ_d came from the photo.
+    pub photo_reflectance: Option<PhotoReflectanceCount>,
+}
+
+/// The two solves of [`site_radiosity_light`] for the given lighting and parameters (the
+/// site's, or their colours on one spectral pass, [`super::spectral_radiosity`]).
+pub(super) fn solve_pair(
+    scene: &Scene,
+    lighting: &TransferLighting,
+    params: &SolveParams,
+    photo: Option<&PhotoView<'_>>,
+    cancel: &AtomicBool,
+) -> Result<SolvedPair, SiteRenderError> {
     let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
     let (groups, _warnings) = lighting
         .light_groups(&dome, SKY_TOLERANCE)
         .map_err(|e| radiosity_error(&e))?;
     let natural = natural_part(scene)?;
-    let (params, element_edge_m) = site_solve_params(doc, scene)?;
     // Both meshes follow the sun's shadow edges in the scene with and without the artificial
     // objects, so that their natural surfaces are meshed alike and each resolves its shadows
     // (an old shadow edge inside a new shadow shows in the photographed state only).
@@ -167,7 +204,7 @@ pub fn site_radiosity_light(
         natural_mesh,
         &natural_tracer,
         &natural_groups,
-        &params,
+        params,
         cancel,
         &|_| {},
         &mut |solution: &crate::radiosity::Solution| refit.as_mut().map(|r| r.next_round(solution)),
@@ -196,7 +233,7 @@ pub fn site_radiosity_light(
         with_mesh,
         &tracer,
         &groups,
-        &params,
+        params,
         cancel,
         &|_| {},
         &mut |_| None,
@@ -204,16 +241,11 @@ pub fn site_radiosity_light(
         twin.as_ref().zip(natural_sky.as_ref()),
     )
     .map_err(|e| radiosity_error(&e))?;
-    let report = RadiosityReport {
-        element_edge_m,
-        elements: [with.mesh.elements.len(), without.mesh.elements.len()],
-        seconds: start.elapsed().as_secs_f64(),
-        notes,
+    Ok(SolvedPair {
+        with,
+        without,
         photo_reflectance: refit.as_ref().and_then(PhotoRefit::count),
-    };
-    let light = RadiosityLight::new(&with, &without, &RadiosityLight::traced_exactly)
-        .map_err(|e| radiosity_error(&e))?;
-    Ok((light, report))
+    })
 }
 
 /// The per-element reflectances of `from` carried to the elements of another mesh whose twins

@@ -117,6 +117,10 @@ pub struct Lighting {
     /// solutions with and without the artificial objects instead of the sky facets and the
     /// photo bounce. `None`: the facet mode.
     pub radiosity: Option<std::sync::Arc<radiosity_light::RadiosityLight>>,
+    /// The radiosity lighting mode of a spectral render: the solutions of each pass
+    /// ([`crate::render::spectral`]); `radiosity` stays `None` then. `None`: the facet mode, or an
+    /// RGB render.
+    pub radiosity_spectral: Option<std::sync::Arc<radiosity_light::SpectralRadiosity>>,
 }
 
 /// What one ray returned.

@@ -32,8 +32,9 @@
 //! The sky's direct light is interpolated on the elements: a change across an element is
 //! blurred over it, so coarse elements near the building blur the sky it blocks. The gathered
 //! light is a Monte Carlo estimate (1024 stratified rays per vertex). The threshold hides changes
-//! below it (by design: they leave the photo untouched). RGB mode only: the spectral passes
-//! ignore the solutions and use the facets.
+//! below it (by design: they leave the photo untouched). In spectral mode each pass reads its
+//! own pair of solutions ([`crate::render::spectral::SpectralRadiosity`]); RGB solutions in a
+//! spectral render are refused.
 
 use std::sync::Arc;
 
@@ -219,4 +220,15 @@ impl RadiosityLight {
     pub fn is_change(&self, delta: &Rgb, natural: &Rgb) -> bool {
         (0..3).any(|c| delta[c].abs() > self.change_fraction * natural[c].abs())
     }
+}
+
+/// The radiosity solutions of each pass of a spectral render (the radiosity lighting mode in
+/// spectral mode): pass `k`'s solutions were solved with the pass's reflectances and light
+/// colours, so that interreflection is computed per spectral sample.
+#[derive(Debug, Clone)]
+pub struct SpectralRadiosity {
+    /// The sample set the passes belong to.
+    pub sample_set: crate::colour::SampleSet,
+    /// One radiosity light per pass, in pass order.
+    pub passes: Vec<Arc<RadiosityLight>>,
 }

@@ -1,0 +1,170 @@
+//! The radiosity lighting mode in spectral mode (`render --spectral --radiosity`): the site's
+//! radiosity is solved once per spectral pass of the render ([`SpectralPasses`], Durisch's 9
+//! samples three at a time, docs/methodology.md "Spectral radiosity"), so that interreflection
+//! is a product of spectra, not of RGB triples (Cohen & Wallace 1993 §9.3: a radiosity solve per
+//! wavelength band). Each pass solves [`super::render_radiosity::solve_pair`] with
+//!
+//! - the scene's materials as the pass sees them (diffuse reflectance from the material's
+//!   tabulated spectrum or Appendix A of its RGB relative to white, emission as a light);
+//! - the sun's, the sky's and the luminaires' colours on the pass (Appendix A);
+//! - the unmodelled ground's albedo on the pass;
+//! - with the photo's reflectances on, the pass's photo and the pass's daylight, so that ρ_d is
+//!   inverted per sample (Durisch's second inversion on each band).
+//!
+//! The meshes (the geometry and the sun's shadow edges) are the same on every pass, so the
+//! vertex gathers of the first pass (their traced rays) serve all of them
+//! ([`RadiosityLight::relit`]).
+//!
+//! # Known limitations
+//! Each pass is a full solve: its form factors are computed again (the same links come out,
+//! the geometry being the same, but the BF refinement reads the pass's light, so a link may be
+//! refined on one pass and not on another). A spectral radiosity render so costs about the
+//! passes' count times the RGB precompute. The studio's live preview keeps RGB transfers only.
+
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use super::SiteDocument;
+use super::photo_reflectance::{PhotoReflectanceCount, PhotoView};
+use super::radiosity_lighting::site_transfer_lighting;
+use super::render_error::SiteRenderError;
+use super::render_radiosity::{RadiosityReport, site_solve_params, solve_pair};
+use crate::colour::SampleSet;
+use crate::radiosity::{SolveParams, TransferLighting};
+use crate::render::SpectralPasses;
+use crate::render::differential::radiosity_light::RadiosityLight;
+use crate::render::spectral::SpectralRadiosity;
+use crate::scene::Scene;
+
+fn spectrum_error(e: &dyn std::fmt::Display) -> SiteRenderError {
+    SiteRenderError::Request {
+        field: "render.spectral",
+        reason: e.to_string(),
+    }
+}
+
+/// The site's transfer lighting on pass `pass`: every light colour through Appendix A.
+#[must_use]
+pub fn pass_transfer_lighting(
+    passes: &SpectralPasses,
+    pass: usize,
+    lighting: &TransferLighting,
+) -> TransferLighting {
+    let mut out = lighting.clone();
+    if let Some(sun) = &mut out.sun {
+        sun.normal_irradiance_rgb = passes.light(pass, sun.normal_irradiance_rgb);
+    }
+    if let Some(sky) = &mut out.sky {
+        sky.horizontal_irradiance_rgb = passes.light(pass, sky.horizontal_irradiance_rgb);
+    }
+    for l in &mut out.luminaires {
+        l.source.intensity_rgb = passes.light(pass, l.source.intensity_rgb);
+    }
+    out
+}
+
+/// The solve parameters on pass `pass`: the unmodelled ground's albedo as a reflectance.
+#[must_use]
+pub fn pass_solve_params(
+    passes: &SpectralPasses,
+    pass: usize,
+    params: &SolveParams,
+) -> SolveParams {
+    let mut out = params.clone();
+    if let Some(ground) = &mut out.ground {
+        ground.albedo_rgb = passes.reflectance(pass, ground.albedo_rgb);
+    }
+    out
+}
+
+/// The scene with its materials as pass `pass` sees them.
+#[must_use]
+pub fn pass_scene(passes: &SpectralPasses, pass: usize, scene: &Scene) -> Scene {
+    let mut out = scene.clone();
+    out.map_materials(&|m| passes.material(pass, m));
+    out
+}
+
+/// Solves the site's radiosity on every pass of `sample_set` (module doc), with and without the
+/// artificial objects, as [`super::render_radiosity::site_radiosity_light`] does in RGB.
+///
+/// # Errors
+/// As [`super::render_radiosity::site_radiosity_light`]; the spectral conversion's.
+pub fn site_spectral_radiosity(
+    doc: &SiteDocument,
+    scene: &Scene,
+    view: &str,
+    photo: Option<&PhotoView<'_>>,
+    sample_set: SampleSet,
+    cancel: &AtomicBool,
+) -> Result<(SpectralRadiosity, RadiosityReport), SiteRenderError> {
+    let start = Instant::now();
+    let passes = SpectralPasses::new(sample_set).map_err(|e| spectrum_error(&e))?;
+    let (lighting, mut notes) = site_transfer_lighting(doc, scene, view)?;
+    let (params, element_edge_m) = site_solve_params(doc, scene)?;
+    let photos = photo.map(|p| passes.photos(p.photo_linear));
+    let mut lights: Vec<Arc<RadiosityLight>> = Vec::with_capacity(passes.count());
+    let mut elements = [0, 0];
+    let mut photo_reflectance: Option<PhotoReflectanceCount> = None;
+    for pass in 0..passes.count() {
+        let pass_photo_lighting = photo
+            .map(|p| passes.lighting(pass, p.lighting))
+            .transpose()
+            .map_err(|e| spectrum_error(&e))?;
+        let pass_photo = photo
+            .zip(photos.as_ref())
+            .zip(pass_photo_lighting.as_ref())
+            .map(|((p, photos), lighting)| PhotoView {
+                camera: p.camera,
+                photo_linear: &photos[pass],
+                lighting,
+            });
+        let pair = solve_pair(
+            &pass_scene(&passes, pass, scene),
+            &pass_transfer_lighting(&passes, pass, &lighting),
+            &pass_solve_params(&passes, pass, &params),
+            pass_photo.as_ref(),
+            cancel,
+        )?;
+        elements = [
+            pair.with.mesh.elements.len(),
+            pair.without.mesh.elements.len(),
+        ];
+        // The count of the first pass (the same elements are seen on every pass).
+        photo_reflectance = photo_reflectance.or(pair.photo_reflectance);
+        let traced = &RadiosityLight::traced_exactly;
+        let light = match lights.first() {
+            // The same meshes: the first pass's vertex gathers are kept.
+            Some(first) => first.relit(&pair.with, &pair.without, traced, [None, None]),
+            None => RadiosityLight::new(&pair.with, &pair.without, traced),
+        }
+        .map_err(|e| SiteRenderError::Request {
+            field: "render.radiosity",
+            reason: e.to_string(),
+        })?;
+        lights.push(Arc::new(light));
+    }
+    notes.push(format!(
+        "spectral radiosity: solved on {} passes of {sample_set:?}",
+        passes.count()
+    ));
+    let report = RadiosityReport {
+        element_edge_m,
+        elements,
+        seconds: start.elapsed().as_secs_f64(),
+        notes,
+        photo_reflectance,
+    };
+    Ok((
+        SpectralRadiosity {
+            sample_set,
+            passes: lights,
+        },
+        report,
+    ))
+}
+
+#[cfg(test)]
+#[path = "spectral_radiosity_tests.rs"]
+mod tests;
