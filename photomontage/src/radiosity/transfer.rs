@@ -640,9 +640,17 @@ impl Transfer {
             }
             None => None,
         };
-        let (new_groups, warnings) =
-            lighting.light_groups(self.sky_rays.transfer.dome(), self.params.sky_tolerance)?;
         let actions = self.actions(&lighting);
+        // A kept sky (a sun step under a sky that does not follow the sun) is not clustered
+        // again: its sources are the same.
+        let kept_sky = (self.kinds.get(1) == Some(&GroupKind::Sky)
+            && actions.get(1) == Some(&Action::Keep))
+        .then(|| &self.groups[1]);
+        let (new_groups, warnings) = lighting.light_groups_keeping_sky(
+            self.sky_rays.transfer.dome(),
+            self.params.sky_tolerance,
+            kept_sky,
+        )?;
         // Re-trace what needs it (only the changed groups' rays; never a form factor).
         let mut retraced: Vec<Option<Vec<Rgb>>> = vec![None; actions.len()];
         let mut sun_counts = None;

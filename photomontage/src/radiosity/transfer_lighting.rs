@@ -88,9 +88,38 @@ impl TransferLighting {
         dome: &IcosahedralDome,
         sky_tolerance: f64,
     ) -> Result<(Vec<LightGroup>, Vec<LightWarning>), RadiosityError> {
+        self.light_groups_keeping_sky(dome, sky_tolerance, None)
+    }
+
+    /// [`Self::light_groups`] with the sky group `kept` instead of clustering the sky again,
+    /// where the caller knows the sky's sources are unchanged (the same sky, and a sun that it
+    /// does not follow, or that did not move; a relight's sun step). The kept group's sun is set
+    /// to this lighting's, so that it equals what clustering would give.
+    ///
+    /// # Errors
+    /// As [`Self::light_groups`].
+    pub fn light_groups_keeping_sky(
+        &self,
+        dome: &IcosahedralDome,
+        sky_tolerance: f64,
+        kept: Option<&LightGroup>,
+    ) -> Result<(Vec<LightGroup>, Vec<LightWarning>), RadiosityError> {
         let mut warnings = Vec::new();
         let sun_group = self.sun_group(&mut warnings)?;
-        let mut groups = vec![sun_group, self.sky_group(dome, sky_tolerance)?];
+        let sky_group = match kept {
+            Some(group) => {
+                let mut group = group.clone();
+                if let Some(sky) = &mut group.sky {
+                    sky.sun_dir_in_world = self
+                        .sun
+                        .as_ref()
+                        .map_or_else(Vector3::z, |s| s.dir_in_world);
+                }
+                group
+            }
+            None => self.sky_group(dome, sky_tolerance)?,
+        };
+        let mut groups = vec![sun_group, sky_group];
         for l in &self.luminaires {
             groups.push(luminaire_group(l)?);
         }

@@ -265,6 +265,45 @@ fn sun_move_sky_change_and_material_change_match_a_full_resolve() {
     }
 }
 
+/// A sun step keeps the sky group when the sky's sources cannot have changed (a sky that does
+/// not follow the sun); the kept group is, field for field, what clustering the sky again gives.
+#[test]
+fn a_kept_sky_group_is_the_clustered_one() {
+    let scene = yard([0.6; 3]);
+    let p = params(RelightStrategy::LinearResponses, Sweep::Shooting);
+    let mut t = build(&scene, &lighting(), &p);
+    let dome = crate::sky_dome::icosahedral::IcosahedralDome::new(
+        &crate::sky_dome::icosahedral::IcosahedralParams::tonn_donath(),
+    )
+    .unwrap();
+    let sky = |model| {
+        Some(Some(Sky {
+            model,
+            horizontal_irradiance_rgb: [0.2, 0.25, 0.35],
+        }))
+    };
+    let steps = [
+        // Under the overcast sky it was built with, then a uniform one, then a CIE clear sky
+        // (which follows the sun: clustered again on every step).
+        (None, sun_at(0.9, 3.4)),
+        (None, sun_at(0.8, 3.5)),
+        (sky(SkyModel::Uniform), sun_at(0.8, 3.5)),
+        (None, sun_at(0.7, 3.6)),
+        (sky(SkyModel::cie_general(12).unwrap()), sun_at(0.7, 3.6)),
+        (None, sun_at(0.6, 3.7)),
+    ];
+    for (k, (sky, sun)) in steps.into_iter().enumerate() {
+        t.relight_in_place(&LightingChange {
+            sun: Some(Some(sun)),
+            sky,
+            ..LightingChange::default()
+        })
+        .unwrap();
+        let (clustered, _) = t.lighting().light_groups(&dome, p.sky_tolerance).unwrap();
+        assert!(t.light_groups() == clustered.as_slice(), "step {k}");
+    }
+}
+
 #[test]
 fn relight_on_the_same_links_is_the_cold_solve() {
     for sweep in [Sweep::GaussSeidel, Sweep::Shooting] {
