@@ -9,7 +9,8 @@
 # the user guide shows, and studio-study.png with montages, which takes long in a debug build and
 # is not in the guide yet) and one shot of each further side tab it knows by label
 # ("Site & light", "Materials", "Variants": docs/images/studio-<tab>.png; "Elevation": the Materials
-# tab with its unfolded elevation drawn by irradiance; "Study": the shadow-map shot alone); a tab
+# tab with its unfolded elevation drawn by irradiance; "Radiosity": the Site & light tab scrolled
+# to its exposure and radiosity switches; "Study": the shadow-map shot alone); a tab
 # the studio does not know yet (`--tab` refuses it) is skipped with a note. With TAB arguments only those tabs.
 # A new tab needs its label in `Studio::select_tab` (app/src/study_panel.rs).
 #
@@ -69,7 +70,7 @@ shot() {
     local out=$1
     shift
     xvfb-run -a -s "-screen 0 1920x1200x24" \
-        "$bin/photomontage-studio" "$site" --frames 30 --screenshot "$out" "$@"
+        "$bin/photomontage-studio" "${shot_site:-$site}" --frames 30 --screenshot "$out" "$@" || return 1
     echo "wrote $out"
 }
 
@@ -78,7 +79,7 @@ if [[ ${#tabs[@]} -eq 0 ]]; then
         --study-dates 2026-06-21 --study-times 09:00,12:00,15:00 --study-frame 1
     shot docs/images/studio-study-shadow.png --tab Study --study-dates 2026-03-20,2026-06-21 \
         --study-times 09:00,12:00,17:00 --study-shadow-maps --study-no-montages --study-frame 4
-    tabs=("Site & light" "Materials" "Variants" "Elevation")
+    tabs=("Site & light" "Materials" "Variants" "Elevation" "Radiosity")
 fi
 for tab in "${tabs[@]}"; do
     slug=$(echo "$tab" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\+/-/g; s/-$//')
@@ -91,6 +92,15 @@ for tab in "${tabs[@]}"; do
         shot docs/images/studio-study-shadow.png --tab Study --study-dates 2026-03-20,2026-06-21 \
             --study-times 09:00,12:00,17:00 --study-shadow-maps --study-no-montages --study-frame 4
         continue
+    fi
+    shot_site=$site
+    if [[ $tab == Radiosity ]]; then
+        # The Site & light tab scrolled to the exposure and the radiosity switches, on a copy of
+        # the solved site with the radiosity mode on.
+        tab="Site & light"
+        extra=(--light-render-settings)
+        shot_site="$work/street/site-radiosity.toml"
+        sed 's/^spp_max = 8$/spp_max = 8\nradiosity = true/' "$site" > "$shot_site"
     fi
     if [[ $tab == Elevation ]]; then
         # The Materials tab's unfolded elevation of the planned building, by irradiance.

@@ -37,6 +37,12 @@ impl Studio {
         self.materials.request_elevation(irradiance);
     }
 
+    /// Scrolls the Site & light tab to its render settings (the exposure and the radiosity
+    /// switches) and keeps them in view (the `--light-render-settings` start option).
+    pub fn scroll_light_to_render_settings(&mut self) {
+        self.light.scroll_to_render = true;
+    }
+
     /// Starts a solve of the site as it is now on the worker thread.
     pub fn start_solve(&mut self, ctx: &egui::Context) {
         let Some(doc) = self.doc.clone() else {

@@ -10,7 +10,8 @@
 //! until killed — the crash-safety test uses it. `--solve`: start a solve on the first frame.
 //! `--tab LABEL` shows that side tab; `--study-dates D --study-times T [--study-shadow-maps
 //! [--study-no-montages]] [--study-frame N]` runs the Study tab's sun study on the first frame (the screenshot waits
-//! for it; `docs/screenshots.sh` uses these).
+//! for it; `docs/screenshots.sh` uses these). `--light-render-settings` scrolls the Site & light
+//! tab to its exposure and radiosity switches.
 
 use anyhow::{Context as _, bail};
 use clap::Parser as _;
@@ -78,6 +79,10 @@ struct Args {
     /// With --elevation: colour the façades by their irradiance from a radiosity solve.
     #[arg(long, requires = "elevation")]
     elevation_irradiance: bool,
+    /// Scroll the Site & light tab to its render settings: the exposure and the radiosity
+    /// switches (with --tab "Site & light").
+    #[arg(long)]
+    light_render_settings: bool,
     /// Largest photo the studio decodes, in megapixels (as the CLI's option).
     #[arg(long, value_name = "MP", default_value_t = 250.0)]
     max_photo_megapixels: f64,
@@ -115,6 +120,8 @@ struct Shell {
     variants_on_start: bool,
     /// `--elevation`: `Some(irradiance)` until asked for on the first frame.
     elevation_on_start: Option<bool>,
+    /// `--light-render-settings`, applied on every frame (a site opened later resets the tab).
+    light_render_settings: bool,
 }
 
 impl eframe::App for Shell {
@@ -129,6 +136,9 @@ impl eframe::App for Shell {
         }
         if let Some(irradiance) = self.elevation_on_start.take() {
             self.studio.start_elevation(irradiance);
+        }
+        if self.light_render_settings {
+            self.studio.scroll_light_to_render_settings();
         }
         if std::mem::take(&mut self.variants_on_start) {
             let ctx = ui.ctx().clone();
@@ -253,6 +263,7 @@ fn main() -> anyhow::Result<()> {
         study_frame: args.study_frame,
         variants_on_start: args.render_variants,
         elevation_on_start: args.elevation.then_some(args.elevation_irradiance),
+        light_render_settings: args.light_render_settings,
     };
     eframe::run_native(
         "photomontage studio",

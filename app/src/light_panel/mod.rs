@@ -41,6 +41,9 @@ const ERROR_COLOUR: Color32 = Color32::from_rgb(230, 80, 60);
 /// The Site & light tab's own state: the text being typed and the last message.
 #[derive(Default)]
 pub struct LightPanel {
+    /// Keep the render settings (exposure, the radiosity switches) scrolled into view (the
+    /// screenshot option `--light-render-settings`).
+    pub scroll_to_render: bool,
     /// Per text field, the site value it was last filled from: a field is refilled only when
     /// its own value in the site changes (its apply, or an undo of it), so text typed but not
     /// applied survives every other edit.
@@ -528,6 +531,9 @@ impl LightPanel {
                 )
                 .on_hover_text("the photographed surfaces take their diffuse reflectance from the photo's pixels where it sees them, else from the material library");
             name_widget(ui, &r, "reflectance from the photo");
+            if self.scroll_to_render {
+                r.scroll_to_me(Some(egui::Align::Center));
+            }
         });
         if (radiosity, photo_reflectance) != (render.radiosity, render.photo_reflectance) {
             out.push(edit(
