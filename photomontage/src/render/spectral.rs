@@ -174,12 +174,6 @@ impl SpectralPasses {
         Ok(Self { conv, bands })
     }
 
-    /// The sample set.
-    #[must_use]
-    pub fn sample_set(&self) -> SampleSet {
-        self.conv.set
-    }
-
     /// Number of passes.
     #[must_use]
     pub fn count(&self) -> usize {
@@ -217,9 +211,7 @@ impl SpectralPasses {
     /// # Errors
     /// [`SpectralError::Atmosphere`] when the atmosphere cannot be expressed on the pass.
     pub fn lighting(&self, pass: usize, lighting: &Lighting) -> Result<Lighting, SpectralError> {
-        let mut out = pass_lighting(lighting, &self.conv, self.bands(pass))?;
-        out.radiosity_spectral = None;
-        Ok(out)
+        pass_lighting(lighting, &self.conv, self.bands(pass))
     }
 
     /// The photo on every pass (Appendix A per pixel).
@@ -264,8 +256,10 @@ fn pass_lighting(
 ) -> Result<Lighting, SpectralError> {
     let light = |rgb: Rgb| pick(&conv.light(rgb), bands);
     let mut out = lighting.clone();
-    // RGB solutions are not a pass's: the pass's own are set by the caller.
+    // RGB solutions are not a pass's, nor are all passes' solutions: the pass's own are set by
+    // the caller.
     out.radiosity = None;
+    out.radiosity_spectral = None;
     if let Some(sun) = &mut out.daylight.sun {
         sun.normal_irradiance_rgb = light(sun.normal_irradiance_rgb);
     }
@@ -356,7 +350,6 @@ fn passes(tracer: &DifferentialTracer<'_>, conv: &Converter) -> Result<Vec<Pass>
         .map(|(k, (bands, photo))| {
             let mut lighting = pass_lighting(tracer.lighting(), conv, bands)?;
             lighting.radiosity = pass_radiosity(tracer.lighting(), conv, k, count)?;
-            lighting.radiosity_spectral = None;
             Ok(Pass {
                 bands,
                 lighting,

@@ -92,7 +92,7 @@ fn area_m2(scene: &Scene) -> f64 {
         .sum()
 }
 
-fn radiosity_error(e: &crate::radiosity::RadiosityError) -> SiteRenderError {
+pub(super) fn radiosity_error(e: &crate::radiosity::RadiosityError) -> SiteRenderError {
     SiteRenderError::Request {
         field: "render.radiosity",
         reason: e.to_string(),

@@ -29,7 +29,7 @@ use super::SiteDocument;
 use super::photo_reflectance::{PhotoReflectanceCount, PhotoView};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
-use super::render_radiosity::{RadiosityReport, site_solve_params, solve_pair};
+use super::render_radiosity::{RadiosityReport, radiosity_error, site_solve_params, solve_pair};
 use crate::colour::SampleSet;
 use crate::radiosity::{SolveParams, TransferLighting};
 use crate::render::SpectralPasses;
@@ -139,10 +139,7 @@ pub fn site_spectral_radiosity(
             Some(first) => first.relit(&pair.with, &pair.without, traced, [None, None]),
             None => RadiosityLight::new(&pair.with, &pair.without, traced),
         }
-        .map_err(|e| SiteRenderError::Request {
-            field: "render.radiosity",
-            reason: e.to_string(),
-        })?;
+        .map_err(|e| radiosity_error(&e))?;
         lights.push(Arc::new(light));
     }
     notes.push(format!(
