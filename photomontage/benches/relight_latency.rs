@@ -8,7 +8,8 @@
 //! step is the studio's path after the site has been read: the site's lighting and materials →
 //! [`photomontage::site::live_relight::lighting_change`] (geometry fingerprint, change) →
 //! `Transfer::relight` on both transfers side by side → the renderer's `RadiosityLight` (the
-//! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth; a
+//! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth back and forth; a
+//! sun drag step moves it on by 1° along a sweep of ±30° (a user dragging the slider); a
 //! material colour step changes the "render" material's colour, which the planned building
 //! shares with seven existing ones, so both transfers relight (the worst case). A proposal
 //! colour step changes the colour of a planned building that has its own material
@@ -28,6 +29,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 
 mod common;
 use common::{cpu_s, load_average};
+use photomontage::radiosity::Solution;
 use photomontage::radiosity::TransferParams;
 use photomontage::radiosity::city_block::{
     RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
@@ -42,6 +44,10 @@ use photomontage::sky::SkyModel;
 const THREADS: usize = 2;
 /// Sun slider step: 1° of azimuth.
 const SUN_STEP_RAD: f64 = 1.0_f64 * std::f64::consts::PI / 180.0;
+/// Half the sweep of the sun drag, in 1° steps.
+const DRAG_HALF_DEG: usize = 30;
+/// Steps of the drag summary (one sweep from one end to the other and back).
+const DRAG_STEPS: usize = 4 * DRAG_HALF_DEG;
 /// The material colour step: "render" between its albedo and this colour.
 const RENDER_COLOUR: [f64; 3] = [0.7, 0.5, 0.4];
 /// The proposal colour step: "proposal" between the render albedo and this colour.
@@ -53,6 +59,21 @@ fn sun_lighting(flip: bool) -> TransferLighting {
         0.7,
         2.6 + if flip { SUN_STEP_RAD } else { 0.0 },
     ));
+    l
+}
+
+/// Sun slider drag: the `i`-th of 1° azimuth steps swept back and forth over ±[`DRAG_HALF_DEG`]
+/// around the base sun (a triangle wave), as a user drags the slider across an afternoon.
+fn drag_lighting(i: usize) -> TransferLighting {
+    let period = 4 * DRAG_HALF_DEG;
+    let k = i % period;
+    let offset_deg = if k <= 2 * DRAG_HALF_DEG {
+        k as f64 - DRAG_HALF_DEG as f64
+    } else {
+        (period - k) as f64 - DRAG_HALF_DEG as f64
+    };
+    let mut l = city_block_lighting();
+    l.sun = Some(city_block_sun(0.7, 2.6 + offset_deg * SUN_STEP_RAD));
     l
 }
 
@@ -133,6 +154,52 @@ impl<'a> StudioTransfers<'a> {
     }
 }
 
+/// One sun drag ([`DRAG_STEPS`] steps of [`drag_lighting`]).
+struct Drag {
+    /// Median and slowest step, milliseconds.
+    median_ms: f64,
+    slowest_ms: f64,
+    /// The sun group of the natural transfer at the drag's end against a cold shooting of the
+    /// same sun (from a dark sun): area-weighted L1 of luminance over the cold one's.
+    drift_l1: f64,
+}
+
+/// The sun group: area-weighted L1 of `a` − `b` over `b`'s.
+fn sun_l1(a: &Solution, b: &Solution) -> f64 {
+    let lum = |v: [f64; 3]| 0.2126 * v[0].abs() + 0.7152 * v[1].abs() + 0.0722 * v[2].abs();
+    let (mut d, mut n) = (0.0, 0.0);
+    for (e, (x, y)) in a.groups[0]
+        .radiosity_rgb
+        .iter()
+        .zip(&b.groups[0].radiosity_rgb)
+        .enumerate()
+    {
+        let w = b.mesh.element_node(e).area_m2;
+        d += lum(std::array::from_fn(|c| x[c] - y[c])) * w;
+        n += lum(*y) * w;
+    }
+    d / n
+}
+
+/// A whole drag from the start of the sweep, then its end against a cold shooting.
+fn sun_drag(studio: &mut StudioTransfers<'_>, scene: &Scene) -> Drag {
+    studio.step(scene, &drag_lighting(0));
+    let mut steps: Vec<f64> = (1..=DRAG_STEPS)
+        .map(|i| once(&mut || studio.step(scene, &drag_lighting(i))))
+        .collect();
+    let slowest_ms = steps.iter().copied().fold(0.0, f64::max);
+    let dragged = studio.transfers.without_artificial().clone();
+    let mut dark = drag_lighting(DRAG_STEPS);
+    dark.sun = None;
+    studio.step(scene, &dark);
+    studio.step(scene, &drag_lighting(DRAG_STEPS));
+    Drag {
+        median_ms: median(&mut steps),
+        slowest_ms,
+        drift_l1: sun_l1(&dragged, studio.transfers.without_artificial()),
+    }
+}
+
 fn bench_relight_latency(c: &mut Criterion) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(THREADS)
@@ -155,6 +222,13 @@ fn bench_relight_latency(c: &mut Criterion) {
             studio.step(&scenes[0], &sun_lighting(flip));
         });
     });
+    let mut drag = 0;
+    group.bench_function("sun_drag_step", |b| {
+        b.iter(|| {
+            drag += 1;
+            studio.step(&scenes[0], &drag_lighting(drag));
+        });
+    });
     // Back to the base sun, then colour steps: the first edit of the material builds its table
     // (`Transfer::relight_material`), the steps read it.
     studio.step(&scenes[0], &sun_lighting(false));
@@ -173,6 +247,8 @@ fn bench_relight_latency(c: &mut Criterion) {
     let (sun_ms, sun_cpu_ms) = timed(&mut |i| {
         studio.step(&scenes[0], &sun_lighting(i % 2 == 0));
     });
+    // One whole drag, step by step (from the start of the sweep): the median and the slowest.
+    let drag = sun_drag(&mut studio, &scenes[0]);
     studio.step(&scenes[0], &sun_lighting(false));
     let colour_first_ms = once(&mut || studio.step(&scenes[1], &sun_lighting(false)));
     let (colour_ms, colour_cpu_ms) = timed(&mut |i| {
@@ -221,6 +297,11 @@ fn bench_relight_latency(c: &mut Criterion) {
     });
     println!("\n== studio relight ({THREADS} threads, median of 8 steps, wall / CPU) ==");
     println!("sun slider step (1° azimuth): {sun_ms:.1} ms / {sun_cpu_ms:.1} ms CPU");
+    println!(
+        "sun slider drag ({DRAG_STEPS} steps of 1° azimuth over ±{DRAG_HALF_DEG}°): median \
+         {:.1} ms, slowest {:.1} ms; its end against a cold shooting of the same sun: L1 {:.1e}",
+        drag.median_ms, drag.slowest_ms, drag.drift_l1
+    );
     println!(
         "material colour step (shared by planned and existing buildings): {colour_ms:.1} ms / \
          {colour_cpu_ms:.1} ms CPU"

@@ -306,6 +306,8 @@ impl Transfer {
                     *b = std::array::from_fn(|ch| clenshaw_f32(c, ch, x[ch]));
                 });
             group.convergence.clear();
+            // The table's values carry the node solves' error, not a kept remainder.
+            self.unshot[g].clear();
         }
         self.solution.locator = std::sync::OnceLock::new();
     }

@@ -80,6 +80,8 @@ mod peer_tests;
 #[cfg(test)]
 mod radiance_tests;
 #[cfg(test)]
+mod relight_drift_tests;
+#[cfg(test)]
 mod shadow_refinement_tests;
 #[cfg(test)]
 mod solver_tests;

@@ -32,6 +32,10 @@
 //! group's row; its residual is the group's unshot power over its total. The patches' powers
 //! are summed in the same parallel pass that pushes a round's gathers down, and the buffers are
 //! kept by the transfer between relights ([`ShootScratch`]), so a relight makes no fresh pages.
+//! A group can give its unshot part outright instead of `old` ([`ShotGroup::unshot`]) and have
+//! what is left unshot at the stop returned ([`Shot::unshot`]): the transfer keeps that
+//! remainder and passes it on with a later relight's D, so relights do not drift
+//! (`Transfer::commit_relight`).
 //! The shot node values and the gathers are `f32` (a round's increment needs ~1e-6 relative, the
 //! factors are `f32` already); B and the unshot leaves stay `f64`.
 
@@ -46,6 +50,35 @@ pub(super) struct ShotGroup<'a> {
     pub name: &'a str,
     pub old: &'a [Rgb],
     pub start: Vec<Rgb>,
+    /// The unshot part given outright (`old` is then not read): the difference with what the
+    /// group's last shooting left unshot ([`Shot::unshot`]) carried over.
+    pub unshot: Option<Vec<Rgb>>,
+    /// Return what is left unshot at the stop ([`Shot::unshot`]).
+    pub keep_unshot: bool,
+}
+
+impl<'a> ShotGroup<'a> {
+    /// D = `start` − `old`, nothing kept.
+    pub fn against(name: &'a str, old: &'a [Rgb], start: Vec<Rgb>) -> Self {
+        Self {
+            name,
+            old,
+            start,
+            unshot: None,
+            keep_unshot: false,
+        }
+    }
+}
+
+/// One group's result of [`shoot`].
+pub(super) struct Shot {
+    /// B per element.
+    pub radiosity: Vec<Rgb>,
+    /// One row per round.
+    pub rows: Vec<ConvergenceRow>,
+    /// What is left unshot per element, for a group that asked ([`ShotGroup::keep_unshot`]):
+    /// B plus its response is the exact solution.
+    pub unshot: Option<Vec<Rgb>>,
 }
 
 /// The buffers of [`shoot`], kept by the transfer between relights so that a relight neither
@@ -122,9 +155,10 @@ fn group_sums(per_patch: &[f64], k: usize) -> Vec<f64> {
     out
 }
 
-/// Shoots D = start − old of every group (module doc) with reflectance `rho` (per element);
-/// `patch_links` are the links read when a patch is shot ([`SourceRows::patch_links`]).
-/// Returns each group's radiosity per element and its convergence rows.
+/// Shoots D = start − old (or the given unshot part) of every group (module doc) with
+/// reflectance `rho` (per element); `patch_links` are the links read when a patch is shot
+/// ([`SourceRows::patch_links`]). Returns each group's radiosity per element and its convergence
+/// rows (and what is left unshot, where asked).
 #[allow(clippy::too_many_lines)]
 pub(super) fn shoot(
     topology: &Topology,
@@ -134,7 +168,7 @@ pub(super) fn shoot(
     stop: &StopRule,
     patch_links: &[u64],
     scratch: &mut ShootScratch,
-) -> Vec<(Vec<Rgb>, Vec<ConvergenceRow>)> {
+) -> Vec<Shot> {
     let k = groups.len();
     let stride = 3 * k;
     let simd = simd_token();
@@ -163,7 +197,16 @@ pub(super) fn shoot(
             let (elo, ehi) = topology.patch_elements[p];
             for (i, e) in (elo..ehi).enumerate() {
                 for (g, group) in groups.iter().enumerate() {
-                    let (s, o) = (group.start[e], group.old[e]);
+                    let s = group.start[e];
+                    if let Some(given) = &group.unshot {
+                        for c in 0..3 {
+                            let j = i * stride + 3 * g + c;
+                            b[j] = s[c];
+                            u[j] = given[e][c];
+                        }
+                        continue;
+                    }
+                    let o = group.old[e];
                     for c in 0..3 {
                         let j = i * stride + 3 * g + c;
                         b[j] = s[c];
@@ -328,14 +371,30 @@ pub(super) fn shoot(
             break;
         }
     }
-    out_rows
+    // The results go into the groups' own buffers (no fresh pages).
+    let read = |v: &[f64], g: usize, out: &mut Vec<Rgb>| {
+        out.resize(n_el, [0.0; 3]);
+        out.par_iter_mut().enumerate().for_each(|(e, o)| {
+            *o = std::array::from_fn(|c| v[e * stride + 3 * g + c]);
+        });
+    };
+    groups
         .into_iter()
+        .zip(out_rows)
         .enumerate()
-        .map(|(g, rows)| {
-            let values = (0..n_el)
-                .map(|e| std::array::from_fn(|c| b[e * stride + 3 * g + c]))
-                .collect();
-            (values, rows)
+        .map(|(g, (group, rows))| {
+            let mut radiosity = group.start;
+            read(b, g, &mut radiosity);
+            let unshot = group.keep_unshot.then(|| {
+                let mut unshot = group.unshot.unwrap_or_default();
+                read(u, g, &mut unshot);
+                unshot
+            });
+            Shot {
+                radiosity,
+                rows,
+                unshot,
+            }
         })
         .collect()
 }

@@ -27,8 +27,9 @@
 //! interreflected part carried over (scaled by the ratio of the group's sources under
 //! `LinearResponses`), and run Gauss–Seidel sweeps (patch by patch, sequential), Jacobi sweeps
 //! (parallel) or ΔB shooting (only the difference from the old solution is passed on, through
-//! the links by source; the default) on the stored links ([`Sweep`]) until the stop rule holds,
-//! its mean-change test measured from the warm start. [`RelightStrategy::WarmGaussSeidel`] is
+//! the links by source, with what the group's last shooting left unshot; the default) on the
+//! stored links ([`Sweep`]) until the stop rule holds, its mean-change test measured from the
+//! warm start. [`RelightStrategy::WarmGaussSeidel`] is
 //! the first way: every change, scalings included, re-iterates the groups it touches from
 //! their previous solution. All are measured in docs/benchmarks.md.
 //!
@@ -158,6 +159,11 @@ pub struct Transfer {
     groups: Vec<LightGroup>,
     /// Per group, the initial exitance of the current solution.
     b0s: Vec<Vec<Rgb>>,
+    /// Per group, what its ΔB shootings left unshot and was not passed on yet (empty: nothing,
+    /// after a build, a sweep or a table read): a shooting passes it on once it carries more
+    /// than the stop rule's residual, so a long series of relights (a sun drag) does not drift
+    /// from the fixed point.
+    unshot: Vec<Vec<Rgb>>,
     /// Per group whose distant sources a relight re-traces (sun, sky), its direct-light sample
     /// points, drawn once.
     direct_samples: Vec<Option<Arc<DirectSamples>>>,
@@ -194,6 +200,27 @@ impl PreparedRelight {
     pub fn sun_counts(&self) -> Option<&SunCounts> {
         self.sun_counts.as_ref()
     }
+}
+
+/// A group a relight iterates: its index, new initial exitance, warm start, the shooting's
+/// unshot part, the ratio its gathered part was carried with, and whether the kept remainder is
+/// in the unshot part.
+struct Pending {
+    g: usize,
+    b0_new: Vec<Rgb>,
+    start: Vec<Rgb>,
+    unshot: Vec<Rgb>,
+    carry: Rgb,
+    pass_on: bool,
+}
+
+/// Σ A_e·Y(|v_e|), the power the shooting weighs (in element order: the same on any number of
+/// threads).
+fn power(v: &[Rgb], areas: &[f64]) -> f64 {
+    v.iter()
+        .zip(areas)
+        .map(|(v, a)| a * super::luminance(&v.map(f64::abs)))
+        .sum()
 }
 
 #[path = "material_table.rs"]
@@ -397,6 +424,7 @@ impl Transfer {
             lighting: lighting.clone(),
             kinds,
             groups,
+            unshot: vec![Vec::new(); b0s.len()],
             b0s,
             direct_samples,
             sky_rays: SkyRays {
@@ -745,8 +773,8 @@ impl Transfer {
             .collect();
         solution_warnings.extend(warnings);
         let linear = self.params.strategy == RelightStrategy::LinearResponses;
-        // Groups to iterate: index, new initial exitance, warm start.
-        let mut pending: Vec<(usize, Vec<Rgb>, Vec<Rgb>)> = Vec::new();
+        // Groups to iterate: index, new initial exitance, warm start, unshot part.
+        let mut pending: Vec<Pending> = Vec::new();
         for (g, action) in actions.into_iter().enumerate() {
             let emission = self.groups[g].emission;
             let group = &mut self.solution.groups[g];
@@ -774,6 +802,11 @@ impl Transfer {
                         b0[c] *= k[c];
                     }
                 }
+                for u in &mut self.unshot[g] {
+                    for c in 0..3 {
+                        u[c] *= k[c];
+                    }
+                }
                 group.convergence.clear();
                 continue;
             }
@@ -785,6 +818,7 @@ impl Transfer {
                 group.radiosity_rgb.clone_from(&b0_new);
                 group.convergence.clear();
                 self.b0s[g] = b0_new;
+                self.unshot[g].clear();
                 continue;
             }
             let carry = if linear {
@@ -793,23 +827,52 @@ impl Transfer {
                 [1.0; 3]
             };
             // Each element on its own, in parallel: the same values on any number of threads.
-            let start: Vec<Rgb> = (0..b0_new.len())
+            // With the warm start, the shooting's unshot part: D = start − old (bit-equal values
+            // pass nothing on) plus what the group's last shooting left unshot, carried over as
+            // the gathered part is.
+            // The kept remainder is passed on once it carries more than the stop rule's
+            // residual of the group's power; until then it is only kept (scaled as the gathered
+            // part is, after the shooting), so a step shoots what it changed and the solution
+            // stays within twice the stop rule of its fixed point however long the series.
+            let kept = &self.unshot[g];
+            let areas = &self.topology.areas;
+            let pass_on = !kept.is_empty()
+                && power(kept, areas)
+                    > self.params.solve.stop.residual * power(&group.radiosity_rgb, areas);
+            let (start, unshot): (Vec<Rgb>, Vec<Rgb>) = (0..b0_new.len())
                 .into_par_iter()
                 .map(|e| {
                     let (b, b0_old) = (group.radiosity_rgb[e], self.b0s[g][e]);
                     let rho_old = old_rho.as_ref().map_or(new_rho[e], |r| r[e]);
-                    std::array::from_fn(|c| {
+                    let left = if pass_on { kept[e] } else { [0.0; 3] };
+                    let mut start = [0.0; 3];
+                    let mut unshot = [0.0; 3];
+                    for c in 0..3 {
                         let gathered = b[c] - b0_old[c];
                         let k = if rho_old[c] > 0.0 {
                             new_rho[e][c] / rho_old[c]
                         } else {
                             0.0
                         };
-                        b0_new[e][c] + k * carry[c] * gathered
-                    })
+                        start[c] = b0_new[e][c] + k * carry[c] * gathered;
+                        let d = if start[c].to_bits() == b[c].to_bits() {
+                            0.0
+                        } else {
+                            start[c] - b[c]
+                        };
+                        unshot[c] = d + k * carry[c] * left[c];
+                    }
+                    (start, unshot)
                 })
-                .collect();
-            pending.push((g, b0_new, start));
+                .unzip();
+            pending.push(Pending {
+                g,
+                b0_new,
+                start,
+                unshot,
+                carry,
+                pass_on,
+            });
         }
         if self.params.sweep == Sweep::Shooting && !pending.is_empty() {
             // Shooting passes on D = start − old, which holds only if the old solution's
@@ -828,19 +891,31 @@ impl Transfer {
             };
             let shot: Vec<ShotGroup<'_>> = pending
                 .iter_mut()
-                .map(|(g, b0_new, start)| ShotGroup {
-                    name: &self.solution.groups[*g].name,
-                    old: if lit_from_zero {
-                        &zeros
-                    } else {
-                        &self.solution.groups[*g].radiosity_rgb
+                .map(
+                    |Pending {
+                         g,
+                         b0_new,
+                         start,
+                         unshot,
+                         ..
+                     }| {
+                        let name = &self.solution.groups[*g].name;
+                        if lit_from_zero {
+                            ShotGroup {
+                                keep_unshot: true,
+                                ..ShotGroup::against(name, &zeros, b0_new.clone())
+                            }
+                        } else {
+                            ShotGroup {
+                                name,
+                                old: &[],
+                                start: std::mem::take(start),
+                                unshot: Some(std::mem::take(unshot)),
+                                keep_unshot: true,
+                            }
+                        }
                     },
-                    start: if lit_from_zero {
-                        b0_new.clone()
-                    } else {
-                        std::mem::take(start)
-                    },
-                })
+                )
                 .collect();
             let results = shoot(
                 &self.topology,
@@ -851,14 +926,41 @@ impl Transfer {
                 &self.patch_links,
                 &mut self.scratch,
             );
-            for ((g, b0_new, _), (radiosity, rows)) in pending.into_iter().zip(results) {
+            for (p, shot) in pending.into_iter().zip(results) {
+                let g = p.g;
                 let group = &mut self.solution.groups[g];
-                group.radiosity_rgb = radiosity;
-                group.convergence = rows;
-                self.b0s[g] = b0_new;
+                group.radiosity_rgb = shot.radiosity;
+                group.convergence = shot.rows;
+                self.b0s[g] = p.b0_new;
+                let remainder = shot.unshot.unwrap_or_default();
+                if p.pass_on || lit_from_zero || self.unshot[g].len() != remainder.len() {
+                    self.unshot[g] = remainder;
+                } else {
+                    // Kept, not passed on: scaled as the gathered part, plus this remainder.
+                    let old_rho = old_rho.as_deref();
+                    self.unshot[g]
+                        .par_iter_mut()
+                        .zip(remainder)
+                        .enumerate()
+                        .for_each(|(e, (u, r))| {
+                            let rho_old = old_rho.map_or(new_rho[e], |o| o[e]);
+                            for c in 0..3 {
+                                let k = if rho_old[c] > 0.0 {
+                                    new_rho[e][c] / rho_old[c]
+                                } else {
+                                    0.0
+                                };
+                                u[c] = k * p.carry[c] * u[c] + r[c];
+                            }
+                        });
+                }
             }
         } else {
-            for (g, b0_new, start) in pending {
+            for Pending {
+                g, b0_new, start, ..
+            } in pending
+            {
+                self.unshot[g].clear();
                 let group = &mut self.solution.groups[g];
                 let (radiosity, rows) = iterate(
                     &self.solution.mesh,
