@@ -8,9 +8,9 @@
 //! step is the studio's path after the site has been read: the site's lighting and materials →
 //! [`photomontage::site::live_relight::lighting_change`] (geometry fingerprint, change) →
 //! `Transfer::relight` on both transfers side by side → the renderer's `RadiosityLight` (the
-//! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth back and forth; a
-//! sun drag step moves it on by 1° along a sweep of ±30° (a user dragging the slider); a
-//! material colour step changes the "render" material's colour, which the planned building
+//! traced groups' direct light taken out). A sun slider step moves the sun by 1° of azimuth
+//! back and forth; a sun drag step moves it on by 1° along a sweep of ±30° (a user dragging the
+//! slider); a material colour step changes the "render" material's colour, which the planned building
 //! shares with seven existing ones, so both transfers relight (the worst case). A proposal
 //! colour step changes the colour of a planned building that has its own material
 //! ([`photomontage::radiosity::city_block::city_block_with_proposal`], as a design imported from
@@ -29,13 +29,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 
 mod common;
 use common::{cpu_s, load_average};
-use photomontage::radiosity::Solution;
 use photomontage::radiosity::TransferParams;
 use photomontage::radiosity::city_block::{
     RENDER_ALBEDO, city_block, city_block_lighting, city_block_params, city_block_sun,
     city_block_with_proposal,
 };
 use photomontage::radiosity::{RelightStrategy, Sweep, TransferLighting};
+use photomontage::radiosity::{Solution, luminance};
 use photomontage::scene::Scene;
 use photomontage::site::live_relight::{SiteTransfers, TransferUpdate};
 use photomontage::sky::SkyModel;
@@ -166,7 +166,7 @@ struct Drag {
 
 /// The sun group: area-weighted L1 of `a` − `b` over `b`'s.
 fn sun_l1(a: &Solution, b: &Solution) -> f64 {
-    let lum = |v: [f64; 3]| 0.2126 * v[0].abs() + 0.7152 * v[1].abs() + 0.0722 * v[2].abs();
+    let lum = |v: [f64; 3]| luminance(&v.map(f64::abs));
     let (mut d, mut n) = (0.0, 0.0);
     for (e, (x, y)) in a.groups[0]
         .radiosity_rgb

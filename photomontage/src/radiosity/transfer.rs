@@ -214,6 +214,12 @@ struct Pending {
     pass_on: bool,
 }
 
+/// ρ′/ρ, the factor an element's gathered light (and kept remainder) is carried over with; 0
+/// where ρ was 0 (nothing was gathered).
+fn rho_ratio(new: f64, old: f64) -> f64 {
+    if old > 0.0 { new / old } else { 0.0 }
+}
+
 /// Σ A_e·Y(|v_e|), the power the shooting weighs (in element order: the same on any number of
 /// threads).
 fn power(v: &[Rgb], areas: &[f64]) -> f64 {
@@ -828,12 +834,11 @@ impl Transfer {
             };
             // Each element on its own, in parallel: the same values on any number of threads.
             // With the warm start, the shooting's unshot part: D = start − old (bit-equal values
-            // pass nothing on) plus what the group's last shooting left unshot, carried over as
-            // the gathered part is.
-            // The kept remainder is passed on once it carries more than the stop rule's
-            // residual of the group's power; until then it is only kept (scaled as the gathered
-            // part is, after the shooting), so a step shoots what it changed and the solution
-            // stays within twice the stop rule of its fixed point however long the series.
+            // pass nothing on), plus the group's kept remainder, carried over as the gathered
+            // part is, once that carries more than the stop rule's residual of the group's
+            // power. Until then it is only kept (scaled after the shooting), so a step shoots
+            // what it changed and the solution stays within twice the stop rule of its fixed
+            // point however long the series.
             let kept = &self.unshot[g];
             let areas = &self.topology.areas;
             let pass_on = !kept.is_empty()
@@ -849,11 +854,7 @@ impl Transfer {
                     let mut unshot = [0.0; 3];
                     for c in 0..3 {
                         let gathered = b[c] - b0_old[c];
-                        let k = if rho_old[c] > 0.0 {
-                            new_rho[e][c] / rho_old[c]
-                        } else {
-                            0.0
-                        };
+                        let k = rho_ratio(new_rho[e][c], rho_old[c]);
                         start[c] = b0_new[e][c] + k * carry[c] * gathered;
                         let d = if start[c].to_bits() == b[c].to_bits() {
                             0.0
@@ -945,11 +946,7 @@ impl Transfer {
                         .for_each(|(e, (u, r))| {
                             let rho_old = old_rho.map_or(new_rho[e], |o| o[e]);
                             for c in 0..3 {
-                                let k = if rho_old[c] > 0.0 {
-                                    new_rho[e][c] / rho_old[c]
-                                } else {
-                                    0.0
-                                };
+                                let k = rho_ratio(new_rho[e][c], rho_old[c]);
                                 u[c] = k * p.carry[c] * u[c] + r[c];
                             }
                         });
