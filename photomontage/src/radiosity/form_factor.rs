@@ -14,7 +14,9 @@
 //! y_k and their pairing with the x_k come from the ordered pair's stream (seed = the
 //! parameters' seed, stream = p·2³² + q), the way `render::tiling` gives each tile a stream. A
 //! factor therefore depends only on the scene, the parameters and the pair, never on the thread
-//! count or on the order of evaluation.
+//! count or on the order of evaluation. A mesh solved beside the natural one (`super::twin`)
+//! names its nodes' streams after their natural twins ([`FormFactorEngine::with_node_streams`]),
+//! so that a pair of twins draws the same points on both sides.
 //!
 //! # Known limitations
 //! Visibility is a binary per-sample estimate, so partly occluded pairs carry Monte Carlo noise
@@ -190,6 +192,8 @@ pub struct FormFactorEngine<'a> {
     params: FormFactorParams,
     /// Per element, the random stream of its direct-light sample points (`None`: its index).
     direct_streams: Option<&'a [u64]>,
+    /// Per node, the number naming its form-factor streams (`None`: its index).
+    node_streams: Option<&'a [u32]>,
 }
 
 impl<'a> FormFactorEngine<'a> {
@@ -208,6 +212,7 @@ impl<'a> FormFactorEngine<'a> {
             tracer,
             params,
             direct_streams: None,
+            node_streams: None,
         })
     }
 
@@ -224,6 +229,25 @@ impl<'a> FormFactorEngine<'a> {
         }
         self.direct_streams = streams;
         self
+    }
+
+    /// The same engine naming node n's form-factor streams (module doc) `streams[n]` instead of
+    /// n, so that the nodes of two meshes draw the same sample points ([`super::twin`]).
+    ///
+    /// # Panics
+    /// When `streams` does not have one entry per node.
+    #[must_use]
+    pub fn with_node_streams(mut self, streams: Option<&'a [u32]>) -> Self {
+        if let Some(s) = streams {
+            assert_eq!(s.len(), self.mesh.nodes.len(), "one stream per node");
+        }
+        self.node_streams = streams;
+        self
+    }
+
+    /// The number naming node `n`'s form-factor streams.
+    fn node_stream(&self, n: u32) -> u64 {
+        u64::from(self.node_streams.map_or(n, |s| s[n as usize]))
     }
 
     /// The random stream of element `e`'s direct-light sample points.
@@ -337,10 +361,11 @@ impl<'a> FormFactorEngine<'a> {
         // The sender's points depend on the sender only, so that a row shares them and sums to
         // exactly the unoccluded solid-angle fraction; the receiver's points and the pairing
         // come from the pair's stream.
+        let (stream_p, stream_q) = (self.node_stream(p), self.node_stream(q));
         let mut sender_rng = ChaCha8Rng::seed_from_u64(self.params.seed ^ SENDER_SEED_SALT);
-        sender_rng.set_stream(u64::from(p));
+        sender_rng.set_stream(stream_p);
         let mut rng = ChaCha8Rng::seed_from_u64(self.params.seed);
-        rng.set_stream((u64::from(p) << 32) | u64::from(q));
+        rng.set_stream((stream_p << 32) | stream_q);
         // A random pairing of the strata on p with those on q.
         let mut partner: Vec<usize> = (0..n * n).collect();
         for i in (1..partner.len()).rev() {

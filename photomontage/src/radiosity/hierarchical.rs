@@ -50,6 +50,7 @@ use rayon::prelude::*;
 use super::convergence::{ConvergenceRow, StopRule, mean_brightness, relative_change};
 use super::form_factor::{FormFactorEngine, in_front};
 use super::mesh::Mesh;
+use super::twin_factors::FactorReuse;
 use super::{RadiosityError, Rgb, luminance};
 
 /// An upper bound of an unoccluded point-to-triangle factor with round-off: the exact factor is
@@ -157,13 +158,21 @@ fn initial_pairs(
     }
 }
 
-fn accurate_links(engine: &FormFactorEngine<'_>, pairs: &[(u32, u32)]) -> Vec<Link> {
+/// The links of `pairs` with their accurate factors: read from the natural solve where `reuse`
+/// has them (the same value, [`super::twin_factors`]), else computed.
+fn accurate_links(
+    engine: &FormFactorEngine<'_>,
+    pairs: &[(u32, u32)],
+    reuse: Option<&FactorReuse<'_>>,
+) -> Vec<Link> {
     pairs
         .par_iter()
         .map(|&(r, s)| Link {
             receiver: r,
             source: s,
-            form_factor: engine.node_to_node(r, s),
+            form_factor: reuse
+                .and_then(|u| u.factor(engine, r, s))
+                .unwrap_or_else(|| engine.node_to_node(r, s)),
         })
         .collect()
 }
@@ -188,6 +197,26 @@ impl Hierarchy {
         cancel: &AtomicBool,
         on_pass: &dyn Fn(&ConvergenceRow),
     ) -> Result<Self, RadiosityError> {
+        Self::build_reusing(engine, params, b0_all, stop, cancel, on_pass, None)
+            .map(|(hierarchy, _)| hierarchy)
+    }
+
+    /// [`Hierarchy::build`] reading the factors `reuse` has from the natural solve
+    /// ([`super::twin_factors`]; the same links as computing them all, when `engine` names its
+    /// streams after the twins); also returns every link whose factor it computed or read
+    /// (refined and dropped ones too), for a later solve beside this one.
+    ///
+    /// # Errors
+    /// As [`Hierarchy::build`].
+    pub(super) fn build_reusing(
+        engine: &FormFactorEngine<'_>,
+        params: &HierarchicalParams,
+        b0_all: &[Rgb],
+        stop: &StopRule,
+        cancel: &AtomicBool,
+        on_pass: &dyn Fn(&ConvergenceRow),
+        reuse: Option<&FactorReuse<'_>>,
+    ) -> Result<(Self, Vec<Link>), RadiosityError> {
         stop.validate()?;
         for (name, value) in [
             ("form_factor_tolerance", params.form_factor_tolerance),
@@ -240,9 +269,10 @@ impl Hierarchy {
             pairs.extend(list.ok_or(RadiosityError::Cancelled)?);
         }
         let mut hierarchy = Self {
-            links: accurate_links(engine, &pairs),
+            links: accurate_links(engine, &pairs, reuse),
             refinement: Vec::new(),
         };
+        let mut computed = hierarchy.links.clone();
         hierarchy.sort();
         // Per link, its unoccluded estimate once computed (`UNKNOWN` before): a pure function of
         // the link's nodes, kept between the refinement passes.
@@ -260,7 +290,15 @@ impl Hierarchy {
             previous_mean = Some(mean);
             on_pass(&row);
             let refined = if hierarchy.links.len() < params.max_links {
-                hierarchy.refine_bf(engine, params, &state, mean, &mut estimates)
+                hierarchy.refine_bf(
+                    engine,
+                    params,
+                    &state,
+                    mean,
+                    &mut estimates,
+                    reuse,
+                    &mut computed,
+                )
             } else {
                 0
             };
@@ -271,7 +309,7 @@ impl Hierarchy {
             }
         }
         hierarchy.drop_occluded();
-        Ok(hierarchy)
+        Ok((hierarchy, computed))
     }
 
     /// Drops, once refinement is over, the links whose factor is exactly 0 (every sample pair
@@ -294,6 +332,7 @@ impl Hierarchy {
     /// how many were replaced. The test of each link reads that link alone, so the links are
     /// tested in parallel and then rebuilt in their order: the same links on any number of
     /// threads.
+    #[allow(clippy::too_many_arguments)]
     fn refine_bf(
         &mut self,
         engine: &FormFactorEngine<'_>,
@@ -301,6 +340,8 @@ impl Hierarchy {
         state: &State,
         mean: f64,
         estimates: &mut Vec<f64>,
+        reuse: Option<&FactorReuse<'_>>,
+        computed: &mut Vec<Link>,
     ) -> usize {
         let mesh = engine.mesh();
         let threshold = params.bf_tolerance * mean;
@@ -370,7 +411,9 @@ impl Hierarchy {
             }
         }
         if refined > 0 {
-            keep.extend(accurate_links(engine, &new_pairs));
+            let new_links = accurate_links(engine, &new_pairs, reuse);
+            computed.extend_from_slice(&new_links);
+            keep.extend(new_links);
             kept_estimates.resize(keep.len(), UNKNOWN);
             // By receiver, as `sort`, with each link's estimate beside it (a stable sort: the
             // same order as `sort`).

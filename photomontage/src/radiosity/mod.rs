@@ -67,6 +67,7 @@ mod topology;
 pub mod transfer;
 pub mod transfer_lighting;
 pub mod twin;
+mod twin_factors;
 pub mod vertex_gather;
 
 #[cfg(test)]
@@ -89,6 +90,8 @@ mod solver_tests;
 pub(crate) mod test_scenes;
 #[cfg(test)]
 mod transfer_tests;
+#[cfg(test)]
+mod twin_factors_tests;
 #[cfg(test)]
 mod twin_tests;
 

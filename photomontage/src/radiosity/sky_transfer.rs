@@ -22,6 +22,8 @@
 //! are finer, so a shadow cast by the circumsolar sky is softer here than in a fresh
 //! [`super::solve`], which traces the clusters of the new sky (docs/methodology.md).
 
+use std::sync::Arc;
+
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -29,17 +31,20 @@ use super::form_factor::FormFactorEngine;
 use super::source_rows::{Simd, simd_token};
 use super::sources::{DIRECT_RAY_LENGTH_M, DIRECT_RAY_OFFSET_M, DirectSamples, sky_leaf_flux};
 use super::twin::Twin;
+use super::twin_factors::NaturalFactors;
 use super::{RadiosityError, Rgb};
 use crate::sky::SkyModel;
 use crate::sky_dome::icosahedral::IcosahedralDome;
 
 /// The sky transfer a natural solve traced, kept for the solve of the scene with the planned
-/// objects ([`super::twin`]).
+/// objects ([`super::twin`]), with the form factors it computed ([`super::twin_factors`]).
 #[derive(Debug, Clone)]
 pub struct SkyRays {
     /// The light group it was traced for (its sample points' random streams).
     pub(super) group: usize,
     pub(super) transfer: SkyTransfer,
+    /// The hierarchical solve's factors (`None` for other solvers).
+    pub(super) factors: Option<Arc<NaturalFactors>>,
 }
 
 /// The sky's visibility transfer of one mesh (module doc).

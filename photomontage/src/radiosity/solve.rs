@@ -14,6 +14,7 @@ use super::sky_transfer::SkyRays;
 use super::sky_transfer::SkyTransfer;
 use super::sources::{self, DistantSource, GroundBelowHorizon, LightWarning, PointSource};
 use super::twin::Twin;
+use super::twin_factors::{FactorReuse, NaturalFactors};
 use super::{RadiosityError, Rgb, direct, progressive};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
@@ -451,8 +452,14 @@ pub fn solve_on_mesh_twinned(
     if params.form_factors.visibility {
         super::covered::mark_covered(&mut mesh, tracer, &params.form_factors);
     }
+    // The natural solve's form factors, read where they are the same (`super::twin_factors`).
+    let reuse = twin.and_then(|(t, sky)| {
+        let natural = sky.factors.as_deref()?;
+        FactorReuse::new(natural, t, &mesh, params.form_factors)
+    });
     let engine = FormFactorEngine::new(&mesh, tracer, params.form_factors)?
-        .with_direct_streams(twin.map(|(t, _)| t.streams.as_slice()));
+        .with_direct_streams(twin.map(|(t, _)| t.streams.as_slice()))
+        .with_node_streams(reuse.as_ref().map(FactorReuse::streams));
     let n = mesh.elements.len();
     let ground = GroundTerm::new(&engine, params.ground.as_ref())?;
     let mut directs = Vec::with_capacity(groups.len());
@@ -482,7 +489,11 @@ pub fn solve_on_mesh_twinned(
                 Some(&samples),
                 Some(&transfer),
             )?;
-            sky_rays = Some(SkyRays { group: g, transfer });
+            sky_rays = Some(SkyRays {
+                group: g,
+                transfer,
+                factors: None,
+            });
             direct
         } else {
             group_direct(&engine, group, g as u64, ground.as_ref(), None, None)?
@@ -494,6 +505,7 @@ pub fn solve_on_mesh_twinned(
     let mut solved = Vec::with_capacity(groups.len());
     let interactions;
     let mut hierarchy = None;
+    let mut computed = Vec::new();
     match params.solver {
         Solver::Progressive => {
             let mut cache = RowCache::new(n, params.row_cache_entries);
@@ -519,7 +531,16 @@ pub fn solve_on_mesh_twinned(
                     }
                 }
             }
-            let built = Hierarchy::build(&engine, &h, &b0_all, &params.stop, cancel, on_pass)?;
+            let (built, links_computed) = Hierarchy::build_reusing(
+                &engine,
+                &h,
+                &b0_all,
+                &params.stop,
+                cancel,
+                on_pass,
+                reuse.as_ref(),
+            )?;
+            computed = links_computed;
             for (group, b0) in groups.iter().zip(&b0s) {
                 solved.push(built.solve(&mesh, b0, &group.name, &params.stop, cancel, on_pass)?);
             }
@@ -565,11 +586,25 @@ pub fn solve_on_mesh_twinned(
         warnings: warnings.clone(),
         locator: std::sync::OnceLock::new(),
     };
+    // A natural solve lends its form factors with its sky rays (a solve beside one does not).
+    let with_factors = |solution: Solution, sky_rays: Option<SkyRays>| {
+        let sky_rays = sky_rays.map(|mut sky| {
+            if hierarchy.is_some() && twin.is_none() {
+                sky.factors = Some(Arc::new(NaturalFactors::new(
+                    Arc::clone(&solution.mesh),
+                    params.form_factors,
+                    &computed,
+                )));
+            }
+            sky
+        });
+        (solution, sky_rays)
+    };
     let (mut mesh, mut solved) = (mesh, solved);
     for _ in 0..rounds {
         let probe = assemble(mesh, solved, directs.clone());
         let (Some(rho), Some(hierarchy)) = (refit(&probe), hierarchy.as_ref()) else {
-            return Ok((probe, sky_rays));
+            return Ok(with_factors(probe, sky_rays));
         };
         mesh = Arc::unwrap_or_clone(probe.mesh);
         mesh.set_element_reflectances(&rho)?;
@@ -579,7 +614,7 @@ pub fn solve_on_mesh_twinned(
             solved.push(hierarchy.solve(&mesh, &b0, &group.name, &params.stop, cancel, on_pass)?);
         }
     }
-    Ok((assemble(mesh, solved, directs), sky_rays))
+    Ok(with_factors(assemble(mesh, solved, directs), sky_rays))
 }
 
 /// The ground below the horizon, ready to apply: its unit-radiance transfer per element.

@@ -67,6 +67,7 @@ use super::topology::Topology;
 use super::transfer_lighting::check_rgb;
 pub use super::transfer_lighting::{LightingChange, NamedLuminaire, Sky, Sun, TransferLighting};
 use super::twin::{Twin, twin_elements};
+use super::twin_factors::{FactorReuse, NaturalFactors};
 use super::{GroupSolution, LightGroup, RadiosityError, Rgb, Solution, SolveParams, Solver};
 use crate::bvh::BuildQuality;
 use crate::scene::{Scene, SceneTracer};
@@ -340,8 +341,15 @@ impl Transfer {
             .map(|twin| (twin, t)),
             None => None,
         };
+        // The natural transfer's form factors, read where they are the same
+        // (`super::twin_factors`).
+        let reuse = twin.as_ref().and_then(|(t, natural)| {
+            let factors = natural.sky_rays.factors.as_deref()?;
+            FactorReuse::new(factors, t, &mesh, params.solve.form_factors)
+        });
         let engine = FormFactorEngine::new(&mesh, &tracer, params.solve.form_factors)?
-            .with_direct_streams(twin.as_ref().map(|(t, _)| t.streams.as_slice()));
+            .with_direct_streams(twin.as_ref().map(|(t, _)| t.streams.as_slice()))
+            .with_node_streams(reuse.as_ref().map(FactorReuse::streams));
         let ground = GroundTerm::new(&engine, params.solve.ground.as_ref())?;
         let n = mesh.elements.len();
         let mut directs = Vec::with_capacity(groups.len());
@@ -385,8 +393,15 @@ impl Transfer {
                 }
             }
         }
-        let hierarchy =
-            Hierarchy::build(&engine, &h, &b0_all, &params.solve.stop, cancel, on_pass)?;
+        let (hierarchy, computed) = Hierarchy::build_reusing(
+            &engine,
+            &h,
+            &b0_all,
+            &params.solve.stop,
+            cancel,
+            on_pass,
+            reuse.as_ref(),
+        )?;
         let mut solved = Vec::with_capacity(groups.len());
         for ((group, b0), direct) in groups.iter().zip(&b0s).zip(directs) {
             let (radiosity, convergence) =
@@ -415,6 +430,15 @@ impl Transfer {
         let topology = Topology::new(&mesh);
         let patch_links = source_rows.patch_links(&topology.patch_ranges);
         let element_rho = topology.element_reflectances(&mesh);
+        let mesh = Arc::new(mesh);
+        // A natural transfer lends its form factors to one built beside it.
+        let factors = twin.is_none().then(|| {
+            Arc::new(NaturalFactors::new(
+                Arc::clone(&mesh),
+                params.solve.form_factors,
+                &computed,
+            ))
+        });
         Ok(Self {
             tracer,
             params: params.clone(),
@@ -436,9 +460,10 @@ impl Transfer {
             sky_rays: SkyRays {
                 group: 1,
                 transfer: sky_transfer,
+                factors,
             },
             solution: Solution {
-                mesh: Arc::new(mesh),
+                mesh,
                 groups: solved,
                 interactions: hierarchy.links.len() as u64,
                 refinement: hierarchy.refinement,

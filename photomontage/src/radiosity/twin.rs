@@ -159,6 +159,12 @@ impl Twin {
         true
     }
 
+    /// The planned objects' bounding box widened by [`BOX_MARGIN_M`], world metres.
+    #[must_use]
+    pub(super) fn artificial_box_in_world_m(&self) -> &[Point3<f64>; 2] {
+        &self.artificial_box_in_world_m
+    }
+
     /// Elements of the mesh with the planned objects that have a twin.
     #[must_use]
     pub fn twins(&self) -> usize {

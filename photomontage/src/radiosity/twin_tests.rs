@@ -20,16 +20,16 @@ use crate::sky_dome::icosahedral::{IcosahedralDome, IcosahedralParams};
 
 /// The city block with its planned building and without it, meshed alike, their tracers in one
 /// frame, and the twins.
-struct Pair {
-    natural_mesh: Mesh,
-    mesh: Mesh,
-    natural_tracer: SceneTracer,
-    tracer: SceneTracer,
-    twin: Twin,
-    ff: FormFactorParams,
+pub(super) struct Pair {
+    pub(super) natural_mesh: Mesh,
+    pub(super) mesh: Mesh,
+    pub(super) natural_tracer: SceneTracer,
+    pub(super) tracer: SceneTracer,
+    pub(super) twin: Twin,
+    pub(super) ff: FormFactorParams,
 }
 
-fn block_pair() -> Pair {
+pub(super) fn block_pair() -> Pair {
     let scene = city_block(1, [0.5; 3]).unwrap();
     let natural = scene.part_of_kind(ObjectKind::Natural).unwrap();
     let artificial = scene.part_of_kind(ObjectKind::Artificial).unwrap();
@@ -92,6 +92,7 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
     let natural_sky = SkyRays {
         group: 1,
         transfer: SkyTransfer::new(&natural_engine, &natural_samples, &dome),
+        factors: None,
     };
     // Every natural element has its twin; the building's elements have none.
     assert_eq!(twin.twins(), natural_mesh.elements.len());

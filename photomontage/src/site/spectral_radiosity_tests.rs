@@ -23,8 +23,11 @@ const PASS_LINEARITY_L1_TOL: f64 = 2e-3;
 /// relative to their mean: the passes' solves as above, and the spectral passes' sampling
 /// (the same positions, but each pass's adaptive decisions read its own result).
 const GREY_RENDER_MEAN_TOL: f64 = 0.005;
-/// Changed pixels of the two renders: pixels on the 1 % threshold may go either way.
-const CHANGED_PIXELS_TOL: f64 = 0.05;
+/// Changed pixels of the two renders: pixels on the 1 % threshold may go either way. Measured
+/// 93 spectral against 97 RGB, and against 98 once the solve with the building read the natural
+/// solve's form factors (`radiosity::twin_factors`, other random streams); a render that
+/// ignores the passes' solutions changes 727.
+const CHANGED_PIXELS_TOL: f64 = 0.08;
 
 /// The enclosure identity on closing form factors (no shadow rays in a convex box, the direct
 /// solver): iteration and rounding error only (`radiosity::solver_tests`).
