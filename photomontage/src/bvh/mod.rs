@@ -251,10 +251,19 @@ impl Bvh {
         self.wide.references
     }
 
-    /// Runs `f` with a traversal stack of the size this tree needs.
+    /// Runs `f` with a traversal stack of the size this tree needs: the smallest of three
+    /// inline sizes that holds it (the stack is zeroed per query, a `memset` that a radiosity
+    /// precompute's millions of shadow rays paid at 3–4 % of its time with one 96-entry size).
     #[inline]
     fn with_stack<R>(&self, f: impl FnOnce(&mut [StackEntry]) -> R) -> R {
-        if self.wide.stack_max <= INLINE_STACK {
+        let need = self.wide.stack_max;
+        if need <= INLINE_STACK / 4 {
+            let mut stack = [StackEntry::default(); INLINE_STACK / 4];
+            f(&mut stack)
+        } else if need <= INLINE_STACK / 2 {
+            let mut stack = [StackEntry::default(); INLINE_STACK / 2];
+            f(&mut stack)
+        } else if need <= INLINE_STACK {
             let mut stack = [StackEntry::default(); INLINE_STACK];
             f(&mut stack)
         } else {

@@ -95,6 +95,14 @@ pub struct Link {
     pub form_factor: f64,
 }
 
+impl Link {
+    /// (receiver, source, F).
+    #[must_use]
+    pub fn triple(&self) -> (u32, u32, f64) {
+        (self.receiver, self.source, self.form_factor)
+    }
+}
+
 /// The links of a refined hierarchy.
 #[derive(Debug, Clone)]
 pub struct Hierarchy {

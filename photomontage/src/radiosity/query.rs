@@ -22,7 +22,7 @@
 //! reflectance carry no interreflected irradiance and are always gathered. The gathered indirect
 //! term is a Monte Carlo estimate (error ∝ 1/√rays).
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -111,7 +111,7 @@ impl ElementLocator {
                 }
             }
         }
-        let mut sums: HashMap<[i64; 6], (Rgb, Rgb, f64)> = HashMap::new();
+        let mut sums: FxHashMap<[i64; 6], (Rgb, Rgb, f64)> = FxHashMap::default();
         for e in 0..n {
             let node = mesh.element_node(e);
             for v in &node.vertices_in_world_m {
@@ -188,6 +188,12 @@ impl ElementLocator {
 impl Solution {
     fn locator(&self) -> &ElementLocator {
         self.locator.get_or_init(|| ElementLocator::new(self))
+    }
+
+    /// Builds the element lookup that the first point query would build (so that two
+    /// solutions can build theirs side by side before a render queries them).
+    pub fn prepare_queries(&self) {
+        self.locator();
     }
 
     /// Irradiance at `point_in_world_m` on a surface of outward unit normal `normal_in_world`,

@@ -113,6 +113,11 @@ impl SkyTransfer {
             .collect();
         let f_count = facets.len();
         let padded = f_count.next_multiple_of(LANES);
+        // Read for every element: one compact array, not the dome's nodes.
+        let dirs: Vec<Vector3<f64>> = facets
+            .iter()
+            .map(|&f| dome.nodes[f].centre_dir_in_world)
+            .collect();
         // A facet reaches in front of a plane iff n·d_f > −sin(r_f), r_f its angular radius.
         let reach: Vec<f64> = facets
             .iter()
@@ -160,11 +165,9 @@ impl SkyTransfer {
                         )
                     })
                 });
-                facets
-                    .iter()
+                dirs.iter()
                     .enumerate()
-                    .map(|(f, &facet)| {
-                        let dir = dome.nodes[facet].centre_dir_in_world;
+                    .map(|(f, &dir)| {
                         if node.normal_in_world.dot(&dir) <= reach[f] {
                             return 0;
                         }

@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use super::convergence::{ConvergenceRow, StopRule};
 use super::form_factor::{FormFactorEngine, FormFactorParams};
-use super::hierarchical::{HierarchicalParams, Hierarchy};
+use super::hierarchical::{HierarchicalParams, Hierarchy, Link};
 use super::mesh::{Mesh, MeshParams};
 use super::progressive::RowCache;
 use super::sky_transfer::SkyRays;
@@ -593,7 +593,7 @@ pub fn solve_on_mesh_twinned(
                 sky.factors = Some(Arc::new(NaturalFactors::new(
                     Arc::clone(&solution.mesh),
                     params.form_factors,
-                    &computed,
+                    computed.iter().map(Link::triple),
                 )));
             }
             sky

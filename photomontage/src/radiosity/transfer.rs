@@ -51,7 +51,7 @@ use rayon::prelude::*;
 
 use super::convergence::ConvergenceRow;
 use super::form_factor::FormFactorEngine;
-use super::hierarchical::Hierarchy;
+use super::hierarchical::{Hierarchy, Link};
 use super::mesh::Mesh;
 use super::shooting::{ShootScratch, ShotGroup, shoot};
 use super::sky_transfer::{SkyRays, SkyTransfer};
@@ -436,7 +436,7 @@ impl Transfer {
             Arc::new(NaturalFactors::new(
                 Arc::clone(&mesh),
                 params.solve.form_factors,
-                &computed,
+                computed.iter().map(Link::triple),
             ))
         });
         Ok(Self {

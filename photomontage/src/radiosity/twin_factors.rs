@@ -28,7 +28,6 @@ use std::sync::Arc;
 use nalgebra::Point3;
 
 use super::form_factor::{FormFactorEngine, FormFactorParams};
-use super::hierarchical::Link;
 use super::mesh::{Mesh, MeshNode};
 use super::twin::Twin;
 
@@ -49,14 +48,15 @@ fn pair_key(r: u32, s: u32) -> u64 {
 }
 
 impl NaturalFactors {
-    /// The factors `computed` (in any order; a pair computed twice has the same factor) on
-    /// `mesh` with `params`.
+    /// The factors `computed` as (receiver, source, F) (in any order; a pair computed twice has
+    /// the same factor) on `mesh` with `params`.
     #[must_use]
-    pub(super) fn new(mesh: Arc<Mesh>, params: FormFactorParams, computed: &[Link]) -> Self {
-        let mut by_pair: Vec<(u64, f64)> = computed
-            .iter()
-            .map(|l| (pair_key(l.receiver, l.source), l.form_factor))
-            .collect();
+    pub(super) fn new(
+        mesh: Arc<Mesh>,
+        params: FormFactorParams,
+        computed: impl Iterator<Item = (u32, u32, f64)>,
+    ) -> Self {
+        let mut by_pair: Vec<(u64, f64)> = computed.map(|(r, s, f)| (pair_key(r, s), f)).collect();
         by_pair.sort_unstable_by_key(|&(k, _)| k);
         by_pair.dedup_by_key(|&mut (k, _)| k);
         Self {

@@ -50,7 +50,11 @@ fn twin_factors_equal_computing_every_factor() {
         None,
     )
     .unwrap();
-    let natural = NaturalFactors::new(Arc::new(pair.natural_mesh.clone()), pair.ff, &computed);
+    let natural = NaturalFactors::new(
+        Arc::new(pair.natural_mesh.clone()),
+        pair.ff,
+        computed.iter().map(Link::triple),
+    );
     assert!(natural.len() > 1000, "{} natural factors", natural.len());
     let reuse = FactorReuse::new(&natural, &pair.twin, &pair.mesh, pair.ff).unwrap();
     let engine = FormFactorEngine::new(&pair.mesh, &pair.tracer, pair.ff)
@@ -134,7 +138,11 @@ fn twin_factors_equal_computing_every_factor() {
 #[test]
 fn factors_of_another_quadrature_are_not_read() {
     let pair = block_pair();
-    let natural = NaturalFactors::new(Arc::new(pair.natural_mesh.clone()), pair.ff, &[]);
+    let natural = NaturalFactors::new(
+        Arc::new(pair.natural_mesh.clone()),
+        pair.ff,
+        std::iter::empty(),
+    );
     let mut other = pair.ff;
     other.samples_per_axis += 1;
     assert!(FactorReuse::new(&natural, &pair.twin, &pair.mesh, other).is_none());

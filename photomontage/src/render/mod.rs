@@ -506,13 +506,15 @@ pub fn linear_photo(photo: &crate::photo::PhotoImage) -> Rgb32FImage {
     match photo.transfer {
         crate::photo::Transfer::Linear => photo.pixels.clone(),
         crate::photo::Transfer::Srgb => {
+            use rayon::prelude::*;
             let mut out = photo.pixels.clone();
-            for p in out.pixels_mut() {
+            let samples: &mut [f32] = &mut out;
+            samples.par_chunks_mut(4096).for_each(|chunk| {
                 #[allow(clippy::cast_possible_truncation)]
-                for c in &mut p.0 {
+                for c in chunk {
                     *c = crate::colour::rgb::srgb_decode(f64::from(*c)) as f32;
                 }
-            }
+            });
             out
         }
     }

@@ -102,13 +102,20 @@ impl RadiosityLight {
             DEFAULT_RAYS_PER_AXIS,
             Arc::clone(&without),
         )?);
-        Self::with_gathers(
+        let light = Self::with_gathers(
             with_artificial,
             without_artificial,
             traced_exactly,
             [with, without],
             [None, None],
-        )
+        )?;
+        // Both element lookups side by side, before the render's first query would build them
+        // one after the other.
+        rayon::join(
+            || light.with_artificial.prepare_queries(),
+            || light.without_artificial.prepare_queries(),
+        );
+        Ok(light)
     }
 
     /// The same for relit solutions: the vertex gathers (the rays they traced) are kept where a
