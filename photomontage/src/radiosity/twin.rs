@@ -172,14 +172,17 @@ impl Twin {
     }
 }
 
+/// The bits of a node's vertices, in order: the key that finds its twin.
+pub(super) fn vertex_bits(node: &MeshNode) -> [u64; 9] {
+    let v = &node.vertices_in_world_m;
+    std::array::from_fn(|k| v[k / 3][k % 3].to_bits())
+}
+
 /// Per element of `to`, the element of `from` with the same vertices in the same order (the
 /// natural surfaces, meshed alike in both); `None` elsewhere.
 #[must_use]
 pub fn twin_elements(from: &Mesh, to: &Mesh) -> Vec<Option<u32>> {
-    let key = |mesh: &Mesh, e: usize| -> [u64; 9] {
-        let v = &mesh.element_node(e).vertices_in_world_m;
-        std::array::from_fn(|k| v[k / 3][k % 3].to_bits())
-    };
+    let key = |mesh: &Mesh, e: usize| vertex_bits(mesh.element_node(e));
     let by_vertices: HashMap<[u64; 9], u32> = (0..from.elements.len())
         .map(|e| (key(from, e), u32::try_from(e).unwrap_or(u32::MAX)))
         .collect();

@@ -22,14 +22,14 @@
 //!
 //! Equality with computing every factor is tested (`twin_factors_tests`).
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use nalgebra::Point3;
+use rustc_hash::FxHashMap;
 
 use super::form_factor::{FormFactorEngine, FormFactorParams};
 use super::mesh::{Mesh, MeshNode};
-use super::twin::Twin;
+use super::twin::{Twin, vertex_bits};
 
 /// The form factors a natural solve computed (every pair it linked, also those refined or
 /// dropped later), lent to the solve of the scene with the planned objects.
@@ -181,17 +181,8 @@ fn box_behind(node: &MeshNode, lo: &Point3<f64>, hi: &Point3<f64>) -> bool {
 /// open fraction (module doc); `None` elsewhere.
 #[must_use]
 pub(super) fn twin_nodes(from: &Mesh, to: &Mesh) -> Vec<Option<u32>> {
-    let key = |node: &MeshNode| -> [u64; 10] {
-        let v = &node.vertices_in_world_m;
-        std::array::from_fn(|k| {
-            if k == 9 {
-                node.open_fraction.to_bits()
-            } else {
-                v[k / 3][k % 3].to_bits()
-            }
-        })
-    };
-    let by_key: HashMap<[u64; 10], u32> = from
+    let key = |node: &MeshNode| (vertex_bits(node), node.open_fraction.to_bits());
+    let by_key: FxHashMap<([u64; 9], u64), u32> = from
         .nodes
         .iter()
         .zip(0u32..)

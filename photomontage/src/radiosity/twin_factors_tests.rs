@@ -10,6 +10,7 @@ use super::convergence::StopRule;
 use super::covered::mark_covered;
 use super::form_factor::FormFactorEngine;
 use super::hierarchical::{HierarchicalParams, Hierarchy, Link};
+use super::twin::vertex_bits;
 use super::twin_factors::{FactorReuse, NaturalFactors};
 use super::twin_tests::block_pair;
 
@@ -113,23 +114,14 @@ fn twin_factors_equal_computing_every_factor() {
     // Nodes under the building have the same vertices as natural nodes but less open area:
     // they are not twins.
     assert!(reuse.twins() < pair.mesh.nodes.len());
-    let key = |v: &[nalgebra::Point3<f64>; 3]| -> [u64; 9] {
-        std::array::from_fn(|k| v[k / 3][k % 3].to_bits())
-    };
-    let natural_vertices: HashSet<[u64; 9]> = pair
-        .natural_mesh
-        .nodes
-        .iter()
-        .map(|n| key(&n.vertices_in_world_m))
-        .collect();
+    let natural_vertices: HashSet<[u64; 9]> =
+        pair.natural_mesh.nodes.iter().map(vertex_bits).collect();
     let same_vertices = pair
         .mesh
         .nodes
         .iter()
         .zip(&twin_nodes)
-        .filter(|(node, t)| {
-            t.is_none() && natural_vertices.contains(&key(&node.vertices_in_world_m))
-        })
+        .filter(|(node, t)| t.is_none() && natural_vertices.contains(&vertex_bits(node)))
         .count();
     assert!(same_vertices > 0, "covered ground nodes without a twin");
 }
