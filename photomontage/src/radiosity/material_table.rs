@@ -309,6 +309,8 @@ impl Transfer {
             // The table's values carry the node solves' error, not a kept remainder.
             self.unshot[g].clear();
         }
+        // The axis responses hold for the old reflectances.
+        self.sun_basis = None;
         self.solution.locator = std::sync::OnceLock::new();
     }
 }

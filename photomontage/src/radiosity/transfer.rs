@@ -178,6 +178,9 @@ pub struct Transfer {
     /// The twins of this transfer's elements in the natural transfer it was built beside
     /// ([`super::twin`]): a relight reads the natural sun counts through them.
     twin: Option<Arc<Twin>>,
+    /// The sun group's axis responses ([`sun_basis`]), built at the first sun step that uses
+    /// them; a reflectance change drops them.
+    sun_basis: Option<sun_basis::SunBasis>,
 }
 
 /// What a relight traced ([`Transfer::prepare_relight`]), before [`Transfer::commit_relight`]
@@ -232,6 +235,8 @@ fn power(v: &[Rgb], areas: &[f64]) -> f64 {
 
 #[path = "material_table.rs"]
 mod material_table;
+#[path = "sun_basis.rs"]
+mod sun_basis;
 pub use material_table::{
     MaterialTableReport, NODE_STOP_FACTOR, TABLE_NODES, chebyshev_coefficients, chebyshev_value,
     table_nodes,
@@ -472,6 +477,7 @@ impl Transfer {
             },
             material_table: None,
             twin: twin.map(|(t, _)| Arc::new(t)),
+            sun_basis: None,
         })
     }
 
@@ -775,12 +781,35 @@ impl Transfer {
             element_mesh,
             new_groups,
             warnings,
-            actions,
+            mut actions,
             mut retraced,
-            sun_counts: _,
+            sun_counts,
         } = prepared;
         self.material_table = None;
         let material_changed = reflectance.is_some() || element_mesh.is_some();
+        let linear = self.params.strategy == RelightStrategy::LinearResponses;
+        if material_changed {
+            self.sun_basis = None;
+        }
+        // A sun step through the axis responses (sun_basis.rs): the sun group is done here and
+        // kept by the loop below.
+        let by_axes = (linear && self.params.sweep == Sweep::Shooting && !material_changed)
+            .then(|| sun_basis::axes_source(&self.kinds, &new_groups))
+            .flatten()
+            .filter(|(g, _)| actions[*g] == Action::Retrace && retraced[*g].is_some());
+        if let (Some((g, source)), Some(counts)) = (by_axes, sun_counts.as_ref()) {
+            let direct = retraced[g].take().unwrap_or_default();
+            let rows = self.relight_sun_by_axes(g, &source, counts);
+            let emitted = self.groups[g]
+                .emission
+                .then(|| self.topology.element_emissions(&self.solution.mesh));
+            let b0 = initial_exitance_from(&self.element_rho, &direct, emitted.as_deref());
+            let group = &mut self.solution.groups[g];
+            group.direct_irradiance_rgb = direct;
+            group.convergence = rows;
+            self.b0s[g] = b0;
+            actions[g] = Action::Keep;
+        }
         if let Some(mesh) = element_mesh {
             self.solution.mesh = Arc::new(mesh);
         }
@@ -803,7 +832,6 @@ impl Transfer {
             .cloned()
             .collect();
         solution_warnings.extend(warnings);
-        let linear = self.params.strategy == RelightStrategy::LinearResponses;
         // Groups to iterate: index, new initial exitance, warm start, unshot part.
         let mut pending: Vec<Pending> = Vec::new();
         for (g, action) in actions.into_iter().enumerate() {

@@ -454,6 +454,13 @@ impl SiteTransfers {
         self.with_artificial.transfer.solution()
     }
 
+    /// Forgets both transfers' sun axis responses ([`Transfer::drop_sun_axes`]): the next sun
+    /// step shoots them from nothing.
+    pub fn drop_sun_axes(&mut self) {
+        self.with_artificial.transfer.drop_sun_axes();
+        self.without_artificial.transfer.drop_sun_axes();
+    }
+
     /// The current solution of the photographed state.
     #[must_use]
     pub fn without_artificial(&self) -> &Solution {
