@@ -19,7 +19,7 @@ const STEPS: u32 = 120;
 const DRAG_L1_REL_TOL: f64 = 6.0 * STOP.residual;
 
 /// The sun group's area-weighted L1 difference over `reference`'s.
-fn sun_l1_rel(a: &Solution, reference: &Solution) -> f64 {
+pub(super) fn sun_l1_rel(a: &Solution, reference: &Solution) -> f64 {
     let (x, y) = (
         &a.groups[0].radiosity_rgb,
         &reference.groups[0].radiosity_rgb,

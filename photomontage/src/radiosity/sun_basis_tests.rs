@@ -2,10 +2,11 @@
 //! within the stop rule, the same bits on 1 and 2 threads, dropped by a reflectance change.
 #![allow(clippy::unwrap_used)]
 
+use crate::radiosity::TransferParams;
+use crate::radiosity::relight_drift_tests::sun_l1_rel;
 use crate::radiosity::sources::GroundBelowHorizon;
 use crate::radiosity::transfer::{LightingChange, RelightStrategy, Sweep, Transfer};
 use crate::radiosity::transfer_tests::{STOP, build, lighting, params, sun_at, yard};
-use crate::radiosity::{Solution, TransferParams, luminance};
 
 /// Both relights stop within the residual of the same fixed point and keep a remainder under
 /// it, each amplified by 1/(1 − ρF) < 2 (`relight_drift_tests`): 6 residuals bound their
@@ -20,21 +21,6 @@ fn params_with_ground(strategy: RelightStrategy) -> TransferParams {
         cluster_tolerance: 0.05,
     });
     p
-}
-
-fn sun_l1_rel(a: &Solution, reference: &Solution) -> f64 {
-    let (mut diff, mut norm) = (0.0, 0.0);
-    for (e, (p, q)) in a.groups[0]
-        .radiosity_rgb
-        .iter()
-        .zip(&reference.groups[0].radiosity_rgb)
-        .enumerate()
-    {
-        let w = reference.mesh.element_node(e).area_m2;
-        diff += luminance(&std::array::from_fn(|c| (p[c] - q[c]).abs())) * w;
-        norm += luminance(&q.map(f64::abs)) * w;
-    }
-    diff / norm
 }
 
 /// A sun drag's step (a quarter degree of azimuth).
