@@ -23,13 +23,16 @@
 //! residual (a bound on what one more round would add) and its mean brightness changed by less
 //! than the stop rule's mean
 //! change. Rounds are sequential. Within a round the links are read in parallel, split by a
-//! fixed set of receiver-node ranges ([`RECEIVER_RANGES`], balanced by links received): the links
+//! set of receiver-node ranges (`source_rows::receiver_ranges_for`, balanced by links received): the links
 //! are stored range by range, and within a range source by source ([`SourceRows`]), so each range
 //! is one task that walks its own arrays forwards and writes only its own receivers. A receiver's
 //! sum runs over the shot nodes in node order and each run in receiver order, exactly as one
 //! thread would, so the result is the same bit for bit on
 //! any number of threads. A round's convergence row counts the links it read (`interactions`), the same in every
-//! group's row; its residual is the group's unshot power over its total. The patches' powers
+//! group's row; its residual is the group's unshot power over its total. The per-patch passes
+//! (the start, the shot patches' node values, the push to the leaves) run over fixed blocks of
+//! whole patches ([`PatchBlock`]); the push and the powers skip a patch that gathered nothing
+//! and was not shot (its B, unshot part and powers cannot have changed). The patches' powers
 //! are summed in the same parallel pass that pushes a round's gathers down, and the buffers are
 //! kept by the transfer between relights ([`ShootScratch`]), so a relight makes no fresh pages.
 //! A group can give its unshot part outright instead of `old` ([`ShotGroup::unshot`]) and have
@@ -40,7 +43,7 @@
 //! factors are `f32` already); B and the unshot leaves stay `f64`.
 
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
-use super::source_rows::{RECEIVER_RANGES, SourceRows, gather_range, gather_range_dyn, simd_token};
+use super::source_rows::{SourceRows, gather_range, gather_range_dyn, simd_token};
 use super::topology::Topology;
 use super::{Rgb, luminance};
 use rayon::prelude::*;
@@ -189,13 +192,24 @@ pub(super) fn shoot(
         total: vec![0.0; patches.len() * k],
         unshot: vec![0.0; patches.len() * k],
     };
-    patch_elements3(topology, stride, b, u)
-        .into_par_iter()
-        .zip(powers.total.par_chunks_mut(k))
-        .zip(powers.unshot.par_chunks_mut(k))
-        .for_each(|(((p, b, u), total), unshot)| {
-            let (elo, ehi) = topology.patch_elements[p];
-            for (i, e) in (elo..ehi).enumerate() {
+    let blocks = patch_blocks(topology);
+    let (b_parts, u_parts) = (
+        split_blocks(&blocks, |b| b.elements, stride, b),
+        split_blocks(&blocks, |b| b.elements, stride, u),
+    );
+    let (total_parts, unshot_parts) = (
+        split_blocks(&blocks, |b| b.patches, k, &mut powers.total),
+        split_blocks(&blocks, |b| b.patches, k, &mut powers.unshot),
+    );
+    blocks
+        .par_iter()
+        .zip(b_parts)
+        .zip(u_parts)
+        .zip(total_parts)
+        .zip(unshot_parts)
+        .for_each(|((((block, b), u), total), unshot)| {
+            let e0 = block.elements.0;
+            for (i, e) in (block.elements.0..block.elements.1).enumerate() {
                 for (g, group) in groups.iter().enumerate() {
                     let s = group.start[e];
                     if let Some(given) = &group.unshot {
@@ -220,7 +234,17 @@ pub(super) fn shoot(
                     }
                 }
             }
-            patch_powers(&areas[elo..ehi], b, u, total, unshot);
+            for (i, p) in (block.patches.0..block.patches.1).enumerate() {
+                let (elo, ehi) = topology.patch_elements[p];
+                let (x, y) = ((elo - e0) * stride, (ehi - e0) * stride);
+                patch_powers(
+                    &areas[elo..ehi],
+                    &b[x..y],
+                    &u[x..y],
+                    &mut total[i * k..(i + 1) * k],
+                    &mut unshot[i * k..(i + 1) * k],
+                );
+            }
         });
     let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
     let mut total = group_sums(&powers.total, k);
@@ -237,57 +261,66 @@ pub(super) fn shoot(
         let before = powers.unshot.clone();
         // Node values of the unshot part of every shot patch (leaves up), then clear its leaves;
         // patch by patch in parallel (each writes only its own nodes and elements).
-        let active_per_patch: Vec<Vec<usize>> = patch_slices(topology, stride, un, u)
-            .into_par_iter()
-            .map(|(p, un, u)| {
-                if !shot_now[p] {
-                    return Vec::new();
-                }
-                let ((lo, hi), (elo, _)) = (patches[p], topology.patch_elements[p]);
-                for n in (lo..hi).rev() {
-                    let (head, tail) = un.split_at_mut((n - lo + 1) * stride);
-                    let own = &mut head[(n - lo) * stride..];
-                    if let Some(e) = node_element(n) {
-                        let e = e as usize - elo;
-                        for (o, v) in own.iter_mut().zip(&u[e * stride..(e + 1) * stride]) {
-                            #[allow(clippy::cast_possible_truncation)]
-                            {
-                                *o = *v as f32;
+        let (un_parts, u_parts) = (
+            split_blocks(&blocks, |b| b.nodes, stride, un),
+            split_blocks(&blocks, |b| b.elements, stride, u),
+        );
+        let active_per_block: Vec<Vec<usize>> = blocks
+            .par_iter()
+            .zip(un_parts)
+            .zip(u_parts)
+            .map(|((block, un), u)| {
+                let (n0, e0) = (block.nodes.0, block.elements.0);
+                let mut active = Vec::new();
+                for p in block.patches.0..block.patches.1 {
+                    if !shot_now[p] {
+                        continue;
+                    }
+                    let (lo, hi) = patches[p];
+                    for n in (lo..hi).rev() {
+                        let (head, tail) = un.split_at_mut((n - n0 + 1) * stride);
+                        let own = &mut head[(n - n0) * stride..];
+                        if let Some(e) = node_element(n) {
+                            let e = e as usize - e0;
+                            for (o, v) in own.iter_mut().zip(&u[e * stride..(e + 1) * stride]) {
+                                #[allow(clippy::cast_possible_truncation)]
+                                {
+                                    *o = *v as f32;
+                                }
                             }
-                        }
-                        u[e * stride..(e + 1) * stride].fill(0.0);
-                    } else {
-                        own.fill(0.0);
-                        for kid in topology.children[n].into_iter().flatten() {
-                            let kid = kid as usize;
-                            #[allow(clippy::cast_possible_truncation)]
-                            let w = topology.weight[kid] as f32;
-                            let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
-                            for (o, v) in own.iter_mut().zip(kid_vals) {
-                                *o += w * v;
+                            u[e * stride..(e + 1) * stride].fill(0.0);
+                        } else {
+                            own.fill(0.0);
+                            for kid in topology.children[n].into_iter().flatten() {
+                                let kid = kid as usize;
+                                #[allow(clippy::cast_possible_truncation)]
+                                let w = topology.weight[kid] as f32;
+                                let kid_vals = &tail[(kid - n - 1) * stride..(kid - n) * stride];
+                                for (o, v) in own.iter_mut().zip(kid_vals) {
+                                    *o += w * v;
+                                }
                             }
                         }
                     }
-                }
-                (lo..hi)
-                    .filter(|&n| {
-                        un[(n - lo) * stride..(n - lo + 1) * stride]
+                    active.extend((lo..hi).filter(|&n| {
+                        un[(n - n0) * stride..(n - n0 + 1) * stride]
                             .iter()
                             .any(|&v| v != 0.0)
-                    })
-                    .collect()
+                    }));
+                }
+                active
             })
             .collect();
         // Patches follow one another in node order, so the active nodes come out sorted: each
         // range task walks its arrays forwards.
-        let active: Vec<usize> = active_per_patch.into_iter().flatten().collect();
+        let active: Vec<usize> = active_per_block.into_iter().flatten().collect();
         debug_assert!(active.is_sorted());
         let interactions: u64 = active.iter().map(|&n| rows.row_len(n)).sum();
         // Each receiver range gathers on its own task; a receiver's sum runs over the shot
         // nodes in node order and each run in receiver order, as one thread would.
-        let mut ranges: Vec<(usize, &mut [f32])> = Vec::with_capacity(RECEIVER_RANGES);
+        let mut ranges: Vec<(usize, &mut [f32])> = Vec::with_capacity(rows.ranges());
         let mut rest: &mut [f32] = acc;
-        for r in 0..RECEIVER_RANGES {
+        for r in 0..rows.ranges() {
             let (lo, hi) = (rows.bounds[r] as usize, rows.bounds[r + 1] as usize);
             let (chunk, tail) = std::mem::take(&mut rest).split_at_mut((hi - lo) * stride);
             ranges.push((r, chunk));
@@ -305,34 +338,65 @@ pub(super) fn shoot(
         // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot; then
         // clear the patch's gathers and sum its powers. Patch by patch in parallel (each writes
         // only its own nodes, elements and powers).
-        patch_slices3(topology, stride, acc, b, u)
-            .into_par_iter()
-            .zip(powers.total.par_chunks_mut(k))
-            .zip(powers.unshot.par_chunks_mut(k))
-            .for_each(|(((p, acc, b, u), total), unshot)| {
-                let ((lo, hi), (elo, ehi)) = (patches[p], topology.patch_elements[p]);
-                for n in lo..hi {
-                    if n > lo {
-                        let parent = topology.parent[n] as usize - lo;
-                        let (head, tail) = acc.split_at_mut((n - lo) * stride);
-                        for (d, s) in tail[..stride]
-                            .iter_mut()
-                            .zip(&head[parent * stride..(parent + 1) * stride])
-                        {
-                            *d += s;
+        let (acc_parts, b_parts, u_parts) = (
+            split_blocks(&blocks, |b| b.nodes, stride, acc),
+            split_blocks(&blocks, |b| b.elements, stride, b),
+            split_blocks(&blocks, |b| b.elements, stride, u),
+        );
+        let (total_parts, unshot_parts) = (
+            split_blocks(&blocks, |b| b.patches, k, &mut powers.total),
+            split_blocks(&blocks, |b| b.patches, k, &mut powers.unshot),
+        );
+        blocks
+            .par_iter()
+            .zip(acc_parts)
+            .zip(b_parts)
+            .zip(u_parts)
+            .zip(total_parts)
+            .zip(unshot_parts)
+            .for_each(|(((((block, acc), b), u), total), unshot)| {
+                let (n0, e0, p0) = (block.nodes.0, block.elements.0, block.patches.0);
+                for p in block.patches.0..block.patches.1 {
+                    let ((lo, hi), (elo, ehi)) = (patches[p], topology.patch_elements[p]);
+                    let acc = &mut acc[(lo - n0) * stride..(hi - n0) * stride];
+                    // A patch that gathered nothing (every value ±0) keeps B and its unshot
+                    // part; its powers change only if it was shot (its unshot part cleared).
+                    let gathered = acc.iter().any(|&v| v != 0.0);
+                    if gathered {
+                        for n in lo..hi {
+                            if n > lo {
+                                let parent = topology.parent[n] as usize - lo;
+                                let (head, tail) = acc.split_at_mut((n - lo) * stride);
+                                for (d, s) in tail[..stride]
+                                    .iter_mut()
+                                    .zip(&head[parent * stride..(parent + 1) * stride])
+                                {
+                                    *d += s;
+                                }
+                            }
+                            if let Some(e) = node_element(n) {
+                                let (e, el) = (e as usize, e as usize - e0);
+                                for j in 0..stride {
+                                    let db = rho[e][j % 3] * f64::from(acc[(n - lo) * stride + j]);
+                                    b[el * stride + j] += db;
+                                    u[el * stride + j] += db;
+                                }
+                            }
                         }
+                        acc.fill(0.0);
                     }
-                    if let Some(e) = node_element(n) {
-                        let (e, el) = (e as usize, e as usize - elo);
-                        for j in 0..stride {
-                            let db = rho[e][j % 3] * f64::from(acc[(n - lo) * stride + j]);
-                            b[el * stride + j] += db;
-                            u[el * stride + j] += db;
-                        }
+                    if gathered || shot_now[p] {
+                        let (x, y) = ((elo - e0) * stride, (ehi - e0) * stride);
+                        let i = p - p0;
+                        patch_powers(
+                            &areas[elo..ehi],
+                            &b[x..y],
+                            &u[x..y],
+                            &mut total[i * k..(i + 1) * k],
+                            &mut unshot[i * k..(i + 1) * k],
+                        );
                     }
                 }
-                acc.fill(0.0);
-                patch_powers(&areas[elo..ehi], b, u, total, unshot);
             });
         total = group_sums(&powers.total, k);
         let unshot_after = group_sums(&powers.unshot, k);
@@ -498,76 +562,58 @@ fn choose_patches(
     shot
 }
 
-/// Per patch p: `(p, its nodes' values in `nodes`, its elements' values in `elements`)`, `stride`
-/// values per node and per element (nodes between patches, above them, are skipped).
-fn patch_slices<'a, N, E>(
-    topology: &Topology,
-    stride: usize,
-    nodes: &'a mut [N],
-    elements: &'a mut [E],
-) -> Vec<(usize, &'a mut [N], &'a mut [E])> {
-    let mut out = Vec::with_capacity(topology.patch_ranges.len());
-    let (mut node_rest, mut node_at) = (nodes, 0);
-    let mut element_rest = elements;
-    for (p, (&(lo, hi), &(elo, ehi))) in topology
-        .patch_ranges
-        .iter()
-        .zip(&topology.patch_elements)
-        .enumerate()
-    {
-        let (_, rest) = std::mem::take(&mut node_rest).split_at_mut((lo - node_at) * stride);
-        let (mine, rest) = rest.split_at_mut((hi - lo) * stride);
-        node_rest = rest;
-        node_at = hi;
-        let (el, rest) = std::mem::take(&mut element_rest).split_at_mut((ehi - elo) * stride);
-        element_rest = rest;
-        out.push((p, mine, el));
+/// Elements per [`PatchBlock`] (at least; a block ends at a patch's end): enough to amortise a
+/// task, few enough to balance two to dozens of threads on 50 000 elements.
+const BLOCK_ELEMENTS: usize = 256;
+
+/// Consecutive patches, with their nodes and elements (half-open ranges): the unit of the
+/// per-patch passes. The node range runs from the first patch's first node to the last patch's
+/// last, so it holds the nodes between them (above the patches), which no pass writes.
+struct PatchBlock {
+    patches: (usize, usize),
+    nodes: (usize, usize),
+    elements: (usize, usize),
+}
+
+/// The patches cut into blocks of at least [`BLOCK_ELEMENTS`] elements, in patch order (a
+/// fixed partition: a pass gives the same values on any number of threads, each patch being
+/// computed on its own).
+fn patch_blocks(topology: &Topology) -> Vec<PatchBlock> {
+    let (ranges, elements) = (&topology.patch_ranges, &topology.patch_elements);
+    let mut out = Vec::new();
+    let mut first = 0;
+    for p in 0..ranges.len() {
+        let last = p + 1 == ranges.len();
+        if elements[p].1 - elements[first].0 >= BLOCK_ELEMENTS || last {
+            out.push(PatchBlock {
+                patches: (first, p + 1),
+                nodes: (ranges[first].0, ranges[p].1),
+                elements: (elements[first].0, elements[p].1),
+            });
+            first = p + 1;
+        }
     }
     out
 }
 
-/// Per patch p: `(p, its values in `a`, its values in `b`)`, two element arrays of `stride`
-/// values per element.
-fn patch_elements3<'a>(
-    topology: &Topology,
+/// `data` cut into the blocks' ranges (`range` of each block, `stride` values per unit; what
+/// lies between blocks is left out).
+fn split_blocks<'a, T>(
+    blocks: &[PatchBlock],
+    range: impl Fn(&PatchBlock) -> (usize, usize),
     stride: usize,
-    a: &'a mut [f64],
-    b: &'a mut [f64],
-) -> Vec<(usize, &'a mut [f64], &'a mut [f64])> {
-    let (mut a_rest, mut b_rest) = (a, b);
-    topology
-        .patch_elements
+    data: &'a mut [T],
+) -> Vec<&'a mut [T]> {
+    let (mut rest, mut at) = (data, 0);
+    blocks
         .iter()
-        .enumerate()
-        .map(|(p, &(elo, ehi))| {
-            let (a, rest) = std::mem::take(&mut a_rest).split_at_mut((ehi - elo) * stride);
-            a_rest = rest;
-            let (b, rest) = std::mem::take(&mut b_rest).split_at_mut((ehi - elo) * stride);
-            b_rest = rest;
-            (p, a, b)
-        })
-        .collect()
-}
-
-/// A patch's index, its node values and its values in two element arrays.
-type PatchSlices3<'a> = (usize, &'a mut [f32], &'a mut [f64], &'a mut [f64]);
-
-/// [`patch_slices`] with two element arrays.
-fn patch_slices3<'a>(
-    topology: &Topology,
-    stride: usize,
-    nodes: &'a mut [f32],
-    a: &'a mut [f64],
-    b: &'a mut [f64],
-) -> Vec<PatchSlices3<'a>> {
-    let mut b_rest = b;
-    patch_slices(topology, stride, nodes, a)
-        .into_iter()
-        .map(|(p, n, a)| {
-            let (elo, ehi) = topology.patch_elements[p];
-            let (mine, rest) = std::mem::take(&mut b_rest).split_at_mut((ehi - elo) * stride);
-            b_rest = rest;
-            (p, n, a, mine)
+        .map(|block| {
+            let (lo, hi) = range(block);
+            let (_, tail) = std::mem::take(&mut rest).split_at_mut((lo - at) * stride);
+            let (mine, tail) = tail.split_at_mut((hi - lo) * stride);
+            rest = tail;
+            at = hi;
+            mine
         })
         .collect()
 }

@@ -32,7 +32,7 @@
 
 use rayon::prelude::*;
 
-use super::{GroupKind, Transfer, power};
+use super::{GroupKind, Transfer, initial_exitance_from, power};
 use crate::radiosity::convergence::ConvergenceRow;
 use crate::radiosity::shooting::{ShotGroup, shoot};
 use crate::radiosity::sources::DistantSource;
@@ -51,6 +51,11 @@ pub(super) struct SunBasis {
     radiosity: [Vec<Rgb>; 3],
     /// Per axis: what its shootings left unshot and its steps added, kept.
     unshot: [Vec<Rgb>; 3],
+    /// The sun group and source of the last step when its composed remainder
+    /// ([`Transfer::unshot`]) and initial exitance ([`Transfer::b0s`]) are not yet written: only
+    /// a relight other than a sun step through the basis reads them
+    /// ([`Transfer::settle_sun_axes`]), so a drag of sun steps never composes them.
+    pending: Option<(usize, DistantSource)>,
 }
 
 /// The sun group's index and its one source, when a relight can go through the basis: the sun
@@ -76,7 +81,28 @@ impl Transfer {
     /// Forgets the sun's axis responses: the next sun step shoots them from nothing, a cold
     /// shooting (the reference of a drift measurement).
     pub fn drop_sun_axes(&mut self) {
+        self.settle_sun_axes();
         self.sun_basis = None;
+    }
+
+    /// Writes the sun group's composed remainder and initial exitance of the last step through
+    /// the basis where they are still pending ([`SunBasis::pending`]), for the transfer's
+    /// current reflectances and the group's direct light: before anything else relights.
+    pub(super) fn settle_sun_axes(&mut self) {
+        let Some((g, source)) = self.sun_basis.as_mut().and_then(|b| b.pending.take()) else {
+            return;
+        };
+        if let Some(basis) = &self.sun_basis {
+            compose(&basis.unshot, &source, &mut self.unshot[g]);
+        }
+        let emitted = self.groups[g]
+            .emission
+            .then(|| self.topology.element_emissions(&self.solution.mesh));
+        self.b0s[g] = initial_exitance_from(
+            &self.element_rho,
+            &self.solution.groups[g].direct_irradiance_rgb,
+            emitted.as_deref(),
+        );
     }
 
     /// Relights sun group `g` to `source` with its ray `counts` through the basis (module doc),
@@ -152,7 +178,7 @@ impl Transfer {
             source,
             &mut self.solution.groups[g].radiosity_rgb,
         );
-        compose(&basis.unshot, source, &mut self.unshot[g]);
+        basis.pending = Some((g, *source));
         self.sun_basis = Some(basis);
         rows
     }
@@ -190,6 +216,7 @@ impl Transfer {
             escaped: counts.escaped.clone(),
             unshot: b0.clone(),
             radiosity: b0,
+            pending: None,
         }
     }
 

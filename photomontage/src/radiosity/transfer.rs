@@ -788,26 +788,26 @@ impl Transfer {
         self.material_table = None;
         let material_changed = reflectance.is_some() || element_mesh.is_some();
         let linear = self.params.strategy == RelightStrategy::LinearResponses;
-        if material_changed {
-            self.sun_basis = None;
-        }
         // A sun step through the axis responses (sun_basis.rs): the sun group is done here and
         // kept by the loop below.
         let by_axes = (linear && self.params.sweep == Sweep::Shooting && !material_changed)
             .then(|| sun_basis::axes_source(&self.kinds, &new_groups))
             .flatten()
             .filter(|(g, _)| actions[*g] == Action::Retrace && retraced[*g].is_some());
+        if by_axes.is_none() || sun_counts.is_none() {
+            self.settle_sun_axes();
+        }
+        if material_changed {
+            self.sun_basis = None;
+        }
         if let (Some((g, source)), Some(counts)) = (by_axes, sun_counts.as_ref()) {
+            // The group's composed remainder and initial exitance are written when something
+            // other than a sun step reads them (`settle_sun_axes`).
             let direct = retraced[g].take().unwrap_or_default();
             let rows = self.relight_sun_by_axes(g, &source, counts);
-            let emitted = self.groups[g]
-                .emission
-                .then(|| self.topology.element_emissions(&self.solution.mesh));
-            let b0 = initial_exitance_from(&self.element_rho, &direct, emitted.as_deref());
             let group = &mut self.solution.groups[g];
             group.direct_irradiance_rgb = direct;
             group.convergence = rows;
-            self.b0s[g] = b0;
             actions[g] = Action::Keep;
         }
         if let Some(mesh) = element_mesh {
