@@ -37,7 +37,7 @@ use crate::radiosity::convergence::ConvergenceRow;
 use crate::radiosity::shooting::{ShotGroup, shoot};
 use crate::radiosity::sources::DistantSource;
 use crate::radiosity::sun_rays::SunCounts;
-use crate::radiosity::{LightGroup, Rgb};
+use crate::radiosity::{LightGroup, Rgb, luminance};
 
 /// The axes' names in the convergence rows.
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -51,6 +51,11 @@ pub(super) struct SunBasis {
     radiosity: [Vec<Rgb>; 3],
     /// Per axis: what its shootings left unshot and its steps added, kept.
     unshot: [Vec<Rgb>; 3],
+    /// Per axis, the power (area-weighted luminance of |v|) of `radiosity` and of `unshot`:
+    /// summed afresh when the axis is built or shot, and updated element by element by a step's
+    /// visibility change (the same order on any number of threads), so that a step reads the
+    /// three axes only where their counts changed.
+    powers: [[f64; 2]; 3],
     /// The sun group and source of the last step when its composed remainder
     /// ([`Transfer::unshot`]) and initial exitance ([`Transfer::b0s`]) are not yet written: only
     /// a relight other than a sun step through the basis reads them
@@ -132,12 +137,9 @@ impl Transfer {
         let (mut basis, shot_axes): (SunBasis, Vec<usize>) = match basis {
             Some(mut b) => {
                 self.add_visibility_change(&mut b, counts, rays);
-                let areas = &self.topology.areas;
                 let residual = self.params.solve.stop.residual;
                 let over: Vec<usize> = (0..3)
-                    .filter(|&c| {
-                        power(&b.unshot[c], areas) > residual * power(&b.radiosity[c], areas)
-                    })
+                    .filter(|&c| b.powers[c][1] > residual * b.powers[c][0])
                     .collect();
                 (b, over)
             }
@@ -167,6 +169,11 @@ impl Transfer {
             for (&c, shot) in shot_axes.iter().zip(shots) {
                 basis.radiosity[c] = shot.radiosity;
                 basis.unshot[c] = shot.unshot.unwrap_or_else(|| vec![[0.0; 3]; n_el]);
+                let areas = &self.topology.areas;
+                basis.powers[c] = [
+                    power(&basis.radiosity[c], areas),
+                    power(&basis.unshot[c], areas),
+                ];
                 rows.extend(shot.rows.into_iter().map(|mut r| {
                     r.group = format!("{name} ({} axis)", AXES[c]);
                     r
@@ -212,10 +219,16 @@ impl Transfer {
     /// The basis for `counts`, nothing shot yet: G_c = B₀_c, all of it unshot.
     fn cold_basis(&self, counts: &SunCounts, rays: f64) -> SunBasis {
         let b0 = self.axis_exitance(counts, rays);
+        let areas = &self.topology.areas;
+        let powers = std::array::from_fn(|c| {
+            let p = power(&b0[c], areas);
+            [p, p]
+        });
         SunBasis {
             escaped: counts.escaped.clone(),
             unshot: b0.clone(),
             radiosity: b0,
+            powers,
             pending: None,
         }
     }
@@ -231,12 +244,18 @@ impl Transfer {
             *old = new;
             let n = mesh.element_node(e).normal_in_world;
             let rho = self.element_rho[e];
+            let area = self.topology.areas[e];
+            let weighted = |v: &Rgb| area * luminance(&v.map(f64::abs));
             for c in 0..3 {
+                let (r, u) = (&mut basis.radiosity[c][e], &mut basis.unshot[c][e]);
+                let before = [weighted(r), weighted(u)];
                 for k in 0..3 {
                     let d = rho[k] * dv * n[c];
-                    basis.radiosity[c][e][k] += d;
-                    basis.unshot[c][e][k] += d;
+                    r[k] += d;
+                    u[k] += d;
                 }
+                basis.powers[c][0] += weighted(r) - before[0];
+                basis.powers[c][1] += weighted(u) - before[1];
             }
         }
     }

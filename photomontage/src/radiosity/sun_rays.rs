@@ -34,7 +34,10 @@ pub struct SunCounts {
 
 /// Per element of `engine`'s mesh, how many of its `samples` rays towards `source` escape the
 /// scene (0 for an element facing away); with `twin` = (the twins, the natural transfer's counts
-/// for the same direction), from the twins' counts where they decide (module doc).
+/// for the same direction), from the twins' counts where they decide (module doc). With them,
+/// in the same pass over the elements (one read of each element's node), the source's direct
+/// irradiance E_n·cos·(escaped / rays): the same operations in the same order as
+/// [`super::sources::direct_irradiance_at`], so the same bits.
 ///
 /// # Panics
 /// When `samples` were drawn for another mesh, or an element has more than 255 points.
@@ -44,7 +47,7 @@ pub(super) fn sun_counts(
     samples: &DirectSamples,
     source: &DistantSource,
     twin: Option<(&Twin, &SunCounts)>,
-) -> SunCounts {
+) -> (SunCounts, Vec<Rgb>) {
     let mesh = engine.mesh();
     let tracer = engine.tracer();
     let visibility = engine.params().visibility;
@@ -53,86 +56,78 @@ pub(super) fn sun_counts(
     let twin = twin.filter(|(t, natural)| {
         t.twin_of.len() == mesh.elements.len() && natural.dir_in_world == [bits.x, bits.y, bits.z]
     });
-    let escaped = (0..mesh.elements.len())
+    let (escaped, direct): (Vec<u8>, Vec<Rgb>) = (0..mesh.elements.len())
         .into_par_iter()
         .map(|e| {
             let node = mesh.element_node(e);
-            if node.normal_in_world.dot(&dir) <= 0.0 {
-                return 0;
-            }
-            let points = samples.of_element(e);
-            let rays = u8::try_from(points.len()).unwrap_or_else(|_| unreachable!("≤ 255 points"));
-            let mut only_planned = None;
-            if let Some((t, natural)) = twin
-                && let Some(w) = t.twin_of[e]
-            {
-                let n = natural.escaped[w as usize];
-                if n == 0 {
-                    return 0;
-                }
-                if n == rays {
-                    if t.cone_from_node(node)
-                        .is_some_and(|(axis, cos)| axis.dot(&dir) < cos)
-                    {
-                        return n;
-                    }
-                    only_planned = Some(t);
-                }
-            }
-            let mut hits = 0u8;
-            for p in points {
-                if only_planned.is_some_and(|t| !t.may_meet_artificial(p, &dir)) {
-                    hits += 1;
-                    continue;
-                }
-                #[allow(clippy::cast_possible_truncation)]
-                let ray =
-                    tracer.ray_from_world(p, &dir, DIRECT_RAY_OFFSET_M as f32, DIRECT_RAY_LENGTH_M);
-                let blocked = match only_planned {
-                    Some(t) => t.artificial.any_hit(&ray),
-                    None => tracer.any_hit(&ray),
-                };
-                if !visibility || !blocked {
-                    hits += 1;
-                }
-            }
-            hits
-        })
-        .collect();
-    SunCounts {
-        dir_in_world: [bits.x, bits.y, bits.z],
-        escaped,
-    }
-}
-
-/// The direct irradiance of the one distant `source` from its `counts` (out of each element's
-/// rays, one per point of `samples`): E_n·cos·(escaped / rays), the same operations in the same
-/// order as [`super::sources::direct_irradiance_at`], so the same bits.
-#[must_use]
-pub(super) fn sun_direct(
-    engine: &FormFactorEngine<'_>,
-    samples: &DirectSamples,
-    source: &DistantSource,
-    counts: &SunCounts,
-) -> Vec<Rgb> {
-    let mesh = engine.mesh();
-    (0..mesh.elements.len())
-        .into_par_iter()
-        .map(|e| {
-            let mut e_rgb = [0.0; 3];
-            let cos = mesh
-                .element_node(e)
-                .normal_in_world
-                .dot(&source.dir_in_world);
+            let cos = node.normal_in_world.dot(&dir);
             if cos <= 0.0 {
-                return e_rgb;
+                return (0, [0.0; 3]);
             }
+            let escaped = escaped_rays(e, node, samples, twin, tracer, &dir, visibility);
             #[allow(clippy::cast_precision_loss)]
-            let visible = f64::from(counts.escaped[e]) / samples.of_element(e).len() as f64;
+            let visible = f64::from(escaped) / samples.of_element(e).len() as f64;
+            let mut e_rgb = [0.0; 3];
             for c in 0..3 {
                 e_rgb[c] += source.normal_irradiance_rgb[c] * cos * visible;
             }
-            e_rgb
+            (escaped, e_rgb)
         })
-        .collect()
+        .unzip();
+    (
+        SunCounts {
+            dir_in_world: [bits.x, bits.y, bits.z],
+            escaped,
+        },
+        direct,
+    )
+}
+
+/// How many of element `e`'s sample rays towards `dir` escape (it faces the sun), from its
+/// twin's count where that decides ([`sun_counts`]).
+fn escaped_rays(
+    e: usize,
+    node: &super::mesh::MeshNode,
+    samples: &DirectSamples,
+    twin: Option<(&Twin, &SunCounts)>,
+    tracer: &crate::scene::SceneTracer,
+    dir: &nalgebra::Vector3<f64>,
+    visibility: bool,
+) -> u8 {
+    let points = samples.of_element(e);
+    let rays = u8::try_from(points.len()).unwrap_or_else(|_| unreachable!("≤ 255 points"));
+    let mut only_planned = None;
+    if let Some((t, natural)) = twin
+        && let Some(w) = t.twin_of[e]
+    {
+        let n = natural.escaped[w as usize];
+        if n == 0 {
+            return 0;
+        }
+        if n == rays {
+            if t.cone_from_node(node)
+                .is_some_and(|(axis, cos)| axis.dot(dir) < cos)
+            {
+                return n;
+            }
+            only_planned = Some(t);
+        }
+    }
+    let mut hits = 0u8;
+    for p in points {
+        if only_planned.is_some_and(|t| !t.may_meet_artificial(p, dir)) {
+            hits += 1;
+            continue;
+        }
+        #[allow(clippy::cast_possible_truncation)]
+        let ray = tracer.ray_from_world(p, dir, DIRECT_RAY_OFFSET_M as f32, DIRECT_RAY_LENGTH_M);
+        let blocked = match only_planned {
+            Some(t) => t.artificial.any_hit(&ray),
+            None => tracer.any_hit(&ray),
+        };
+        if !visibility || !blocked {
+            hits += 1;
+        }
+    }
+    hits
 }

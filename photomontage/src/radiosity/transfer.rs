@@ -60,7 +60,7 @@ use super::solve::{
 };
 use super::source_rows::SourceRows;
 use super::sources::{self, DirectSamples, LightWarning};
-use super::sun_rays::{SunCounts, sun_counts as sun_counts_of, sun_direct};
+use super::sun_rays::{SunCounts, sun_counts as sun_counts_of};
 pub use super::sweeps::Sweep;
 use super::sweeps::{LinkRows, iterate};
 use super::topology::Topology;
@@ -742,8 +742,7 @@ impl Transfer {
                 ) {
                     sources::validate(&group.name, &group.sources)?;
                     let twin = self.twin.as_deref().zip(natural_sun);
-                    let counts = sun_counts_of(&engine, samples, source, twin);
-                    let mut direct = sun_direct(&engine, samples, source, &counts);
+                    let (counts, mut direct) = sun_counts_of(&engine, samples, source, twin);
                     if let Some(ground) = self.ground.as_ref() {
                         ground.add(&group.sources, &mut direct);
                     }
