@@ -82,6 +82,9 @@ pub(super) struct Shot {
     /// What is left unshot per element, for a group that asked ([`ShotGroup::keep_unshot`]):
     /// B plus its response is the exact solution.
     pub unshot: Option<Vec<Rgb>>,
+    /// The power (area-weighted luminance of |v|) of `radiosity` and of what is left unshot, as
+    /// the stop rule read them (summed patch by patch).
+    pub powers: [f64; 2],
 }
 
 /// The buffers of [`shoot`], kept by the transfer between relights so that a relight neither
@@ -181,9 +184,30 @@ pub(super) fn shoot(
     let areas = &topology.areas;
     let area_sum: f64 = areas.iter().sum();
     let patches = &topology.patch_ranges;
+    // One group that gives its unshot part and keeps what is left: its own buffers are B and
+    // the unshot part (an `Rgb` per element is the layout of one group's values), so nothing is
+    // copied in or out.
+    let mut groups = groups;
+    let in_place = k == 1
+        && groups[0].keep_unshot
+        && groups[0].start.len() == n_el
+        && groups[0].unshot.as_ref().is_some_and(|v| v.len() == n_el);
+    let (mut own_b, mut own_u) = if in_place {
+        (
+            std::mem::take(&mut groups[0].start),
+            groups[0].unshot.take().unwrap_or_default(),
+        )
+    } else {
+        (Vec::new(), Vec::new())
+    };
     let ShootScratch { b, u, un, acc } = scratch;
-    b.resize(n_el * stride, 0.0);
-    u.resize(n_el * stride, 0.0);
+    let (b, u): (&mut [f64], &mut [f64]) = if in_place {
+        (own_b.as_flattened_mut(), own_u.as_flattened_mut())
+    } else {
+        b.resize(n_el * stride, 0.0);
+        u.resize(n_el * stride, 0.0);
+        (b, u)
+    };
     un.resize(n_nodes * stride, 0.0);
     acc.resize(n_nodes * stride, 0.0);
     // Leaves: B and the unshot part, `stride` values per element (group-major within), and the
@@ -209,7 +233,12 @@ pub(super) fn shoot(
         .zip(unshot_parts)
         .for_each(|((((block, b), u), total), unshot)| {
             let e0 = block.elements.0;
-            for (i, e) in (block.elements.0..block.elements.1).enumerate() {
+            let copied = if in_place {
+                0..0
+            } else {
+                block.elements.0..block.elements.1
+            };
+            for (i, e) in copied.enumerate() {
                 for (g, group) in groups.iter().enumerate() {
                     let s = group.start[e];
                     if let Some(given) = &group.unshot {
@@ -435,6 +464,16 @@ pub(super) fn shoot(
             break;
         }
     }
+    let (total, unshot) = (group_sums(&powers.total, k), group_sums(&powers.unshot, k));
+    if in_place {
+        let rows = out_rows.pop().unwrap_or_default();
+        return vec![Shot {
+            radiosity: own_b,
+            rows,
+            unshot: Some(own_u),
+            powers: [total[0], unshot[0]],
+        }];
+    }
     // The results go into the groups' own buffers (no fresh pages).
     let read = |v: &[f64], g: usize, out: &mut Vec<Rgb>| {
         out.resize(n_el, [0.0; 3]);
@@ -449,7 +488,7 @@ pub(super) fn shoot(
         .map(|(g, (group, rows))| {
             let mut radiosity = group.start;
             read(b, g, &mut radiosity);
-            let unshot = group.keep_unshot.then(|| {
+            let kept = group.keep_unshot.then(|| {
                 let mut unshot = group.unshot.unwrap_or_default();
                 read(u, g, &mut unshot);
                 unshot
@@ -457,7 +496,8 @@ pub(super) fn shoot(
             Shot {
                 radiosity,
                 rows,
-                unshot,
+                unshot: kept,
+                powers: [total[g], unshot[g]],
             }
         })
         .collect()

@@ -169,11 +169,7 @@ impl Transfer {
             for (&c, shot) in shot_axes.iter().zip(shots) {
                 basis.radiosity[c] = shot.radiosity;
                 basis.unshot[c] = shot.unshot.unwrap_or_else(|| vec![[0.0; 3]; n_el]);
-                let areas = &self.topology.areas;
-                basis.powers[c] = [
-                    power(&basis.radiosity[c], areas),
-                    power(&basis.unshot[c], areas),
-                ];
+                basis.powers[c] = shot.powers;
                 rows.extend(shot.rows.into_iter().map(|mut r| {
                     r.group = format!("{name} ({} axis)", AXES[c]);
                     r
