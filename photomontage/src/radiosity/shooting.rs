@@ -217,22 +217,11 @@ pub(super) fn shoot(
         unshot: vec![0.0; patches.len() * k],
     };
     let blocks = patch_blocks(topology);
-    let (b_parts, u_parts) = (
-        split_blocks(&blocks, |b| b.elements, stride, b),
-        split_blocks(&blocks, |b| b.elements, stride, u),
-    );
-    let (total_parts, unshot_parts) = (
-        split_blocks(&blocks, |b| b.patches, k, &mut powers.total),
-        split_blocks(&blocks, |b| b.patches, k, &mut powers.unshot),
-    );
     blocks
         .par_iter()
-        .zip(b_parts)
-        .zip(u_parts)
-        .zip(total_parts)
-        .zip(unshot_parts)
-        .for_each(|((((block, b), u), total), unshot)| {
-            let e0 = block.elements.0;
+        .zip(block_leaves(&blocks, stride, k, b, u, &mut powers))
+        .for_each(|(block, mut leaves)| {
+            let BlockLeaves { b, u, .. } = &mut leaves;
             let copied = if in_place {
                 0..0
             } else {
@@ -263,16 +252,8 @@ pub(super) fn shoot(
                     }
                 }
             }
-            for (i, p) in (block.patches.0..block.patches.1).enumerate() {
-                let (elo, ehi) = topology.patch_elements[p];
-                let (x, y) = ((elo - e0) * stride, (ehi - e0) * stride);
-                patch_powers(
-                    &areas[elo..ehi],
-                    &b[x..y],
-                    &u[x..y],
-                    &mut total[i * k..(i + 1) * k],
-                    &mut unshot[i * k..(i + 1) * k],
-                );
+            for p in block.patches.0..block.patches.1 {
+                leaves.sum_powers(topology, block, p);
             }
         });
     let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
@@ -367,26 +348,14 @@ pub(super) fn shoot(
         // Push what every node gathered down to its leaves: ΔB = ρ′·G, added and unshot; then
         // clear the patch's gathers and sum its powers. Patch by patch in parallel (each writes
         // only its own nodes, elements and powers).
-        let (acc_parts, b_parts, u_parts) = (
-            split_blocks(&blocks, |b| b.nodes, stride, acc),
-            split_blocks(&blocks, |b| b.elements, stride, b),
-            split_blocks(&blocks, |b| b.elements, stride, u),
-        );
-        let (total_parts, unshot_parts) = (
-            split_blocks(&blocks, |b| b.patches, k, &mut powers.total),
-            split_blocks(&blocks, |b| b.patches, k, &mut powers.unshot),
-        );
         blocks
             .par_iter()
-            .zip(acc_parts)
-            .zip(b_parts)
-            .zip(u_parts)
-            .zip(total_parts)
-            .zip(unshot_parts)
-            .for_each(|(((((block, acc), b), u), total), unshot)| {
-                let (n0, e0, p0) = (block.nodes.0, block.elements.0, block.patches.0);
+            .zip(split_blocks(&blocks, |b| b.nodes, stride, acc))
+            .zip(block_leaves(&blocks, stride, k, b, u, &mut powers))
+            .for_each(|((block, acc), mut leaves)| {
+                let (n0, e0) = (block.nodes.0, block.elements.0);
                 for p in block.patches.0..block.patches.1 {
-                    let ((lo, hi), (elo, ehi)) = (patches[p], topology.patch_elements[p]);
+                    let (lo, hi) = patches[p];
                     let acc = &mut acc[(lo - n0) * stride..(hi - n0) * stride];
                     // A patch that gathered nothing (every value ±0) keeps B and its unshot
                     // part; its powers change only if it was shot (its unshot part cleared).
@@ -407,23 +376,15 @@ pub(super) fn shoot(
                                 let (e, el) = (e as usize, e as usize - e0);
                                 for j in 0..stride {
                                     let db = rho[e][j % 3] * f64::from(acc[(n - lo) * stride + j]);
-                                    b[el * stride + j] += db;
-                                    u[el * stride + j] += db;
+                                    leaves.b[el * stride + j] += db;
+                                    leaves.u[el * stride + j] += db;
                                 }
                             }
                         }
                         acc.fill(0.0);
                     }
                     if gathered || shot_now[p] {
-                        let (x, y) = ((elo - e0) * stride, (ehi - e0) * stride);
-                        let i = p - p0;
-                        patch_powers(
-                            &areas[elo..ehi],
-                            &b[x..y],
-                            &u[x..y],
-                            &mut total[i * k..(i + 1) * k],
-                            &mut unshot[i * k..(i + 1) * k],
-                        );
+                        leaves.sum_powers(topology, block, p);
                     }
                 }
             });
@@ -634,6 +595,60 @@ fn patch_blocks(topology: &Topology) -> Vec<PatchBlock> {
         }
     }
     out
+}
+
+/// One block's leaves: B and the unshot part of its elements, and its patches' powers.
+struct BlockLeaves<'a> {
+    b: &'a mut [f64],
+    u: &'a mut [f64],
+    total: &'a mut [f64],
+    unshot: &'a mut [f64],
+}
+
+impl BlockLeaves<'_> {
+    /// Sums the powers of patch `p` of `block` from its elements' B and unshot part.
+    fn sum_powers(&mut self, topology: &Topology, block: &PatchBlock, p: usize) {
+        let k = self.total.len() / (block.patches.1 - block.patches.0);
+        let stride = 3 * k;
+        let (elo, ehi) = topology.patch_elements[p];
+        let (x, y) = (
+            (elo - block.elements.0) * stride,
+            (ehi - block.elements.0) * stride,
+        );
+        let i = p - block.patches.0;
+        patch_powers(
+            &topology.areas[elo..ehi],
+            &self.b[x..y],
+            &self.u[x..y],
+            &mut self.total[i * k..(i + 1) * k],
+            &mut self.unshot[i * k..(i + 1) * k],
+        );
+    }
+}
+
+/// The leaves of every block: `b` and `u` (`stride` values per element) and the patches' powers
+/// (`k` per patch) cut into the blocks' ranges.
+fn block_leaves<'a>(
+    blocks: &[PatchBlock],
+    stride: usize,
+    k: usize,
+    b: &'a mut [f64],
+    u: &'a mut [f64],
+    powers: &'a mut PatchPowers,
+) -> Vec<BlockLeaves<'a>> {
+    let PatchPowers { total, unshot } = powers;
+    split_blocks(blocks, |b| b.elements, stride, b)
+        .into_iter()
+        .zip(split_blocks(blocks, |b| b.elements, stride, u))
+        .zip(split_blocks(blocks, |b| b.patches, k, total))
+        .zip(split_blocks(blocks, |b| b.patches, k, unshot))
+        .map(|(((b, u), total), unshot)| BlockLeaves {
+            b,
+            u,
+            total,
+            unshot,
+        })
+        .collect()
 }
 
 /// `data` cut into the blocks' ranges (`range` of each block, `stride` values per unit; what
