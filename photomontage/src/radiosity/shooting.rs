@@ -31,7 +31,7 @@
 //! any number of threads. A round's convergence row counts the links it read (`interactions`), the same in every
 //! group's row; its residual is the group's unshot power over its total. The per-patch passes
 //! (the start, the shot patches' node values, the push to the leaves) run over fixed blocks of
-//! whole patches ([`PatchBlock`]); the push and the powers skip a patch that gathered nothing
+//! whole patches ([`blocks::PatchBlock`]); the push and the powers skip a patch that gathered nothing
 //! and was not shot (its B, unshot part and powers cannot have changed). The patches' powers
 //! are summed in the same parallel pass that pushes a round's gathers down, and the buffers are
 //! kept by the transfer between relights ([`ShootScratch`]), so a relight makes no fresh pages.
@@ -46,6 +46,7 @@ use super::convergence::{ConvergenceRow, StopRule, relative_change};
 use super::source_rows::{SourceRows, gather_range, gather_range_dyn, simd_token};
 use super::topology::Topology;
 use super::{Rgb, luminance};
+use blocks::{BlockLeaves, block_leaves, patch_blocks, split_blocks};
 use rayon::prelude::*;
 
 /// One light group to shoot: its old radiosity and its warm start, per element.
@@ -563,112 +564,5 @@ fn choose_patches(
     shot
 }
 
-/// Elements per [`PatchBlock`] (at least; a block ends at a patch's end): enough to amortise a
-/// task, few enough to balance two to dozens of threads on 50 000 elements.
-const BLOCK_ELEMENTS: usize = 256;
-
-/// Consecutive patches, with their nodes and elements (half-open ranges): the unit of the
-/// per-patch passes. The node range runs from the first patch's first node to the last patch's
-/// last, so it holds the nodes between them (above the patches), which no pass writes.
-struct PatchBlock {
-    patches: (usize, usize),
-    nodes: (usize, usize),
-    elements: (usize, usize),
-}
-
-/// The patches cut into blocks of at least [`BLOCK_ELEMENTS`] elements, in patch order (a
-/// fixed partition: a pass gives the same values on any number of threads, each patch being
-/// computed on its own).
-fn patch_blocks(topology: &Topology) -> Vec<PatchBlock> {
-    let (ranges, elements) = (&topology.patch_ranges, &topology.patch_elements);
-    let mut out = Vec::new();
-    let mut first = 0;
-    for p in 0..ranges.len() {
-        let last = p + 1 == ranges.len();
-        if elements[p].1 - elements[first].0 >= BLOCK_ELEMENTS || last {
-            out.push(PatchBlock {
-                patches: (first, p + 1),
-                nodes: (ranges[first].0, ranges[p].1),
-                elements: (elements[first].0, elements[p].1),
-            });
-            first = p + 1;
-        }
-    }
-    out
-}
-
-/// One block's leaves: B and the unshot part of its elements, and its patches' powers.
-struct BlockLeaves<'a> {
-    b: &'a mut [f64],
-    u: &'a mut [f64],
-    total: &'a mut [f64],
-    unshot: &'a mut [f64],
-}
-
-impl BlockLeaves<'_> {
-    /// Sums the powers of patch `p` of `block` from its elements' B and unshot part.
-    fn sum_powers(&mut self, topology: &Topology, block: &PatchBlock, p: usize) {
-        let k = self.total.len() / (block.patches.1 - block.patches.0);
-        let stride = 3 * k;
-        let (elo, ehi) = topology.patch_elements[p];
-        let (x, y) = (
-            (elo - block.elements.0) * stride,
-            (ehi - block.elements.0) * stride,
-        );
-        let i = p - block.patches.0;
-        patch_powers(
-            &topology.areas[elo..ehi],
-            &self.b[x..y],
-            &self.u[x..y],
-            &mut self.total[i * k..(i + 1) * k],
-            &mut self.unshot[i * k..(i + 1) * k],
-        );
-    }
-}
-
-/// The leaves of every block: `b` and `u` (`stride` values per element) and the patches' powers
-/// (`k` per patch) cut into the blocks' ranges.
-fn block_leaves<'a>(
-    blocks: &[PatchBlock],
-    stride: usize,
-    k: usize,
-    b: &'a mut [f64],
-    u: &'a mut [f64],
-    powers: &'a mut PatchPowers,
-) -> Vec<BlockLeaves<'a>> {
-    let PatchPowers { total, unshot } = powers;
-    split_blocks(blocks, |b| b.elements, stride, b)
-        .into_iter()
-        .zip(split_blocks(blocks, |b| b.elements, stride, u))
-        .zip(split_blocks(blocks, |b| b.patches, k, total))
-        .zip(split_blocks(blocks, |b| b.patches, k, unshot))
-        .map(|(((b, u), total), unshot)| BlockLeaves {
-            b,
-            u,
-            total,
-            unshot,
-        })
-        .collect()
-}
-
-/// `data` cut into the blocks' ranges (`range` of each block, `stride` values per unit; what
-/// lies between blocks is left out).
-fn split_blocks<'a, T>(
-    blocks: &[PatchBlock],
-    range: impl Fn(&PatchBlock) -> (usize, usize),
-    stride: usize,
-    data: &'a mut [T],
-) -> Vec<&'a mut [T]> {
-    let (mut rest, mut at) = (data, 0);
-    blocks
-        .iter()
-        .map(|block| {
-            let (lo, hi) = range(block);
-            let (_, tail) = std::mem::take(&mut rest).split_at_mut((lo - at) * stride);
-            let (mine, tail) = tail.split_at_mut((hi - lo) * stride);
-            rest = tail;
-            at = hi;
-            mine
-        })
-        .collect()
-}
+#[path = "shooting_blocks.rs"]
+mod blocks;
