@@ -45,6 +45,7 @@ pub mod corner_refinement;
 pub mod covered;
 pub mod direct;
 mod element_grid;
+mod element_lookup;
 pub mod element_reflectance;
 pub mod form_factor;
 #[cfg(target_arch = "x86_64")]

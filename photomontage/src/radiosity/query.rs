@@ -22,32 +22,17 @@
 //! reflectance carry no interreflected irradiance and are always gathered. The gathered indirect
 //! term is a Monte Carlo estimate (error ∝ 1/√rays).
 
-use rustc_hash::FxHashMap;
-
 use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::element_grid::ElementGrid;
+use super::element_lookup::ElementLocator;
 use super::sources::{DIRECT_RAY_OFFSET_M, DistantSource};
-use super::surface_point::{TriangleShape, cosine_direction, point_seed, vertex_key};
+use super::surface_point::{cosine_direction, point_seed};
 use super::vertex_gather::GatheredExitance;
 use super::{RadiosityError, Rgb, Solution, Transfer};
 
-/// A query point lies on an element when it is within this distance of its plane, metres
-/// (survey points on a façade are good to a centimetre).
-pub const ON_SURFACE_TOL_M: f64 = 0.02;
-
-/// A query normal matches an element's when their angle is below acos of this (≈ 18°).
-pub const NORMAL_MATCH_COS: f64 = 0.95;
-
-/// Barycentric slack when locating a point on an element (points on shared edges).
-const BARYCENTRIC_SLACK: f64 = 1e-6;
-
-/// Padding of the element boxes in the lookup grid, metres: a located point lies within
-/// [`ON_SURFACE_TOL_M`] of the plane and about as far outside an edge, so within √2 of that
-/// of the triangle on any axis; twice the tolerance holds it.
-const GRID_PAD_M: f64 = 2.0 * ON_SURFACE_TOL_M + BARYCENTRIC_SLACK;
+pub use super::element_lookup::{NORMAL_MATCH_COS, ON_SURFACE_TOL_M};
 
 /// Irradiance at a point, per channel, in the site's linear units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,119 +66,21 @@ impl Default for QueryParams {
     }
 }
 
-/// Element lookup grid and per-vertex irradiance of one solution.
-#[derive(Debug, Clone, Default)]
-pub struct ElementLocator {
-    grid: ElementGrid,
-    /// Per element and vertex: (total, direct).
-    vertex_values: Vec<[(Rgb, Rgb); 3]>,
-    /// Per element, total radiosity B (for gathers).
-    radiosity: Vec<Rgb>,
-    /// Per element: reflects (ρ > 0 in some channel).
-    reflects: Vec<bool>,
-    /// Per element, its triangle as the lookup tests it.
-    shapes: Vec<TriangleShape>,
-}
-
-impl ElementLocator {
-    fn new(solution: &Solution) -> Self {
-        let mesh = &solution.mesh;
-        let n = mesh.elements.len();
-        let mut total = vec![[0.0; 3]; n];
-        let mut direct = vec![[0.0; 3]; n];
-        for g in &solution.groups {
-            // The emitters group owns the emission (`LightGroup::emitters`).
-            let h = g.irradiance_rgb(mesh, g.name == "emitters");
-            for e in 0..n {
-                for c in 0..3 {
-                    total[e][c] += h[e][c];
-                    direct[e][c] += g.direct_irradiance_rgb[e][c];
-                }
-            }
-        }
-        let mut sums: FxHashMap<[i64; 6], (Rgb, Rgb, f64)> = FxHashMap::default();
-        for e in 0..n {
-            let node = mesh.element_node(e);
-            for v in &node.vertices_in_world_m {
-                let s = sums
-                    .entry(vertex_key(v, &node.normal_in_world))
-                    .or_insert(([0.0; 3], [0.0; 3], 0.0));
-                for c in 0..3 {
-                    s.0[c] += total[e][c];
-                    s.1[c] += direct[e][c];
-                }
-                s.2 += 1.0;
-            }
-        }
-        let vertex_values = (0..n)
-            .map(|e| {
-                let node = mesh.element_node(e);
-                node.vertices_in_world_m.map(|v| {
-                    let (t, d, k) = sums[&vertex_key(&v, &node.normal_in_world)];
-                    (t.map(|x| x / k), d.map(|x| x / k))
-                })
-            })
-            .collect();
-        let shapes: Vec<TriangleShape> = (0..n)
-            .map(|e| {
-                let node = mesh.element_node(e);
-                TriangleShape::new(&node.vertices_in_world_m, &node.normal_in_world)
-            })
-            .collect();
-        let grid = ElementGrid::new(mesh, GRID_PAD_M);
-        let radiosity = solution.total_radiosity_rgb();
-        let reflects = (0..n)
-            .map(|e| mesh.element_reflectance_rgb(e).iter().any(|&r| r > 0.0))
-            .collect();
-        Self {
-            grid,
-            vertex_values,
-            radiosity,
-            reflects,
-            shapes,
-        }
-    }
-
-    /// The element `point` lies on (normal within [`NORMAL_MATCH_COS`], plane within
-    /// [`ON_SURFACE_TOL_M`]) and its barycentric weights.
-    fn locate(&self, point: &Point3<f64>, normal: &Vector3<f64>) -> Option<(usize, [f64; 3])> {
-        let mut best: Option<(f64, usize, [f64; 3])> = None;
-        for e in self.grid.candidates(point) {
-            let shape = &self.shapes[e as usize];
-            if shape.normal.dot(normal) < NORMAL_MATCH_COS {
-                continue;
-            }
-            let distance = shape.distance_m(point);
-            if distance > ON_SURFACE_TOL_M {
-                continue;
-            }
-            let w = shape.weights(point);
-            let outside = w.iter().map(|&x| (-x).max(0.0)).sum::<f64>() * shape.longest_edge_m;
-            if outside > BARYCENTRIC_SLACK + ON_SURFACE_TOL_M {
-                continue;
-            }
-            let score = distance + outside;
-            // The lowest score, and of equal scores the lowest element (candidates come level
-            // by level, so the order alone does not decide).
-            if best.is_none_or(|(s, b, _)| score.total_cmp(&s).then((e as usize).cmp(&b)).is_lt()) {
-                let clamped = w.map(|x| x.max(0.0));
-                let sum: f64 = clamped.iter().sum();
-                best = Some((score, e as usize, clamped.map(|x| x / sum)));
-            }
-        }
-        best.map(|(_, e, w)| (e, w))
-    }
-}
-
 impl Solution {
+    /// The element lookup, built on this thread alone by the first query (module
+    /// `element_lookup`: never a parallel build inside the cell).
     fn locator(&self) -> &ElementLocator {
-        self.locator.get_or_init(|| ElementLocator::new(self))
+        self.locator
+            .get_or_init(|| ElementLocator::new(self, false))
     }
 
-    /// Builds the element lookup that the first point query would build (so that two
-    /// solutions can build theirs side by side before a render queries them).
+    /// Builds the element lookup that the first point query would build, over rayon's pool and
+    /// outside the cell (so that two solutions can build theirs side by side before a render
+    /// queries them).
     pub fn prepare_queries(&self) {
-        self.locator();
+        if self.locator.get().is_none() {
+            let _ = self.locator.set(ElementLocator::new(self, true));
+        }
     }
 
     /// Irradiance at `point_in_world_m` on a surface of outward unit normal `normal_in_world`,
@@ -293,7 +180,7 @@ impl Transfer {
             let e = sample.element.unwrap_or(usize::MAX);
             let locator = solution.locator();
             if locator.reflects[e]
-                && locator.shapes[e].longest_edge_m <= params.max_interpolation_edge_m
+                && locator.geometry.shapes[e].longest_edge_m <= params.max_interpolation_edge_m
             {
                 return Ok(sample);
             }

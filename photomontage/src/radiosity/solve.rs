@@ -163,24 +163,28 @@ impl GroupSolution {
     #[must_use]
     pub fn irradiance_rgb(&self, mesh: &Mesh, include_emission: bool) -> Vec<Rgb> {
         (0..mesh.elements.len())
-            .map(|e| {
-                let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
-                let reflectance = mesh.element_reflectance_rgb(e);
-                std::array::from_fn(|c| {
-                    let rho = reflectance[c];
-                    let emitted = if include_emission {
-                        surface.emission_rgb[c]
-                    } else {
-                        0.0
-                    };
-                    if rho > 0.0 {
-                        (self.radiosity_rgb[e][c] - emitted) / rho
-                    } else {
-                        self.direct_irradiance_rgb[e][c]
-                    }
-                })
-            })
+            .map(|e| self.irradiance_of(mesh, e, include_emission))
             .collect()
+    }
+
+    /// [`GroupSolution::irradiance_rgb`] of element `e` alone.
+    #[must_use]
+    pub fn irradiance_of(&self, mesh: &Mesh, e: usize, include_emission: bool) -> Rgb {
+        let surface = &mesh.surfaces[mesh.element_node(e).surface as usize];
+        let reflectance = mesh.element_reflectance_rgb(e);
+        std::array::from_fn(|c| {
+            let rho = reflectance[c];
+            let emitted = if include_emission {
+                surface.emission_rgb[c]
+            } else {
+                0.0
+            };
+            if rho > 0.0 {
+                (self.radiosity_rgb[e][c] - emitted) / rho
+            } else {
+                self.direct_irradiance_rgb[e][c]
+            }
+        })
     }
 }
 
@@ -198,7 +202,10 @@ pub struct Solution {
     /// Lights that do not do what they seem to (a luminaire inside a wall, the sun down).
     pub warnings: Vec<LightWarning>,
     /// Element lookup and per-vertex irradiance for [`Solution::irradiance_at`], built on first use.
-    pub(crate) locator: std::sync::OnceLock<super::query::ElementLocator>,
+    pub(crate) locator: std::sync::OnceLock<super::element_lookup::ElementLocator>,
+    /// The geometry part of the lookup, lent by the solution this one relit or built with the
+    /// lookup ([`Solution::reuse_query_geometry`]).
+    pub(crate) query_geometry: std::sync::OnceLock<Arc<super::element_lookup::LookupGeometry>>,
 }
 
 /// [`Solution::relative_difference`]: area-weighted, in luminance.
@@ -314,6 +321,7 @@ impl Solution {
             refinement: self.refinement.clone(),
             warnings: self.warnings.clone(),
             locator: std::sync::OnceLock::new(),
+            query_geometry: self.query_geometry.clone(),
         }
     }
 
@@ -585,6 +593,7 @@ pub fn solve_on_mesh_twinned(
         refinement: refinement.clone(),
         warnings: warnings.clone(),
         locator: std::sync::OnceLock::new(),
+        query_geometry: std::sync::OnceLock::new(),
     };
     // A natural solve lends its form factors with its sky rays (a solve beside one does not).
     let with_factors = |solution: Solution, sky_rays: Option<SkyRays>| {

@@ -474,6 +474,7 @@ impl Transfer {
                 refinement: hierarchy.refinement,
                 warnings,
                 locator: std::sync::OnceLock::new(),
+                query_geometry: std::sync::OnceLock::new(),
             },
             material_table: None,
             twin: twin.map(|(t, _)| Arc::new(t)),

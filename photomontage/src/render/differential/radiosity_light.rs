@@ -103,11 +103,11 @@ impl RadiosityLight {
             Arc::clone(&without),
         )?);
         let light = Self::with_gathers(
-            with_artificial,
-            without_artificial,
+            [with_artificial, without_artificial],
             traced_exactly,
             [with, without],
             [None, None],
+            None,
         )?;
         // Both element lookups side by side, before the render's first query would build them
         // one after the other.
@@ -155,36 +155,38 @@ impl RadiosityLight {
         };
         let gathers = [with, without];
         Self::with_gathers(
-            with_artificial,
-            without_artificial,
+            [with_artificial, without_artificial],
             traced_exactly,
             gathers,
             element_rho,
+            Some([&self.with_artificial, &self.without_artificial]),
         )
     }
 
+    /// `previous`: the solutions this light replaces, whose point lookups' geometry the new
+    /// ones take over where the meshes' geometry is the same
+    /// ([`Solution::reuse_query_geometry`]).
     fn with_gathers(
-        with_artificial: &Solution,
-        without_artificial: &Solution,
+        solutions: [&Solution; 2],
         traced_exactly: &(dyn Fn(&str) -> bool + Sync),
         gathers: [Arc<VertexGather>; 2],
         element_rho: [Option<&[Rgb]>; 2],
+        previous: Option<[&Solution; 2]>,
     ) -> Result<Self, RadiosityError> {
         // The two solutions are independent: side by side.
-        let side = |s: &Solution,
-                    gather: Arc<VertexGather>,
-                    rho: Option<&[Rgb]>|
-         -> Result<_, RadiosityError> {
+        let side = |k: usize, gather: Arc<VertexGather>| -> Result<_, RadiosityError> {
+            let s = solutions[k];
+            let without_exact = s.without_direct_of_given(traced_exactly, element_rho[k]);
+            if let Some(previous) = previous {
+                without_exact.reuse_query_geometry(previous[k]);
+            }
             Ok((
-                Arc::new(s.without_direct_of_given(traced_exactly, rho)),
+                Arc::new(without_exact),
                 GatheredExitance::new(gather, total_radiosity(s))?,
             ))
         };
         let [with_gather, without_gather] = gathers;
-        let (with, without) = rayon::join(
-            || side(with_artificial, with_gather, element_rho[0]),
-            || side(without_artificial, without_gather, element_rho[1]),
-        );
+        let (with, without) = rayon::join(|| side(0, with_gather), || side(1, without_gather));
         let ((with, with_gathered), (without, without_gathered)) = (with?, without?);
         Ok(Self {
             with_artificial: with,
