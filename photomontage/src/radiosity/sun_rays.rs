@@ -105,7 +105,7 @@ fn escaped_rays(
             return 0;
         }
         if n == rays {
-            if t.cone_from_node(node)
+            if t.element_cone(e, node)
                 .is_some_and(|(axis, cos)| axis.dot(dir) < cos)
             {
                 return n;

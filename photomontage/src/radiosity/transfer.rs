@@ -342,6 +342,7 @@ impl Transfer {
                 &t.tracer,
                 &tracer,
                 artificial,
+                &mesh,
             )?
             .map(|twin| (twin, t)),
             None => None,

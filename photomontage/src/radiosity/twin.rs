@@ -25,6 +25,7 @@
 use std::collections::HashMap;
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use super::mesh::{Mesh, MeshNode};
 use crate::bvh::BuildQuality;
@@ -43,6 +44,9 @@ pub struct Twin {
     artificial_box_in_world_m: [Point3<f64>; 2],
     /// The centre and radius of the widened box's bounding sphere, world metres.
     artificial_sphere_in_world_m: (Point3<f64>, f64),
+    /// Per element of the mesh with the planned objects, [`Twin::cone_from_node`] of its node,
+    /// computed once (a sun step reads it for every element in full sun).
+    element_cones: Vec<Option<(Vector3<f64>, f64)>>,
 }
 
 /// The planned objects' box is widened by this much before a ray is tested against it, metres
@@ -58,8 +62,9 @@ impl Twin {
     /// The twins `twin_of` ([`twin_elements`]) of the elements of the mesh with the planned
     /// objects (traced by `tracer`) in the natural mesh of `natural_elements` elements (traced by
     /// `natural_tracer`), with `artificial`, the planned objects alone, traced in `tracer`'s
-    /// local frame. `None` when there is nothing planned or the two tracers' frames differ (the
-    /// same rays would then not be the same `f32` rays).
+    /// local frame; `mesh` is the mesh with the planned objects. `None` when there is nothing
+    /// planned or the two tracers' frames differ (the same rays would then not be the same
+    /// `f32` rays).
     ///
     /// # Errors
     /// The planned objects' tracer cannot be built.
@@ -69,6 +74,7 @@ impl Twin {
         natural_tracer: &SceneTracer,
         tracer: &SceneTracer,
         artificial: &Scene,
+        mesh: &Mesh,
     ) -> Result<Option<Self>, SceneError> {
         let Some(artificial_box_in_world_m) = artificial.bounding_box_in_world_m() else {
             return Ok(None);
@@ -86,13 +92,19 @@ impl Twin {
         let [lo, hi] = artificial_box_in_world_m;
         let margin = Vector3::repeat(BOX_MARGIN_M);
         let (lo, hi) = (lo - margin, hi + margin);
-        Ok(Some(Self {
+        let mut twin = Self {
             twin_of,
             streams,
             artificial,
             artificial_box_in_world_m: [lo, hi],
             artificial_sphere_in_world_m: (nalgebra::center(&lo, &hi), (hi - lo).norm() / 2.0),
-        }))
+            element_cones: Vec::new(),
+        };
+        twin.element_cones = (0..mesh.elements.len())
+            .into_par_iter()
+            .map(|e| twin.cone_from_node(mesh.element_node(e)))
+            .collect();
+        Ok(Some(twin))
     }
 
     /// The directions in which a ray from within `radius_m` of `centre_in_world_m` can meet the
@@ -129,6 +141,16 @@ impl Twin {
             .map(|v| (v - centre).norm())
             .fold(0.0, f64::max);
         self.cone_towards_artificial(&centre, radius)
+    }
+
+    /// [`Twin::cone_from_node`] of element `e` of the mesh with the planned objects (`node`),
+    /// as computed when the twins were made.
+    #[must_use]
+    pub(super) fn element_cone(&self, e: usize, node: &MeshNode) -> Option<(Vector3<f64>, f64)> {
+        match self.element_cones.get(e) {
+            Some(cone) => *cone,
+            None => self.cone_from_node(node),
+        }
     }
 
     /// Whether the ray from `origin_in_world_m` along `dir_in_world` (t ≥ 0) meets the planned

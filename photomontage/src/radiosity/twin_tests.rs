@@ -60,6 +60,7 @@ pub(super) fn block_pair() -> Pair {
         &natural_tracer,
         &tracer,
         &artificial,
+        &mesh,
     )
     .unwrap()
     .unwrap();
@@ -141,6 +142,15 @@ fn the_twins_sky_transfer_equals_tracing_every_ray_in_the_whole_scene() {
 #[test]
 fn sun_twin_counts_equal_tracing_every_ray() {
     let pair = block_pair();
+    // The cones kept per element are those of their nodes.
+    for e in 0..pair.mesh.elements.len() {
+        let node = pair.mesh.element_node(e);
+        assert_eq!(
+            pair.twin.element_cone(e, node),
+            pair.twin.cone_from_node(node),
+            "element {e}"
+        );
+    }
     let natural_engine =
         FormFactorEngine::new(&pair.natural_mesh, &pair.natural_tracer, pair.ff).unwrap();
     let natural_samples = DirectSamples::new(&natural_engine, 0);

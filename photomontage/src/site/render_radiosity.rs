@@ -228,6 +228,7 @@ pub(super) fn solve_pair(
         &natural_tracer,
         &tracer,
         &artificial_part(scene)?,
+        &with_mesh,
     )?;
     let (with, _) = solve_on_mesh_twinned(
         with_mesh,
