@@ -161,7 +161,7 @@ impl SkyTransfer {
                         (
                             &natural.transfer.escaped[w * padded..w * padded + f_count],
                             t,
-                            t.element_cone(e, node),
+                            t.element_cone(e),
                         )
                     })
                 });

@@ -64,7 +64,7 @@ pub(super) fn sun_counts(
             if cos <= 0.0 {
                 return (0, [0.0; 3]);
             }
-            let escaped = escaped_rays(e, node, samples, twin, tracer, &dir, visibility);
+            let escaped = escaped_rays(e, samples, twin, tracer, &dir, visibility);
             #[allow(clippy::cast_precision_loss)]
             let visible = f64::from(escaped) / samples.of_element(e).len() as f64;
             let mut e_rgb = [0.0; 3];
@@ -87,7 +87,6 @@ pub(super) fn sun_counts(
 /// twin's count where that decides ([`sun_counts`]).
 fn escaped_rays(
     e: usize,
-    node: &super::mesh::MeshNode,
     samples: &DirectSamples,
     twin: Option<(&Twin, &SunCounts)>,
     tracer: &crate::scene::SceneTracer,
@@ -105,7 +104,7 @@ fn escaped_rays(
             return 0;
         }
         if n == rays {
-            if t.element_cone(e, node)
+            if t.element_cone(e)
                 .is_some_and(|(axis, cos)| axis.dot(dir) < cos)
             {
                 return n;

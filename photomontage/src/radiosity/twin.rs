@@ -143,14 +143,11 @@ impl Twin {
         self.cone_towards_artificial(&centre, radius)
     }
 
-    /// [`Twin::cone_from_node`] of element `e` of the mesh with the planned objects (`node`),
-    /// as computed when the twins were made.
+    /// [`Twin::cone_from_node`] of element `e` of the mesh with the planned objects, as computed
+    /// when the twins were made.
     #[must_use]
-    pub(super) fn element_cone(&self, e: usize, node: &MeshNode) -> Option<(Vector3<f64>, f64)> {
-        match self.element_cones.get(e) {
-            Some(cone) => *cone,
-            None => self.cone_from_node(node),
-        }
+    pub(super) fn element_cone(&self, e: usize) -> Option<(Vector3<f64>, f64)> {
+        self.element_cones[e]
     }
 
     /// Whether the ray from `origin_in_world_m` along `dir_in_world` (t ≥ 0) meets the planned

@@ -146,7 +146,7 @@ fn sun_twin_counts_equal_tracing_every_ray() {
     for e in 0..pair.mesh.elements.len() {
         let node = pair.mesh.element_node(e);
         assert_eq!(
-            pair.twin.element_cone(e, node),
+            pair.twin.element_cone(e),
             pair.twin.cone_from_node(node),
             "element {e}"
         );
