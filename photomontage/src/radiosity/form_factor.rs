@@ -126,62 +126,77 @@ pub fn point_to_triangle(
     tri: &[Point3<f64>; 3],
     tri_normal: &Vector3<f64>,
 ) -> f64 {
-    // Light leaves the triangle through its front only.
-    if tri_normal.dot(&(x - tri[0])) <= 0.0 {
-        return 0.0;
-    }
-    let (poly, count) = clip_above_plane(x, n, tri);
-    if count < 3 {
-        return 0.0;
-    }
-    let mut sum = 0.0;
-    for k in 0..count {
-        let a = poly[k];
-        let b = poly[(k + 1) % count];
-        let (la, lb) = (a.norm(), b.norm());
-        if la <= 0.0 || lb <= 0.0 {
-            continue;
-        }
-        let cross = a.cross(&b);
-        let cn = cross.norm();
-        if cn <= 0.0 {
-            continue;
-        }
-        let angle = cn.atan2(a.dot(&b));
-        sum += angle * n.dot(&cross) / cn;
-    }
-    (sum / std::f64::consts::TAU).abs()
+    Above::new(x, n, tri, tri_normal).map_or(0.0, |above| above.factor(n))
 }
 
-/// A point of the part of `tri` above the tangent plane at `x` (the part
-/// [`point_to_triangle`] integrates over), from the unit-square sample `(u, v)`: uniform in
-/// area over that part, so that a shadow ray to it never tests a part of the triangle the
-/// factor has already left out. `None` when nothing of `tri` is above the plane.
-fn point_above_plane(
-    x: &Point3<f64>,
-    n: &Vector3<f64>,
-    tri: &[Point3<f64>; 3],
-    (u, v): (f64, f64),
-) -> Option<Point3<f64>> {
-    let (poly, count) = clip_above_plane(x, n, tri);
-    if count < 3 {
-        return None;
+/// The part of a triangle that a point's factor integrates over: above the tangent plane at
+/// `x`, as seen from a point in front of the triangle. Clipped once per sample, for the factor
+/// ([`point_to_triangle`]) and for the shadow ray's end ([`Above::point`]) alike.
+struct Above {
+    /// The clipped polygon's corners as vectors from `x`.
+    poly: [Vector3<f64>; 4],
+    /// Its corners (3 or 4).
+    count: usize,
+}
+
+impl Above {
+    /// `None` when `x` is behind the triangle (light leaves it through its front only) or
+    /// nothing of it is above the plane.
+    fn new(
+        x: &Point3<f64>,
+        n: &Vector3<f64>,
+        tri: &[Point3<f64>; 3],
+        tri_normal: &Vector3<f64>,
+    ) -> Option<Self> {
+        if tri_normal.dot(&(x - tri[0])) <= 0.0 {
+            return None;
+        }
+        let (poly, count) = clip_above_plane(x, n, tri);
+        (count >= 3).then_some(Self { poly, count })
     }
-    // Fan (0, k, k + 1): one or two triangles; choose one by area with u, reuse u inside it.
-    let area = |k: usize| (poly[k] - poly[0]).cross(&(poly[k + 1] - poly[0])).norm();
-    let first = area(1);
-    let total = first + if count == 4 { area(2) } else { 0.0 };
-    let (k, u) = if count == 4 && total > 0.0 && u * total >= first {
-        (2, ((u * total - first) / (total - first)).clamp(0.0, 1.0))
-    } else if total > 0.0 && count == 4 {
-        (1, (u * total / first).clamp(0.0, 1.0))
-    } else {
-        (1, u)
-    };
-    // Uniform in the triangle (a, b, c) from the square (Shirley's square-root map).
-    let su = u.sqrt();
-    let (a, b, c) = (poly[0], poly[k], poly[k + 1]);
-    Some(x + a * (1.0 - su) + b * (su * (1.0 - v)) + c * (su * v))
+
+    /// Lambert's contour integral over the polygon for the normal `n` at its apex.
+    fn factor(&self, n: &Vector3<f64>) -> f64 {
+        let (poly, count) = (&self.poly, self.count);
+        let mut sum = 0.0;
+        for k in 0..count {
+            let a = poly[k];
+            let b = poly[(k + 1) % count];
+            // A corner at the apex adds nothing (its norm is 0 exactly when its square is).
+            if a.norm_squared() <= 0.0 || b.norm_squared() <= 0.0 {
+                continue;
+            }
+            let cross = a.cross(&b);
+            let cn = cross.norm();
+            if cn <= 0.0 {
+                continue;
+            }
+            let angle = cn.atan2(a.dot(&b));
+            sum += angle * n.dot(&cross) / cn;
+        }
+        (sum / std::f64::consts::TAU).abs()
+    }
+
+    /// A point of the polygon from the unit-square sample `(u, v)`, uniform in area, so that a
+    /// shadow ray to it never tests a part of the triangle the factor has already left out.
+    fn point(&self, x: &Point3<f64>, (u, v): (f64, f64)) -> Point3<f64> {
+        let (poly, count) = (&self.poly, self.count);
+        // Fan (0, k, k + 1): one or two triangles; choose one by area with u, reuse u inside it.
+        let area = |k: usize| (poly[k] - poly[0]).cross(&(poly[k + 1] - poly[0])).norm();
+        let first = area(1);
+        let total = first + if count == 4 { area(2) } else { 0.0 };
+        let (k, u) = if count == 4 && total > 0.0 && u * total >= first {
+            (2, ((u * total - first) / (total - first)).clamp(0.0, 1.0))
+        } else if total > 0.0 && count == 4 {
+            (1, (u * total / first).clamp(0.0, 1.0))
+        } else {
+            (1, u)
+        };
+        // Uniform in the triangle (a, b, c) from the square (Shirley's square-root map).
+        let su = u.sqrt();
+        let (a, b, c) = (poly[0], poly[k], poly[k + 1]);
+        x + a * (1.0 - su) + b * (su * (1.0 - v)) + c * (su * v)
+    }
 }
 
 /// Form factors between mesh nodes, with visibility on the scene's BVH.
@@ -384,28 +399,24 @@ impl<'a> FormFactorEngine<'a> {
             let (u, v) = stratum(k, &mut sender_rng);
             let x = np.point_at(u, v);
             let (u_q, v_q) = stratum(k_q, &mut rng);
-            let f = point_to_triangle(
+            let Some(above) = Above::new(
                 &x,
                 &np.normal_in_world,
                 &nq.vertices_in_world_m,
                 &nq.normal_in_world,
-            );
+            ) else {
+                continue;
+            };
+            let f = above.factor(&np.normal_in_world);
             if f <= 0.0 {
                 continue;
             }
-            if self.params.visibility {
-                // The shadow ray goes to the part of q that the factor counts (above x's
-                // tangent plane): a point of q behind that plane is hidden by p's own surface
-                // and would count the clipped part twice (a bias at junctions, where a
-                // receiver's element straddles the footprint of a wall standing on it).
-                let Some(y) =
-                    point_above_plane(&x, &np.normal_in_world, &nq.vertices_in_world_m, (u_q, v_q))
-                else {
-                    continue;
-                };
-                if !self.visible(&x, &y) {
-                    continue;
-                }
+            // The shadow ray goes to the part of q that the factor counts (above x's tangent
+            // plane): a point of q behind that plane is hidden by p's own surface and would
+            // count the clipped part twice (a bias at junctions, where a receiver's element
+            // straddles the footprint of a wall standing on it).
+            if self.params.visibility && !self.visible(&x, &above.point(&x, (u_q, v_q))) {
+                continue;
             }
             sum += f;
         }

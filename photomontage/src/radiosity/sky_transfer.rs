@@ -24,7 +24,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::form_factor::FormFactorEngine;
@@ -33,6 +33,7 @@ use super::sources::{DIRECT_RAY_LENGTH_M, DIRECT_RAY_OFFSET_M, DirectSamples, sk
 use super::twin::Twin;
 use super::twin_factors::NaturalFactors;
 use super::{RadiosityError, Rgb};
+use crate::bvh::Ray;
 use crate::sky::SkyModel;
 use crate::sky_dome::icosahedral::IcosahedralDome;
 
@@ -149,38 +150,59 @@ impl SkyTransfer {
                 && natural.transfer.dome.nodes.len() == dome.nodes.len()
                 && natural.transfer.inv_rays == inv_rays
         });
-        let escaped: Vec<u8> = (0..mesh.elements.len())
-            .into_par_iter()
-            .flat_map_iter(|e| {
-                let node = mesh.element_node(e);
-                let points_of_e = samples.of_element(e);
-                // The twin's escaped counts per facet, and the planned objects' tracer.
-                let twin_counts = twin.and_then(|(t, natural, _)| {
-                    t.twin_of[e].map(|w| {
-                        let w = w as usize;
-                        (
-                            &natural.transfer.escaped[w * padded..w * padded + f_count],
-                            t,
-                            t.element_cone(e),
-                        )
-                    })
-                });
-                dirs.iter()
-                    .enumerate()
-                    .map(|(f, &dir)| {
-                        if node.normal_in_world.dot(&dir) <= reach[f] {
-                            return 0;
+        // Per facet, its ray with the direction the tracer gives it (normalised, `f32`, with
+        // its inverse): only the origin changes from ray to ray.
+        #[allow(clippy::cast_possible_truncation)]
+        let facet_rays: Vec<Ray> = dirs
+            .iter()
+            .map(|dir| {
+                tracer.ray_from_world(
+                    &Point3::origin(),
+                    dir,
+                    DIRECT_RAY_OFFSET_M as f32,
+                    DIRECT_RAY_LENGTH_M,
+                )
+            })
+            .collect();
+        let mut escaped = vec![0u8; mesh.elements.len() * padded];
+        escaped
+            .par_chunks_mut(padded * ELEMENTS_PER_TASK)
+            .enumerate()
+            .for_each(|(task, out)| {
+                let mut origins = Vec::with_capacity(points);
+                for (i, out) in out.chunks_exact_mut(padded).enumerate() {
+                    let e = task * ELEMENTS_PER_TASK + i;
+                    let normal = mesh.element_node(e).normal_in_world;
+                    let points_of_e = samples.of_element(e);
+                    // The sample points in the tracer's frame, once per element.
+                    origins.clear();
+                    origins.extend(points_of_e.iter().map(|p| tracer.local_from_world(p)));
+                    // The twin's escaped counts per facet, and the planned objects' tracer.
+                    let twin_counts = twin.and_then(|(t, natural, _)| {
+                        t.twin_of[e].map(|w| {
+                            let w = w as usize;
+                            (
+                                &natural.transfer.escaped[w * padded..w * padded + f_count],
+                                t,
+                                t.element_cone(e),
+                            )
+                        })
+                    });
+                    for (f, (dir, facet_ray)) in dirs.iter().zip(&facet_rays).enumerate() {
+                        if normal.dot(dir) <= reach[f] {
+                            continue;
                         }
                         // None escaped the natural scene: none escapes with more in it; all
                         // escaped: only the planned objects can stop them (module doc of
                         // `twin`); else every ray in the whole scene.
                         let (blockers, twin) = match twin_counts {
-                            Some((counts, _, _)) if counts[f] == 0 => return 0,
+                            Some((counts, _, _)) if counts[f] == 0 => continue,
                             Some((counts, t, cone)) if usize::from(counts[f]) == rays[f] => {
                                 // All escaped the natural scene; outside the cone towards the
                                 // planned objects they escape the whole scene too.
-                                if cone.is_some_and(|(axis, cos)| axis.dot(&dir) < cos) {
-                                    return counts[f];
+                                if cone.is_some_and(|(axis, cos)| axis.dot(dir) < cos) {
+                                    out[f] = counts[f];
+                                    continue;
                                 }
                                 (&t.artificial, Some(t))
                             }
@@ -188,27 +210,22 @@ impl SkyTransfer {
                         };
                         let mut hits = 0u8;
                         for k in (f % points..points).step_by(f_count).take(rays[f]) {
-                            if twin.is_some_and(|t| !t.may_meet_artificial(&points_of_e[k], &dir)) {
+                            if twin.is_some_and(|t| !t.may_meet_artificial(&points_of_e[k], dir)) {
                                 hits += 1;
                                 continue;
                             }
-                            #[allow(clippy::cast_possible_truncation)]
-                            let ray = tracer.ray_from_world(
-                                &points_of_e[k],
-                                &dir,
-                                DIRECT_RAY_OFFSET_M as f32,
-                                DIRECT_RAY_LENGTH_M,
-                            );
+                            let ray = Ray {
+                                origin: origins[k],
+                                ..*facet_ray
+                            };
                             if !visibility || !blockers.any_hit(&ray) {
                                 hits += 1;
                             }
                         }
-                        hits
-                    })
-                    .chain(std::iter::repeat_n(0, padded - f_count))
-                    .collect::<Vec<u8>>()
-            })
-            .collect();
+                        out[f] = hits;
+                    }
+                }
+            });
         Self {
             dome: dome.clone(),
             leaves: facets
@@ -296,7 +313,7 @@ impl SkyTransfer {
     }
 }
 
-/// Elements per parallel task of [`SkyTransfer::direct`].
+/// Elements per parallel task of [`SkyTransfer::beside`] and [`SkyTransfer::direct`].
 const ELEMENTS_PER_TASK: usize = 256;
 
 /// `weights[b][j]` = max(0, n·S_f) for facet f = b·LANES + j (`axes` as in
