@@ -19,10 +19,13 @@ use super::mesh::Mesh;
 /// Elements by cell: key (level L, cell x, y, z) with cells of 2^L metres.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ElementGrid {
-    /// The levels that hold elements, ascending.
-    levels: Vec<i32>,
-    /// Integer keys hash with Fx (the renderer looks up every level at every shading point).
-    cells: FxHashMap<[i64; 4], Vec<u32>>,
+    /// The levels that hold elements, ascending, each with 2^−L (exact).
+    levels: Vec<(i32, f64)>,
+    /// Integer keys hash with Fx (the renderer looks up every level at every shading point);
+    /// each cell's elements are `members[start..end]`, in ascending order.
+    cells: FxHashMap<[i64; 4], (u32, u32)>,
+    /// The cells' elements, cell after cell.
+    members: Vec<u32>,
     /// Per element, its padded box (low and high corner).
     boxes: Vec<[Point3<f64>; 2]>,
 }
@@ -36,15 +39,33 @@ fn level_of(size_m: f64) -> i32 {
     level.clamp(-LEVEL_LIMIT, LEVEL_LIMIT)
 }
 
-#[allow(clippy::cast_possible_truncation)]
-fn cell_of(p: &Point3<f64>, level: i32) -> [i64; 4] {
-    let inv = (-f64::from(level)).exp2();
+/// 2^−L, exactly (a power of two within the levels' range).
+fn inverse_size(level: i32) -> f64 {
+    2.0_f64.powi(-level)
+}
+
+/// The cell of level `level` (with `inv` = [`inverse_size`]) that holds `p`.
+fn cell_of(p: &Point3<f64>, level: i32, inv: f64) -> [i64; 4] {
     [
         i64::from(level),
-        (p.x * inv).floor() as i64,
-        (p.y * inv).floor() as i64,
-        (p.z * inv).floor() as i64,
+        floor_to_int(p.x * inv),
+        floor_to_int(p.y * inv),
+        floor_to_int(p.z * inv),
     ]
+}
+
+/// `x.floor() as i64` without a call to `floor` (a library call on the baseline x86-64 this is
+/// built for; the renderer asks it three times per level at every shading point): truncate,
+/// then step down where that rounded up. The same value for every `x`, NaN and infinities
+/// included (both saturate).
+#[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
+fn floor_to_int(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
 }
 
 /// The bounding box of element `e`, padded by `pad_m` on every side (low and high corner).
@@ -59,7 +80,7 @@ fn padded_box(mesh: &Mesh, e: usize, pad_m: f64) -> [Point3<f64>; 2] {
 impl ElementGrid {
     /// The grid of `mesh`'s elements, each box padded by `pad_m` on every side.
     pub(crate) fn new(mesh: &Mesh, pad_m: f64) -> Self {
-        let mut cells: FxHashMap<[i64; 4], Vec<u32>> = FxHashMap::default();
+        let mut entries: Vec<([i64; 4], u32)> = Vec::new();
         let mut levels: Vec<i32> = Vec::new();
         let boxes: Vec<[Point3<f64>; 2]> = (0..mesh.elements.len())
             .map(|e| padded_box(mesh, e, pad_m))
@@ -69,19 +90,31 @@ impl ElementGrid {
             if let Err(at) = levels.binary_search(&level) {
                 levels.insert(at, level);
             }
-            let (a, b) = (cell_of(lo, level), cell_of(hi, level));
+            let inv = inverse_size(level);
+            let (a, b) = (cell_of(lo, level, inv), cell_of(hi, level, inv));
             for x in a[1]..=b[1] {
                 for y in a[2]..=b[2] {
                     for z in a[3]..=b[3] {
                         #[allow(clippy::cast_possible_truncation)]
-                        cells.entry([a[0], x, y, z]).or_default().push(e as u32);
+                        entries.push(([a[0], x, y, z], e as u32));
                     }
                 }
             }
         }
+        // By cell, each cell's elements in ascending order (every entry is another pair).
+        entries.sort_unstable();
+        let mut cells: FxHashMap<[i64; 4], (u32, u32)> = FxHashMap::default();
+        let members: Vec<u32> = entries.iter().map(|&(_, e)| e).collect();
+        for (i, (key, _)) in (0u32..).zip(&entries) {
+            cells
+                .entry(*key)
+                .and_modify(|r| r.1 = i + 1)
+                .or_insert((i, i + 1));
+        }
         Self {
-            levels,
+            levels: levels.into_iter().map(|l| (l, inverse_size(l))).collect(),
             cells,
+            members,
             boxes,
         }
     }
@@ -92,8 +125,8 @@ impl ElementGrid {
         let point = *point;
         self.levels
             .iter()
-            .filter_map(move |&level| self.cells.get(&cell_of(&point, level)))
-            .flatten()
+            .filter_map(move |&(level, inv)| self.cells.get(&cell_of(&point, level, inv)))
+            .flat_map(|&(start, end)| &self.members[start as usize..end as usize])
             .copied()
             .filter(move |&e| {
                 let [lo, hi] = &self.boxes[e as usize];
@@ -197,5 +230,38 @@ mod tests {
         // Half the points lie on the ground, on elements of every size (not a vacuous
         // comparison): 3 616 candidates were measured.
         assert!(found > 2000, "{found} candidates in all");
+    }
+
+    /// The call-free floor is `floor() as i64` for every value class: random values at every
+    /// scale, integers, the values just below them, ±0, the ends of `i64`, infinities and NaN.
+    #[test]
+    #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
+    fn the_floor_without_a_call_is_floor() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            i64::MAX as f64,
+            i64::MIN as f64,
+            1e30,
+            -1e30,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+        ];
+        for _ in 0..20_000 {
+            let scale = 10f64.powi(rng.random_range(-3..19));
+            let x: f64 = rng.random_range(-1.0..1.0) * scale;
+            values.extend([x, x.round(), x.round().next_down(), x.round().next_up()]);
+        }
+        for x in values {
+            assert_eq!(floor_to_int(x), x.floor() as i64, "at {x:e}");
+        }
     }
 }
