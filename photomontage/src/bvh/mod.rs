@@ -388,6 +388,22 @@ impl Bvh {
                 });
             });
     }
+
+    /// Any-hit answers of `rays` in order on the calling thread, with one traversal stack for
+    /// all of them (zeroed once, not per ray: a kernel reads only the entries it pushed). For a
+    /// caller that is itself one task of a parallel loop (a radiosity sky transfer's rays of one
+    /// element).
+    ///
+    /// # Panics
+    /// If `out` and `rays` differ in length.
+    pub fn any_hits_here(&self, rays: &[Ray], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "one output per ray");
+        self.with_stack(|stack| {
+            for (ray, o) in rays.iter().zip(out) {
+                *o = self.any_hit_with(ray, stack);
+            }
+        });
+    }
 }
 
 #[cfg(test)]
@@ -458,6 +474,10 @@ mod tests {
         bvh.closest_hits_into(&rays, &mut hits);
         let mut any = vec![false; rays.len()];
         bvh.any_hits_into(&rays, &mut any);
+        // One stack for every ray of a batch answers as a fresh stack per ray.
+        let mut here = vec![false; rays.len()];
+        bvh.any_hits_here(&rays, &mut here);
+        assert_eq!(here, any);
         let mut n_hit = 0;
         for ((ray, hit), any) in rays.iter().zip(&hits).zip(&any) {
             let oracle = brute_force(&tris, ray);

@@ -170,6 +170,10 @@ impl SkyTransfer {
             .enumerate()
             .for_each(|(task, out)| {
                 let mut origins = Vec::with_capacity(points);
+                // The element's rays in the whole scene, traced together (one stack), and the
+                // facet each counts for.
+                let (mut batch, mut batch_facets, mut blocked) =
+                    (Vec::new(), Vec::new(), Vec::new());
                 for (i, out) in out.chunks_exact_mut(padded).enumerate() {
                     let e = task * ELEMENTS_PER_TASK + i;
                     let normal = mesh.element_node(e).normal_in_world;
@@ -188,6 +192,8 @@ impl SkyTransfer {
                             )
                         })
                     });
+                    batch.clear();
+                    batch_facets.clear();
                     for (f, (dir, facet_ray)) in dirs.iter().zip(&facet_rays).enumerate() {
                         if normal.dot(dir) <= reach[f] {
                             continue;
@@ -218,11 +224,21 @@ impl SkyTransfer {
                                 origin: origins[k],
                                 ..*facet_ray
                             };
-                            if !visibility || !blockers.any_hit(&ray) {
+                            if !visibility {
+                                hits += 1;
+                            } else if twin.is_none() {
+                                batch.push(ray);
+                                batch_facets.push(f);
+                            } else if !blockers.any_hit(&ray) {
                                 hits += 1;
                             }
                         }
                         out[f] = hits;
+                    }
+                    blocked.resize(batch.len(), false);
+                    tracer.any_hits_here(&batch, &mut blocked);
+                    for (&f, &b) in batch_facets.iter().zip(&blocked) {
+                        out[f] += u8::from(!b);
                     }
                 }
             });

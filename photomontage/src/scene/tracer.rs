@@ -226,6 +226,12 @@ impl SceneTracer {
         out
     }
 
+    /// Any-hit answers of `rays` in order on the calling thread, one traversal stack for all
+    /// ([`Bvh::any_hits_here`]).
+    pub fn any_hits_here(&self, rays: &[Ray], out: &mut [bool]) {
+        self.bvh.any_hits_here(rays, out);
+    }
+
     /// Any-hit answers of many rays on the current rayon pool.
     #[must_use]
     pub fn any_hits(&self, rays: &[Ray]) -> Vec<bool> {
