@@ -142,6 +142,7 @@ impl SkyTransfer {
             .collect();
         #[allow(clippy::cast_precision_loss)]
         let inv_rays: Vec<f64> = rays.iter().map(|&r| 1.0 / r as f64).collect();
+        let first_point: Vec<usize> = (0..f_count).map(|f| f % points).collect();
         // The twin's transfer, where it was traced for this group on the same dome with the
         // same rays per facet.
         let twin = twin.filter(|(t, natural, group)| {
@@ -215,7 +216,8 @@ impl SkyTransfer {
                             _ => (tracer, None),
                         };
                         let mut hits = 0u8;
-                        for k in (f % points..points).step_by(f_count).take(rays[f]) {
+                        // Points f mod P, f mod P + F, … (`rays`), without a division per facet.
+                        for k in (0..rays[f]).map(|j| first_point[f] + j * f_count) {
                             if twin.is_some_and(|t| !t.may_meet_artificial(&points_of_e[k], dir)) {
                                 hits += 1;
                                 continue;
