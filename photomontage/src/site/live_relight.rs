@@ -38,7 +38,8 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
-use super::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS};
+use super::other_photos::OtherPhotos;
+use super::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
 use super::render_radiosity::{
@@ -306,7 +307,7 @@ impl SiteTransfers {
     ) -> Result<Self, SiteRenderError> {
         let start = Instant::now();
         let inputs = inputs(doc, scene, view)?;
-        let mut built = Self::from_inputs(inputs, photo, cancel, start)?;
+        let mut built = Self::from_site_inputs(doc, view, inputs, photo, cancel, start)?;
         built.photo_view = photo.map(|_| view.to_owned());
         Ok(built)
     }
@@ -342,9 +343,24 @@ impl SiteTransfers {
         self.relight(&scene_inputs(scene, lighting, params)?)
     }
 
-    fn from_inputs(
+    /// [`SiteTransfers::from_inputs`] with `photo` and, as `site_radiosity_light` reads them,
+    /// the site's other photos under the same sun where `photo` does not see.
+    fn from_site_inputs(
+        doc: &SiteDocument,
+        view: &str,
         inputs: Inputs,
         photo: Option<&PhotoView<'_>>,
+        cancel: &AtomicBool,
+        start: Instant,
+    ) -> Result<Self, SiteRenderError> {
+        let others = photo.map(|_| OtherPhotos::load(doc, view));
+        let views = photo.zip(others.as_ref()).map(|(p, o)| o.views(*p));
+        Self::from_inputs(inputs, views.as_ref(), cancel, start)
+    }
+
+    fn from_inputs(
+        inputs: Inputs,
+        photo: Option<&PhotoViews<'_>>,
         cancel: &AtomicBool,
         start: Instant,
     ) -> Result<Self, SiteRenderError> {
@@ -353,7 +369,7 @@ impl SiteTransfers {
             scenes,
             params,
             element_edge_m,
-            notes,
+            mut notes,
         } = inputs;
         // As `site_radiosity_light`: both meshes follow the shadows of the scene with and
         // without the artificial objects.
@@ -384,11 +400,13 @@ impl SiteTransfers {
         // on the photographed state, then carried to the same elements with the objects.
         let mut photo_reflectance = None;
         if let Some(view) = photo {
-            let mut refit = PhotoRefit::new(PhotoSamples::new(
+            let samples = PhotoSamples::from_views(
                 &without_artificial.transfer.solution().mesh,
                 &natural_tracer,
                 view,
-            ));
+            );
+            notes.extend(samples.notes());
+            let mut refit = PhotoRefit::new(samples);
             for _ in 0..REFIT_ROUNDS {
                 let rho = refit.next_round(without_artificial.transfer.solution());
                 without_artificial
@@ -518,7 +536,7 @@ impl SiteTransfers {
             }
         }
         *slot = None;
-        let mut built = Self::from_inputs(inputs, photo, cancel, start)?;
+        let mut built = Self::from_site_inputs(doc, view, inputs, photo, cancel, start)?;
         built.photo_view = photo_view;
         let light = built.light();
         *slot = Some(built);

@@ -21,6 +21,7 @@ pub mod luminaires;
 pub mod material_pick;
 pub mod models;
 pub mod new;
+pub mod other_photos;
 pub mod photo_points;
 pub mod photo_reflectance;
 #[cfg(test)]

@@ -10,7 +10,10 @@ use std::sync::atomic::AtomicBool;
 use image::Rgb32FImage;
 use nalgebra::Point2;
 
-use super::photo_reflectance::{PhotoSamples, PhotoView, REFIT_ROUNDS, sky_and_bounce_per_element};
+use super::photo_reflectance::{
+    MIN_COMMON_SAMPLES, OtherView, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS,
+    sky_and_bounce_per_element,
+};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render::prepare_view;
 use super::render::tests::fixture;
@@ -40,116 +43,161 @@ fn true_reflectance(library: Rgb, e: usize) -> Rgb {
     library.map(|v| (v * k).min(0.9))
 }
 
-#[test]
-fn reflectances_read_off_a_photo_made_with_known_ones_come_back() {
-    let dir = tempfile::tempdir().unwrap();
-    let doc = fixture(dir.path());
-    let mut job = prepare_view(&doc, "p1").unwrap();
-    // No atmosphere (tested with the renderer's eq. 8); a finer camera at the photo's pose.
-    job.lighting.atmosphere = None;
-    let camera = Camera {
-        intrinsics: Intrinsics::centred(600.0, [640, 480]),
-        pose: job.camera.pose,
-    };
-    let scene = natural_part(&job.scene.scene).unwrap();
-    let (lighting, _) = site_transfer_lighting(&doc, &job.scene.scene, "p1").unwrap();
-    let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
-    let (groups, _) = lighting.light_groups(&dome, SKY_TOLERANCE).unwrap();
-    let groups: Vec<_> = groups
-        .into_iter()
-        .filter(|g| !g.name.starts_with("luminaire"))
-        .collect();
-    assert!(
-        groups.iter().any(|g| g.name == "sun"),
-        "the fixture has a sun"
-    );
-    let (params, _) = site_solve_params(&doc, &job.scene.scene).unwrap();
-    let tracer = SceneTracer::new(&scene, BuildQuality::Medium).unwrap();
-    let cancel = AtomicBool::new(false);
-    let mesh =
-        || Mesh::build_lit(&scene, &params.mesh, &sun_directions(&groups), &[&tracer]).unwrap();
+/// The fixture's natural scene solved with known reflectances, and what a photo of it needs.
+struct Truth {
+    job: super::render::ViewJob,
+    scene: crate::scene::Scene,
+    groups: Vec<crate::radiosity::LightGroup>,
+    params: crate::radiosity::SolveParams,
+    tracer: SceneTracer,
+    rho_true: Vec<Rgb>,
+    truth: Solution,
+    e_rad: Vec<Rgb>,
+    camera: Camera,
+}
 
-    // The truth: every element at its own reflectance.
-    let mut truth_mesh = mesh();
-    let rho_true: Vec<Rgb> = (0..truth_mesh.elements.len())
-        .map(|e| true_reflectance(truth_mesh.element_reflectance_rgb(e), e))
-        .collect();
-    truth_mesh
-        .set_element_reflectances(&rho_true.iter().copied().map(Some).collect::<Vec<_>>())
+impl Truth {
+    fn new(dir: &std::path::Path) -> Self {
+        let doc = fixture(dir);
+        let mut job = prepare_view(&doc, "p1").unwrap();
+        // No atmosphere (tested with the renderer's eq. 8); a finer camera at the photo's pose.
+        job.lighting.atmosphere = None;
+        let camera = Camera {
+            intrinsics: Intrinsics::centred(600.0, [640, 480]),
+            pose: job.camera.pose,
+        };
+        let scene = natural_part(&job.scene.scene).unwrap();
+        let (lighting, _) = site_transfer_lighting(&doc, &job.scene.scene, "p1").unwrap();
+        let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
+        let (groups, _) = lighting.light_groups(&dome, SKY_TOLERANCE).unwrap();
+        let groups: Vec<_> = groups
+            .into_iter()
+            .filter(|g| !g.name.starts_with("luminaire"))
+            .collect();
+        assert!(
+            groups.iter().any(|g| g.name == "sun"),
+            "the fixture has a sun"
+        );
+        let (params, _) = site_solve_params(&doc, &job.scene.scene).unwrap();
+        let tracer = SceneTracer::new(&scene, BuildQuality::Medium).unwrap();
+        let cancel = AtomicBool::new(false);
+        // The truth: every element at its own reflectance.
+        let mut truth_mesh =
+            Mesh::build_lit(&scene, &params.mesh, &sun_directions(&groups), &[&tracer]).unwrap();
+        let rho_true: Vec<Rgb> = (0..truth_mesh.elements.len())
+            .map(|e| true_reflectance(truth_mesh.element_reflectance_rgb(e), e))
+            .collect();
+        truth_mesh
+            .set_element_reflectances(&rho_true.iter().copied().map(Some).collect::<Vec<_>>())
+            .unwrap();
+        let truth = solve_on_mesh(truth_mesh, &tracer, &groups, &params, &cancel, &|_| {}).unwrap();
+        let e_rad = sky_and_bounce_per_element(&truth);
+        Self {
+            job,
+            scene,
+            groups,
+            params,
+            tracer,
+            rho_true,
+            truth,
+            e_rad,
+            camera,
+        }
+    }
+
+    /// The mesh every solve starts from (the library's reflectances).
+    fn mesh(&self) -> Mesh {
+        Mesh::build_lit(
+            &self.scene,
+            &self.params.mesh,
+            &sun_directions(&self.groups),
+            &[&self.tracer],
+        )
+        .unwrap()
+    }
+
+    /// The photo `camera` takes: each pixel centre's natural hit, L = ρ_true/π · E_nat, times
+    /// `exposure`.
+    fn photo(&self, camera: &Camera, exposure: f64) -> Rgb32FImage {
+        let daylight = &self.job.lighting.daylight;
+        let tracer = &self.tracer;
+        let (w, h) = (
+            camera.intrinsics.image_size_px[0],
+            camera.intrinsics.image_size_px[1],
+        );
+        Rgb32FImage::from_fn(w, h, |x, y| {
+            let pixel = Point2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let dir = camera.ray_dir_in_world(pixel);
+            let centre = camera.pose.camera_center_in_world;
+            let ray = tracer.ray_from_world(&centre, &dir, 0.0, f32::INFINITY);
+            let Some(hit) = tracer.closest_hit(&ray) else {
+                return image::Rgb([0.0; 3]);
+            };
+            let point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+            let [a, b, c] =
+                self.scene.triangles()[hit.hit.triangle_id as usize].vertices_in_world_m;
+            let normal = (b - a).cross(&(c - a)).normalize();
+            let Some(sample) = self.truth.irradiance_at(&point, &normal) else {
+                return image::Rgb([0.0; 3]);
+            };
+            let e = sample.element.unwrap();
+            let origin = point + normal * crate::radiosity::shadow_refinement::SURFACE_OFFSET_M;
+            let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
+                s.dir_in_world.dot(&normal) > 0.0
+                    && !tracer.any_hit(&tracer.ray_from_world(
+                        &origin,
+                        &s.dir_in_world,
+                        0.0,
+                        f32::INFINITY,
+                    ))
+            });
+            let fixed = natural_irradiance_rgb(daylight, &normal, sun_visible, |_| false);
+            #[allow(clippy::cast_possible_truncation)]
+            image::Rgb(std::array::from_fn(|k| {
+                (exposure * self.rho_true[e][k] / std::f64::consts::PI
+                    * (fixed[k] + self.e_rad[e][k])) as f32
+            }))
+        })
+    }
+
+    /// The refitted solve's last reflectances from `samples` (library values first).
+    fn refit(&self, samples: &PhotoSamples) -> Vec<Vec<Option<Rgb>>> {
+        let mut rounds: Vec<Vec<Option<Rgb>>> = Vec::new();
+        let mut refit = |s: &Solution| {
+            let (rho, _) = samples.reflectances(s);
+            rounds.push(rho.clone());
+            Some(rho)
+        };
+        let solved = solve_on_mesh_refitting(
+            self.mesh(),
+            &self.tracer,
+            &self.groups,
+            &self.params,
+            &AtomicBool::new(false),
+            &|_| {},
+            &mut refit,
+            REFIT_ROUNDS,
+        )
         .unwrap();
-    let truth = solve_on_mesh(truth_mesh, &tracer, &groups, &params, &cancel, &|_| {}).unwrap();
-    let e_rad = sky_and_bounce_per_element(&truth);
+        assert_eq!(rounds.len(), REFIT_ROUNDS);
+        assert_eq!(
+            &solved.mesh.element_reflectance_overrides(),
+            rounds.last().unwrap()
+        );
+        rounds
+    }
 
-    // The photo: each pixel centre's natural hit, L = ρ_true/π · E_nat.
-    let daylight = &job.lighting.daylight;
-    let photo = Rgb32FImage::from_fn(640, 480, |x, y| {
-        let pixel = Point2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-        let dir = camera.ray_dir_in_world(pixel);
-        let centre = camera.pose.camera_center_in_world;
-        let ray = tracer.ray_from_world(&centre, &dir, 0.0, f32::INFINITY);
-        let Some(hit) = tracer.closest_hit(&ray) else {
-            return image::Rgb([0.0; 3]);
-        };
-        let point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
-        let [a, b, c] = scene.triangles()[hit.hit.triangle_id as usize].vertices_in_world_m;
-        let normal = (b - a).cross(&(c - a)).normalize();
-        let Some(sample) = truth.irradiance_at(&point, &normal) else {
-            return image::Rgb([0.0; 3]);
-        };
-        let e = sample.element.unwrap();
-        let origin = point + normal * crate::radiosity::shadow_refinement::SURFACE_OFFSET_M;
-        let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
-            s.dir_in_world.dot(&normal) > 0.0
-                && !tracer.any_hit(&tracer.ray_from_world(
-                    &origin,
-                    &s.dir_in_world,
-                    0.0,
-                    f32::INFINITY,
-                ))
-        });
-        let fixed = natural_irradiance_rgb(daylight, &normal, sun_visible, |_| false);
-        #[allow(clippy::cast_possible_truncation)]
-        image::Rgb(std::array::from_fn(|k| {
-            (rho_true[e][k] / std::f64::consts::PI * (fixed[k] + e_rad[e][k])) as f32
-        }))
-    });
-
-    // Read back: library values first, then refitted.
-    let view = PhotoView {
-        camera: &camera,
-        photo_linear: &photo,
-        lighting: &job.lighting,
-    };
-    let start_mesh = mesh();
-    let samples = PhotoSamples::new(&start_mesh, &tracer, &view);
-    let mut rounds: Vec<Vec<Option<Rgb>>> = Vec::new();
-    let mut refit = |s: &Solution| {
-        let (rho, _) = samples.reflectances(s);
-        rounds.push(rho.clone());
-        Some(rho)
-    };
-    let solved = solve_on_mesh_refitting(
-        start_mesh,
-        &tracer,
-        &groups,
-        &params,
-        &cancel,
-        &|_| {},
-        &mut refit,
-        REFIT_ROUNDS,
-    )
-    .unwrap();
-    assert_eq!(rounds.len(), REFIT_ROUNDS);
-    let recovered = rounds.last().unwrap().clone();
-    assert_eq!(solved.mesh.element_reflectance_overrides(), recovered);
-    let quantiles = |rho: &[Option<Rgb>]| {
+    /// (elements valued, median, 95th percentile) of the largest relative error of a channel
+    /// over the elements of `rho` that `keep` keeps.
+    fn quantiles(&self, rho: &[Option<Rgb>], keep: impl Fn(usize) -> bool) -> (usize, f64, f64) {
         let mut errors: Vec<f64> = rho
             .iter()
             .enumerate()
+            .filter(|(e, _)| keep(*e))
             .filter_map(|(e, r)| {
                 r.map(|r| {
                     (0..3)
-                        .map(|c| (r[c] / rho_true[e][c] - 1.0).abs())
+                        .map(|c| (r[c] / self.rho_true[e][c] - 1.0).abs())
                         .fold(0.0, f64::max)
                 })
             })
@@ -157,7 +205,24 @@ fn reflectances_read_off_a_photo_made_with_known_ones_come_back() {
         errors.sort_by(f64::total_cmp);
         let n = errors.len();
         (n, errors[n / 2], errors[n * 95 / 100])
+    }
+}
+
+#[test]
+fn reflectances_read_off_a_photo_made_with_known_ones_come_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = Truth::new(dir.path());
+    let photo = truth.photo(&truth.camera, 1.0);
+    // Read back: library values first, then refitted.
+    let view = PhotoView {
+        camera: &truth.camera,
+        photo_linear: &photo,
+        lighting: &truth.job.lighting,
     };
+    let samples = PhotoSamples::new(&truth.mesh(), &truth.tracer, &view);
+    let rounds = truth.refit(&samples);
+    let recovered = rounds.last().unwrap().clone();
+    let quantiles = |rho: &[Option<Rgb>]| truth.quantiles(rho, |_| true);
     let (seen, median, p95) = quantiles(&recovered);
     let (_, first_median, first_p95) = quantiles(&rounds[0]);
     println!(
@@ -170,13 +235,147 @@ fn reflectances_read_off_a_photo_made_with_known_ones_come_back() {
     // The refit is what gets there: E_nat's interreflected part needs the photo's values.
     assert!(first_p95 > p95, "{first_p95} vs {p95}");
     // The library's values are far from the truth (the test can fail).
-    let library = mesh();
+    let library = truth.mesh();
     let library_off = (0..library.elements.len())
         .filter(|&e| recovered[e].is_some())
         .filter(|&e| {
             let l = library.element_reflectance_rgb(e);
-            (0..3).any(|c| (l[c] / rho_true[e][c] - 1.0).abs() > 0.1)
+            (0..3).any(|c| (l[c] / truth.rho_true[e][c] - 1.0).abs() > 0.1)
         })
         .count();
     assert!(library_off > seen / 2, "{library_off} of {seen}");
+}
+
+/// A camera 10 m above the ground at (0.5, −8), looking straight down: it sees the ground the
+/// first photo's camera (at y = −10, 1.5 m up, looking along +y) does not see below its frame,
+/// and a strip both see.
+fn camera_above() -> Camera {
+    use nalgebra::{Matrix3, Point3, Rotation3};
+    Camera {
+        intrinsics: Intrinsics::centred(600.0, [640, 480]),
+        pose: crate::camera::Pose {
+            rotation_world_from_camera: Rotation3::from_matrix_unchecked(Matrix3::new(
+                1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0,
+            )),
+            camera_center_in_world: Point3::new(0.5, -8.0, 10.0),
+        },
+    }
+}
+
+/// Recovered relative to true, per channel, as a ratio of exposures: within this of the true
+/// ratio (the median over the points both photos see; the two photos' pixel centres fall on
+/// different points of a shadow edge or an element edge, the median keeps those out).
+const EXPOSURE_RATIO_TOL: f64 = 0.01;
+
+#[test]
+fn elements_the_rendered_photo_does_not_see_are_read_off_an_other_photo() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = Truth::new(dir.path());
+    let rendered_photo = truth.photo(&truth.camera, 1.0);
+    let above = camera_above();
+    let above_photo = truth.photo(&above, 1.0);
+    let rendered = PhotoView {
+        camera: &truth.camera,
+        photo_linear: &rendered_photo,
+        lighting: &truth.job.lighting,
+    };
+    let views = PhotoViews {
+        rendered,
+        others: vec![OtherView {
+            id: "above",
+            view: PhotoView {
+                camera: &above,
+                photo_linear: &above_photo,
+                lighting: &truth.job.lighting,
+            },
+        }],
+        notes: Vec::new(),
+    };
+    let mesh = truth.mesh();
+    let alone = PhotoSamples::new(&mesh, &truth.tracer, &rendered);
+    let both = PhotoSamples::from_views(&mesh, &truth.tracer, &views);
+    // Where the rendered photo sees an element, its samples are kept.
+    for (e, s) in alone.sources().iter().enumerate() {
+        if s.is_some() {
+            assert_eq!(both.sources()[e], Some(0), "element {e}");
+        }
+    }
+    let read = &both.other_views()[0];
+    println!("{read:?}; notes {:?}", both.notes());
+    assert!(read.accepted);
+    let ratio = read.exposure_ratio.unwrap();
+    assert!(
+        ratio.iter().all(|r| (r - 1.0).abs() < EXPOSURE_RATIO_TOL),
+        "{ratio:?}"
+    );
+    assert!(read.common_samples >= MIN_COMMON_SAMPLES);
+    let from_above: Vec<bool> = both.sources().iter().map(|s| *s == Some(1)).collect();
+    let n_above = from_above.iter().filter(|&&a| a).count();
+    assert_eq!(read.elements, n_above);
+    assert!(
+        n_above > 30,
+        "{n_above} elements read off the photo from above"
+    );
+    assert_eq!(both.seen_elements(), alone.seen_elements() + n_above);
+    assert!(both.notes()[0].contains(&format!("photo above read on {n_above} elements")));
+
+    // Those elements come back as the rendered photo's do.
+    let rounds = truth.refit(&both);
+    let recovered = rounds.last().unwrap();
+    let (n, median, p95) = truth.quantiles(recovered, |e| from_above[e]);
+    println!(
+        "{n} elements from the photo above: relative error median {median:.4}, 95th percentile {p95:.4}"
+    );
+    assert_eq!(n, n_above);
+    assert!(median < MEDIAN_REL_TOL, "median {median}");
+    assert!(p95 < ELEMENT_REL_TOL, "95th percentile {p95}");
+    let (_, count) = both.reflectances(&truth.truth);
+    assert_eq!(count.from_other_photos, n_above);
+    assert_eq!(count.from_photo, both.seen_elements());
+}
+
+#[test]
+fn an_other_photo_exposed_differently_is_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = Truth::new(dir.path());
+    let rendered_photo = truth.photo(&truth.camera, 1.0);
+    let above = camera_above();
+    let brighter = 1.2;
+    let above_photo = truth.photo(&above, brighter);
+    let views = PhotoViews {
+        rendered: PhotoView {
+            camera: &truth.camera,
+            photo_linear: &rendered_photo,
+            lighting: &truth.job.lighting,
+        },
+        others: vec![OtherView {
+            id: "above",
+            view: PhotoView {
+                camera: &above,
+                photo_linear: &above_photo,
+                lighting: &truth.job.lighting,
+            },
+        }],
+        notes: vec!["photo reflectance: photo p3 not read: it is not solved".to_owned()],
+    };
+    let both = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &views);
+    let read = &both.other_views()[0];
+    assert!(!read.accepted);
+    assert_eq!(read.elements, 0);
+    let ratio = read.exposure_ratio.unwrap();
+    assert!(
+        ratio
+            .iter()
+            .all(|r| (r / brighter - 1.0).abs() < EXPOSURE_RATIO_TOL),
+        "{ratio:?}"
+    );
+    assert!(both.sources().iter().all(|s| *s != Some(1)));
+    let notes = both.notes();
+    assert_eq!(notes[0], views.notes[0]);
+    assert!(
+        notes[1].starts_with("photo reflectance: photo above not read: its true colours over the rendered photo's 1.2"),
+        "{}",
+        notes[1]
+    );
+    assert!(notes[1].contains("exposure or white balance differs"));
 }

@@ -302,7 +302,8 @@ fn atmosphere(a: &super::Atmosphere) -> Result<Option<SchachterAtmosphere>, Site
     )?))
 }
 
-fn sun_needed(doc: &SiteDocument) -> bool {
+/// Whether the site's light needs a sun direction (a sun weight, or a sky that follows the sun).
+pub(super) fn sun_needed(doc: &SiteDocument) -> bool {
     let l = &doc.site.lighting;
     l.sun_weight.iter().any(|&k| k != 0.0) || l.sky_model.needs_sun()
 }

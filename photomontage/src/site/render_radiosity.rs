@@ -23,8 +23,9 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
+use super::other_photos::OtherPhotos;
 use super::photo_reflectance::{
-    PhotoRefit, PhotoReflectanceCount, PhotoSamples, PhotoView, REFIT_ROUNDS,
+    PhotoRefit, PhotoReflectanceCount, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS,
 };
 use super::radiosity_lighting::{site_ground_below_horizon, site_transfer_lighting};
 use super::render_error::SiteRenderError;
@@ -125,7 +126,8 @@ pub fn site_solve_params(
 /// Solves the site scene `scene` (natural and artificial objects, as rendered) with and without
 /// its artificial objects under the lighting of photo `view` (module doc). With `photo`, the
 /// natural elements it sees take their ρ_d from it ([`super::photo_reflectance`]), in both
-/// solves.
+/// solves; those it does not see, from the site's other solved photos taken under the same sun
+/// ([`super::other_photos`]).
 ///
 /// # Errors
 /// The lighting's errors; a solve error (a scene too large, a bad source) as
@@ -140,7 +142,9 @@ pub fn site_radiosity_light(
     let start = Instant::now();
     let (lighting, notes) = site_transfer_lighting(doc, scene, view)?;
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
-    let pair = solve_pair(scene, &lighting, &params, photo, cancel)?;
+    let others = photo.map(|_| OtherPhotos::load(doc, view));
+    let views = photo.zip(others.as_ref()).map(|(p, o)| o.views(*p));
+    let pair = solve_pair(scene, &lighting, &params, views.as_ref(), cancel)?;
     let report = RadiosityReport {
         element_edge_m,
         elements: [
@@ -148,7 +152,7 @@ pub fn site_radiosity_light(
             pair.without.mesh.elements.len(),
         ],
         seconds: start.elapsed().as_secs_f64(),
-        notes,
+        notes: notes.into_iter().chain(pair.photo_notes).collect(),
         photo_reflectance: pair.photo_reflectance,
     };
     let light = RadiosityLight::new(&pair.with, &pair.without, &RadiosityLight::traced_exactly)
@@ -164,6 +168,8 @@ pub(super) struct SolvedPair {
     pub without: crate::radiosity::Solution,
     /// Natural elements whose ρ_d came from the photo.
     pub photo_reflectance: Option<PhotoReflectanceCount>,
+    /// What the other photos gave ([`PhotoSamples::notes`]).
+    pub photo_notes: Vec<String>,
 }
 
 /// The two solves of [`site_radiosity_light`] for the given lighting and parameters (the
@@ -172,7 +178,7 @@ pub(super) fn solve_pair(
     scene: &Scene,
     lighting: &TransferLighting,
     params: &SolveParams,
-    photo: Option<&PhotoView<'_>>,
+    photo: Option<&PhotoViews<'_>>,
     cancel: &AtomicBool,
 ) -> Result<SolvedPair, SiteRenderError> {
     let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
@@ -197,8 +203,12 @@ pub(super) fn solve_pair(
         .cloned()
         .collect();
     let natural_mesh = mesh(&natural)?;
-    let mut refit =
-        photo.map(|p| PhotoRefit::new(PhotoSamples::new(&natural_mesh, &natural_tracer, p)));
+    let samples = photo.map(|p| PhotoSamples::from_views(&natural_mesh, &natural_tracer, p));
+    let photo_notes = samples
+        .as_ref()
+        .map(PhotoSamples::notes)
+        .unwrap_or_default();
+    let mut refit = samples.map(PhotoRefit::new);
     let rounds = if refit.is_some() { REFIT_ROUNDS } else { 0 };
     let (without, natural_sky) = solve_on_mesh_twinned(
         natural_mesh,
@@ -246,6 +256,7 @@ pub(super) fn solve_pair(
         with,
         without,
         photo_reflectance: refit.as_ref().and_then(PhotoRefit::count),
+        photo_notes,
     })
 }
 

@@ -26,6 +26,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
+use super::other_photos::OtherPhotos;
 use super::photo_reflectance::{PhotoReflectanceCount, PhotoView};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
@@ -104,6 +105,14 @@ pub fn site_spectral_radiosity(
     let (lighting, mut notes) = site_transfer_lighting(doc, scene, view)?;
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
     let photos = photo.map(|p| passes.photos(p.photo_linear));
+    // The site's other photos under the same sun ([`super::other_photos`]), each as every
+    // pass's image.
+    let others = photo.map(|_| OtherPhotos::load(doc, view));
+    let other_photos: Vec<Vec<_>> = others
+        .iter()
+        .flat_map(OtherPhotos::images)
+        .map(|image| passes.photos(image))
+        .collect();
     let mut lights: Vec<Arc<RadiosityLight>> = Vec::with_capacity(passes.count());
     let mut elements = [0, 0];
     let mut photo_reflectance: Option<PhotoReflectanceCount> = None;
@@ -115,10 +124,16 @@ pub fn site_spectral_radiosity(
         let pass_photo = photo
             .zip(photos.as_ref())
             .zip(pass_photo_lighting.as_ref())
-            .map(|((p, photos), lighting)| PhotoView {
-                camera: p.camera,
-                photo_linear: &photos[pass],
-                lighting,
+            .zip(others.as_ref())
+            .map(|(((p, photos), lighting), others)| {
+                others.views_with(
+                    PhotoView {
+                        camera: p.camera,
+                        photo_linear: &photos[pass],
+                        lighting,
+                    },
+                    |k| &other_photos[k][pass],
+                )
             });
         let pair = solve_pair(
             &pass_scene(&passes, pass, scene),
@@ -131,7 +146,10 @@ pub fn site_spectral_radiosity(
             pair.with.mesh.elements.len(),
             pair.without.mesh.elements.len(),
         ];
-        // The count of the first pass (the same elements are seen on every pass).
+        // The count and notes of the first pass (the same elements are seen on every pass).
+        if pass == 0 {
+            notes.extend(pair.photo_notes);
+        }
         photo_reflectance = photo_reflectance.or(pair.photo_reflectance);
         let traced = &RadiosityLight::traced_exactly;
         let light = match lights.first() {

@@ -341,10 +341,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
         if let Some(p) = &r.photo_reflectance {
             println!(
-                "  reflectance from the photo on {} of {} natural elements ({} clamped to 1; last \
-                 refit moved them by {:.2} % on average), the others from the material library",
+                "  reflectance from the photos on {} of {} natural elements ({} of them from the \
+                 site's other photos; {} clamped to 1; last refit moved them by {:.2} % on \
+                 average), the others from the material library",
                 p.from_photo,
                 p.elements,
+                p.from_other_photos,
                 p.clamped,
                 100.0 * p.mean_change_rel
             );
