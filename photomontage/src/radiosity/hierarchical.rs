@@ -185,6 +185,10 @@ fn accurate_links(
         .collect()
 }
 
+/// What the BF test of [`Hierarchy::refine_bf`] found for one link: whether it is split, its
+/// unoccluded estimate, and the (receiver, source) pairs that replace it.
+type LinkTest = (bool, f64, Vec<(u32, u32)>);
+
 /// Per-node state of a solve.
 struct State {
     /// B per node (leaves: solution; inner nodes: area-weighted mean of their leaves).
@@ -353,7 +357,9 @@ impl Hierarchy {
     ) -> usize {
         let mesh = engine.mesh();
         let threshold = params.bf_tolerance * mean;
-        let tests: Vec<(Option<bool>, f64)> = self
+        // Per link: whether it is split, its estimate, and the facing child pairs that replace
+        // it (found here, in parallel, in the order the serial loop below would find them).
+        let tests: Vec<LinkTest> = self
             .links
             .par_iter()
             .zip(estimates.par_iter())
@@ -387,47 +393,46 @@ impl Hierarchy {
                 } else {
                     None
                 };
-                (split, estimate)
+                let pairs = match split {
+                    None => Vec::new(),
+                    Some(true) => children(mesh, link.receiver)
+                        .into_iter()
+                        .filter(|&c| engine.facing(c, link.source))
+                        .map(|c| (c, link.source))
+                        .collect(),
+                    Some(false) => children(mesh, link.source)
+                        .into_iter()
+                        .filter(|&c| engine.facing(link.receiver, c))
+                        .map(|c| (link.receiver, c))
+                        .collect(),
+                };
+                (split.is_some(), estimate, pairs)
             })
             .collect();
         let mut keep = Vec::with_capacity(self.links.len());
         let mut kept_estimates = Vec::with_capacity(self.links.len());
         let mut new_pairs = Vec::new();
         let mut refined = 0;
-        for (link, (split, estimate)) in self.links.iter().zip(tests) {
-            match split {
-                None => {
-                    keep.push(*link);
-                    kept_estimates.push(estimate);
-                }
-                Some(true) => {
-                    refined += 1;
-                    for c in children(mesh, link.receiver) {
-                        if engine.facing(c, link.source) {
-                            new_pairs.push((c, link.source));
-                        }
-                    }
-                }
-                Some(false) => {
-                    refined += 1;
-                    for c in children(mesh, link.source) {
-                        if engine.facing(link.receiver, c) {
-                            new_pairs.push((link.receiver, c));
-                        }
-                    }
-                }
+        for (link, (split, estimate, pairs)) in self.links.iter().zip(tests) {
+            if split {
+                refined += 1;
+                new_pairs.extend(pairs);
+            } else {
+                keep.push(*link);
+                kept_estimates.push(estimate);
             }
         }
         if refined > 0 {
-            let new_links = accurate_links(engine, &new_pairs, reuse);
+            let mut new_links = accurate_links(engine, &new_pairs, reuse);
             computed.extend_from_slice(&new_links);
-            keep.extend(new_links);
-            kept_estimates.resize(keep.len(), UNKNOWN);
-            // By receiver, as `sort`, with each link's estimate beside it (a stable sort: the
-            // same order as `sort`).
-            let mut paired: Vec<(Link, f64)> = keep.into_iter().zip(kept_estimates).collect();
-            paired.sort_by_key(|(l, _)| l.receiver);
-            (self.links, *estimates) = paired.into_iter().unzip();
+            // By receiver, as `sort`, with each link's estimate beside it: the kept links are
+            // in receiver order already, so the new ones are sorted (stably) and merged after
+            // the kept ones of the same receiver — the order a stable sort of the kept links
+            // followed by the new ones gives.
+            new_links.par_sort_by_key(|l| l.receiver);
+            let (links, merged_estimates) = merge_by_receiver(keep, kept_estimates, new_links);
+            self.links = links;
+            *estimates = merged_estimates;
         } else {
             *estimates = kept_estimates;
         }
@@ -459,21 +464,32 @@ impl Hierarchy {
             gathered[r as usize] = g;
         }
         let mut new_b = state.b.clone();
-        let mut update = 0.0;
-        for &p in &mesh.patches {
-            push_pull(
-                mesh,
-                p,
-                [0.0; 3],
-                &gathered,
-                b0,
-                &mut new_b,
-                &state.b,
-                &mut update,
-            );
-        }
+        // Each patch's subtree is its own run of nodes (`Mesh::add_subtree` numbers them in
+        // preorder): the patches are pushed and pulled in parallel, each writing its run, and
+        // their updates summed in patch order (the same sum on any number of threads).
+        let runs = patch_runs(&mesh.patches, &mut new_b);
+        let updates: Vec<f64> = runs
+            .into_par_iter()
+            .map(|(p, run)| {
+                let mut update = 0.0;
+                push_pull(
+                    mesh,
+                    p,
+                    [0.0; 3],
+                    &gathered,
+                    b0,
+                    &mut NodeRun {
+                        first: p,
+                        values: run,
+                    },
+                    &state.b,
+                    &mut update,
+                );
+                update
+            })
+            .collect();
         state.b = new_b;
-        update
+        updates.iter().sum()
     }
 
     fn row(
@@ -578,6 +594,55 @@ fn pull(mesh: &Mesh, n: u32, leaf_values: &[Rgb], b: &mut [Rgb]) -> Rgb {
     value
 }
 
+/// The kept links (`keep`, in receiver order, with their estimates `kept_estimates`) and the
+/// new links (`new`, in receiver order) in one receiver order, the kept links first among those
+/// of one receiver; the new links' estimates are [`UNKNOWN`].
+fn merge_by_receiver(
+    keep: Vec<Link>,
+    kept_estimates: Vec<f64>,
+    new: Vec<Link>,
+) -> (Vec<Link>, Vec<f64>) {
+    let total = keep.len() + new.len();
+    let mut links = Vec::with_capacity(total);
+    let mut estimates = Vec::with_capacity(total);
+    let mut kept = keep.into_iter().zip(kept_estimates).peekable();
+    for l in new {
+        while let Some((k, e)) = kept.next_if(|(k, _)| k.receiver <= l.receiver) {
+            links.push(k);
+            estimates.push(e);
+        }
+        links.push(l);
+        estimates.push(UNKNOWN);
+    }
+    for (k, e) in kept {
+        links.push(k);
+        estimates.push(e);
+    }
+    (links, estimates)
+}
+
+/// The node values of one patch's subtree: nodes `first ..` of the mesh.
+struct NodeRun<'a> {
+    first: u32,
+    values: &'a mut [Rgb],
+}
+
+/// Splits `b` (per node) into one run per patch of `patches` (in increasing order), from the
+/// patch's node to the next patch's; the nodes before the first patch (ancestors above the patch
+/// level) are in none.
+fn patch_runs<'a>(patches: &[u32], b: &'a mut [Rgb]) -> Vec<(u32, &'a mut [Rgb])> {
+    let mut runs = Vec::with_capacity(patches.len());
+    let first = patches.first().map_or(b.len(), |&p| p as usize);
+    let (_, mut rest) = b.split_at_mut(first);
+    for (k, &p) in patches.iter().enumerate() {
+        let end = patches.get(k + 1).map_or(rest.len(), |&q| (q - p) as usize);
+        let (run, tail) = rest.split_at_mut(end);
+        runs.push((p, run));
+        rest = tail;
+    }
+    runs
+}
+
 #[allow(clippy::too_many_arguments)]
 fn push_pull(
     mesh: &Mesh,
@@ -585,7 +650,7 @@ fn push_pull(
     down: Rgb,
     gathered: &[Rgb],
     b0: &[Rgb],
-    new_b: &mut [Rgb],
+    new_b: &mut NodeRun<'_>,
     old_b: &[Rgb],
     update: &mut f64,
 ) -> Rgb {
@@ -613,7 +678,8 @@ fn push_pull(
         }
         (None, None) => [0.0; 3],
     };
-    new_b[n as usize] = value;
+    // A node outside its patch's run would break `patch_runs`' preorder: this panics then.
+    new_b.values[(n - new_b.first) as usize] = value;
     value
 }
 
@@ -622,80 +688,5 @@ fn leaf_b(mesh: &Mesh, b: &[Rgb]) -> Vec<Rgb> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Dropping the occluded links keeps every other link, in order.
-    #[test]
-    fn only_links_of_factor_zero_are_dropped() {
-        let links: Vec<Link> = (0..40u32)
-            .map(|i| Link {
-                receiver: i / 8,
-                source: i,
-                form_factor: match i % 5 {
-                    0 => 0.0,
-                    1 => 1e-300,
-                    _ => f64::from(i) * 1e-3,
-                },
-            })
-            .collect();
-        let mut h = Hierarchy {
-            links: links.clone(),
-            refinement: Vec::new(),
-        };
-        h.drop_occluded();
-        let expected: Vec<Link> = links.into_iter().filter(|l| l.source % 5 != 0).collect();
-        assert_eq!(h.links, expected);
-    }
-
-    /// The refinement test skips the estimate when even a factor of [`ESTIMATE_BOUND`] could
-    /// not pass it: every computed point factor stays under that bound, here for seeded random
-    /// triangles seen from points near and far, at grazing angles and next to a contact
-    /// (the point on an edge's extension, a hemisphere nearly filled).
-    #[test]
-    fn point_factors_stay_under_the_refinement_bound() {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
-        let mut largest = 0.0_f64;
-        for i in 0..200_000 {
-            let scale = [1e-3, 1.0, 1e3][i % 3];
-            let mut p = || Point3::new(rng.random::<f64>(), rng.random(), rng.random()) * scale;
-            let tri = [p(), p(), p()];
-            let tri_normal = (tri[1] - tri[0]).cross(&(tri[2] - tri[0]));
-            if tri_normal.norm() < 1e-12 * scale * scale {
-                continue;
-            }
-            let tri_normal = tri_normal.normalize();
-            // A point just in front of the triangle (a nearly filled hemisphere) or anywhere.
-            let x = if i % 2 == 0 {
-                let w = [rng.random::<f64>(), rng.random::<f64>()];
-                let (u, v) = if w[0] + w[1] > 1.0 {
-                    (1.0 - w[0], 1.0 - w[1])
-                } else {
-                    (w[0], w[1])
-                };
-                tri[0]
-                    + (tri[1] - tri[0]) * u
-                    + (tri[2] - tri[0]) * v
-                    + tri_normal * (scale * 10f64.powf(-6.0 * rng.random::<f64>()))
-            } else {
-                Point3::new(rng.random::<f64>(), rng.random(), rng.random()) * (2.0 * scale)
-            };
-            let n = Vector3::new(
-                rng.random::<f64>() - 0.5,
-                rng.random::<f64>() - 0.5,
-                rng.random::<f64>() - 0.5,
-            );
-            let n = if i % 4 == 0 {
-                -tri_normal
-            } else {
-                n.normalize()
-            };
-            let f = super::super::form_factor::point_to_triangle(&x, &n, &tri, &tri_normal);
-            largest = largest.max(f);
-        }
-        assert!(largest <= ESTIMATE_BOUND, "largest point factor {largest}");
-        // The configurations do reach factors near 1 (the bound is tested where it matters).
-        assert!(largest > 0.99, "largest point factor {largest}");
-    }
-}
+#[path = "hierarchical_tests.rs"]
+mod tests;
