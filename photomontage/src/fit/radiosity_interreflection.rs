@@ -11,8 +11,16 @@
 //! at each sample is the interreflected part of the solution's irradiance there as the renderer
 //! reads it at a natural point ([`crate::radiosity::Solution::irradiance_gathered_at`]: final
 //! gathers at the element vertices, traced once per transfer, blended over the element; a final
-//! gather from the point where it lies on no element). The surfaces reflect with their material
-//! library reflectances, as in the renderer's solution.
+//! gather from the point where it lies on no element).
+//!
+//! The surfaces reflect as in the renderer's solution: with `[render] photo_reflectance` (the
+//! default), the natural elements the photo sees take their ρ_d from it, those it does not see
+//! from the site's other solved photos under the same sun, the rest the library's
+//! ([`crate::site::photo_reflectance`], [`crate::site::other_photos`]). The photo's ρ_d depends
+//! on the lighting it is read under (ρ_d = π·L₀ / E_nat), so at each pass, after the relight to
+//! the pass's weights, the photos are read again under those weights and the transfer refitted
+//! ([`REFIT_ROUNDS`] reflectance updates on the stored links, as the renderer's solve); without
+//! it, the library's values.
 //!
 //! # Known limitations
 //! The links are refined for the lighting of the build (the weights of the fit's first pass,
@@ -27,13 +35,18 @@ use std::sync::atomic::AtomicBool;
 
 use nalgebra::{Point3, Vector3};
 
+use crate::bvh::BuildQuality;
+use crate::camera::Camera;
 use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
 use crate::radiosity::{
     GatheredExitance, LightingChange, QueryParams, Transfer, TransferParams, VertexGather,
 };
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneTracer};
 use crate::site::SiteDocument;
+use crate::site::other_photos::OtherPhotos;
+use crate::site::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS};
 use crate::site::radiosity_lighting::site_transfer_lighting;
+use crate::site::render::{SiteLightingOptions, site_camera, site_lighting, site_photo_linear};
 use crate::site::render_radiosity::{SKY_TOLERANCE, site_solve_params};
 
 use super::interreflection::{GatherPoint, InterreflectionError};
@@ -42,13 +55,24 @@ use super::interreflection::{GatherPoint, InterreflectionError};
 /// mesh has from the other side only): a few samples, so enough rays for ≈ 1.5 % noise.
 pub const FALLBACK_GATHER_RAYS: u32 = 4096;
 
+/// What the photo reflectances read for one photo's transfer: its camera and image, and the
+/// site's other photos under the same sun.
+struct PhotoRead {
+    camera: Camera,
+    photo_linear: image::Rgb32FImage,
+    others: OtherPhotos,
+}
+
 /// The photographed state's transfers, one per photo, and the points read on each.
 pub struct RadiosityInterreflection {
     /// Per photo: its transfer, the vertex gathers on its mesh and the indices of its points.
     photos: BTreeMap<String, (Transfer, Arc<VertexGather>, Vec<usize>)>,
+    /// Per photo, what its reflectances are read from (`[render] photo_reflectance`).
+    reads: BTreeMap<String, PhotoRead>,
     /// Each point and its unit normal, world frame.
     points: Vec<(Point3<f64>, Vector3<f64>)>,
     natural: Scene,
+    natural_tracer: SceneTracer,
 }
 
 fn lighting_error(photo: &str, e: &dyn std::fmt::Display) -> InterreflectionError {
@@ -90,7 +114,22 @@ impl RadiosityInterreflection {
             ..TransferParams::default()
         };
         let mut photos = BTreeMap::new();
+        let mut reads = BTreeMap::new();
         for (photo, indices) in by_photo {
+            if doc.site.render.photo_reflectance {
+                let camera = site_camera(&doc, &photo).map_err(|e| lighting_error(&photo, &e))?;
+                let photo_linear = site_photo_linear(&doc, &photo, &camera)
+                    .map_err(|e| lighting_error(&photo, &e))?;
+                let others = OtherPhotos::load(&doc, &photo);
+                reads.insert(
+                    photo.clone(),
+                    PhotoRead {
+                        camera,
+                        photo_linear,
+                        others,
+                    },
+                );
+            }
             let (lighting, _) = site_transfer_lighting(&doc, natural, &photo)
                 .map_err(|e| lighting_error(&photo, &e))?;
             let transfer = Transfer::build(natural, &lighting, &params, cancel, &|_| {})
@@ -100,8 +139,12 @@ impl RadiosityInterreflection {
                     .map_err(|e| lighting_error(&photo, &e))?;
             photos.insert(photo, (transfer, Arc::new(gather), indices));
         }
+        let natural_tracer = SceneTracer::new(natural, BuildQuality::Medium)
+            .map_err(|e| InterreflectionError::Scene(e.to_string()))?;
         Ok(Self {
             photos,
+            reads,
+            natural_tracer,
             points: points
                 .iter()
                 .map(|p| (p.point_in_world_m, p.normal_in_world))
@@ -133,6 +176,28 @@ impl RadiosityInterreflection {
                     ..LightingChange::default()
                 })
                 .map_err(|e| lighting_error(photo, &e))?;
+            if let Some(read) = self.reads.get(photo) {
+                // The photos read under this pass's weights, the transfer refitted to them.
+                let (photo_lighting, _) =
+                    site_lighting(&doc, photo, &SiteLightingOptions::default())
+                        .map_err(|e| lighting_error(photo, &e))?;
+                let views = read.others.views(PhotoView {
+                    camera: &read.camera,
+                    photo_linear: &read.photo_linear,
+                    lighting: &photo_lighting,
+                });
+                let mut refit = PhotoRefit::new(PhotoSamples::from_views(
+                    &transfer.solution().mesh,
+                    &self.natural_tracer,
+                    &views,
+                ));
+                for _ in 0..REFIT_ROUNDS {
+                    let rho = refit.next_round(transfer.solution());
+                    transfer
+                        .set_element_reflectances(&rho)
+                        .map_err(|e| lighting_error(photo, &e))?;
+                }
+            }
             let solution = transfer.solution();
             let gathered =
                 GatheredExitance::new(Arc::clone(gather), solution.total_radiosity_rgb())

@@ -193,7 +193,7 @@ struct Synthetic {
 /// Writes the site, the material library and the photo; `corrupt_every` paints every n-th
 /// daylight sample's window ×1.6 (a mis-click on a poster or a window).
 fn synthetic_site(seed: u64, corrupt_every: Option<usize>) -> Synthetic {
-    synthetic_site_lit(seed, corrupt_every, false)
+    synthetic_site_lit(seed, corrupt_every, false, false)
 }
 
 /// [`synthetic_site`]; with `radiosity`, the site is in the radiosity mode with the fit's
@@ -201,11 +201,24 @@ fn synthetic_site(seed: u64, corrupt_every: Option<usize>) -> Synthetic {
 /// solution of the natural scene built here with the true weights (the renderer's solve
 /// parameters and light groups, read as the renderer reads it at a natural point: vertex
 /// gathers).
-fn synthetic_site_lit(seed: u64, corrupt_every: Option<usize>, radiosity: bool) -> Synthetic {
+///
+/// With `whole_photo` (radiosity mode), every pixel showing a natural surface that faces the
+/// camera holds Durisch's model of that solution too (ρ_d/π · E_nat, E_nat the sun by a shadow
+/// ray, the ambient term and the element's sky and interreflected irradiance, through the
+/// atmosphere), so that the fit can read the surfaces' reflectances off the photo
+/// (`[render] photo_reflectance`); without it the rest of the image is the horizon colour and
+/// the fit reads the library's.
+fn synthetic_site_lit(
+    seed: u64,
+    corrupt_every: Option<usize>,
+    radiosity: bool,
+    whole_photo: bool,
+) -> Synthetic {
     let dir = tempfile::tempdir().unwrap();
     let mut site = base_site();
     if radiosity {
         site.render.radiosity = true;
+        site.render.photo_reflectance = whole_photo;
         site.fit_settings.interreflection = true;
     }
     std::fs::write(
@@ -282,6 +295,9 @@ fn synthetic_site_lit(seed: u64, corrupt_every: Option<usize>, radiosity: bool) 
     };
     let camera = stored_camera(&site, "P1").unwrap();
     let mut img = Rgb32FImage::from_pixel(SIZE_PX[0], SIZE_PX[1], Rgb(HORIZON.map(|c| c as f32)));
+    if let Some((_, solution, _)) = truth.as_ref().filter(|_| whole_photo) {
+        paint_whole_photo(&mut img, &doc0, &scene, &tracer, solution);
+    }
     let mut taken: Vec<[i64; 2]> = Vec::new();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut paint = |p: Point3<f64>, n: Vector3<f64>, factor: f64, img: &mut Rgb32FImage| -> bool {
@@ -428,6 +444,78 @@ fn synthetic_site_lit(seed: u64, corrupt_every: Option<usize>, radiosity: bool) 
     }
 }
 
+/// Paints every pixel of `img` whose ray first meets a natural surface facing the camera with
+/// Durisch's model of `solution` (the true weights; [`synthetic_site_lit`]).
+fn paint_whole_photo(
+    img: &mut Rgb32FImage,
+    doc0: &SiteDocument,
+    scene: &crate::scene::Scene,
+    tracer: &SceneTracer,
+    solution: &crate::radiosity::Solution,
+) {
+    let mut doc = doc0.clone();
+    doc.site.lighting.sun_weight = K_S;
+    doc.site.lighting.ambient_weight = K_U;
+    doc.site.lighting.sky_weight = K_H;
+    let (lighting, _) = crate::site::render::site_lighting(
+        &doc,
+        "P1",
+        &crate::site::render::SiteLightingOptions::default(),
+    )
+    .unwrap();
+    let daylight = &lighting.daylight;
+    let e_rad = crate::site::photo_reflectance::sky_and_bounce_per_element(solution);
+    let camera = stored_camera(&doc.site, "P1").unwrap();
+    let centre = camera_centre();
+    for y in 0..SIZE_PX[1] {
+        for x in 0..SIZE_PX[0] {
+            let pixel = nalgebra::Point2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let dir = camera.ray_dir_in_world(pixel);
+            let ray = tracer.ray_from_world(&centre, &dir, 0.0, f32::INFINITY);
+            let Some(hit) = tracer.closest_hit(&ray) else {
+                continue;
+            };
+            let point = tracer.hit_point_in_world_m(&ray, hit.hit.t);
+            let [a, b, c] = scene.triangles()[hit.hit.triangle_id as usize].vertices_in_world_m;
+            let normal = (b - a).cross(&(c - a)).normalize();
+            if normal.dot(&(centre - point)) <= 0.0 {
+                continue;
+            }
+            let Some(e) = solution
+                .irradiance_at(&point, &normal)
+                .and_then(|s| s.element)
+            else {
+                continue;
+            };
+            let origin = point + normal * crate::radiosity::shadow_refinement::SURFACE_OFFSET_M;
+            let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
+                s.dir_in_world.dot(&normal) > 0.0
+                    && !tracer.any_hit(&tracer.ray_from_world(
+                        &origin,
+                        &s.dir_in_world,
+                        0.0,
+                        f32::INFINITY,
+                    ))
+            });
+            let fixed = crate::render::illumination::natural_irradiance_rgb(
+                daylight,
+                &normal,
+                sun_visible,
+                |_| false,
+            );
+            let rho = solution.mesh.element_reflectance_rgb(e);
+            let d = (point - centre).norm();
+            let colour = [0, 1, 2].map(|k| {
+                let l0 = rho[k] / std::f64::consts::PI * (fixed[k] + e_rad[e][k]);
+                crate::atmosphere::schachter::apparent_radiance(
+                    l0, HORIZON[k], TAU_1KM[k], d, 1000.0,
+                ) as f32
+            });
+            img.put_pixel(x, y, Rgb(colour));
+        }
+    }
+}
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
@@ -490,7 +578,7 @@ fn recovers_the_chosen_lighting_from_the_photo_and_writes_it_back() {
 /// E_r (interreflection off) the same photo gives weights off by more than the tolerance.
 #[test]
 fn weights_are_recovered_with_the_radiosity_interreflection() {
-    let s = synthetic_site_lit(7, None, true);
+    let s = synthetic_site_lit(7, None, true, false);
     let report = fit_site(&s.doc, &SiteFitOptions::default(), None).unwrap();
     assert!(
         report.residuals.iter().all(|r| !r.flagged),
@@ -514,6 +602,30 @@ fn weights_are_recovered_with_the_radiosity_interreflection() {
             || rel(s_off[k], K_S[k]) > 3.0 * RADIOSITY_SITE_REL),
         "the photo's interreflection is large enough to matter: k_s {s_off:?}, k_h {h_off:?}"
     );
+}
+
+/// The radiosity mode with the surroundings' reflectances read off the photo (`[render]
+/// photo_reflectance`, the renderer's default): the whole photo holds Durisch's model of a
+/// solution with the true weights, the fit reads the surfaces' ρ_d off it under each pass's
+/// weights and refits its transfer to them, and recovers the weights as with the library's.
+#[test]
+fn weights_are_recovered_with_the_reflectances_read_off_the_photo() {
+    let s = synthetic_site_lit(7, None, true, true);
+    assert!(s.doc.site.render.photo_reflectance);
+    let report = fit_site(&s.doc, &SiteFitOptions::default(), None).unwrap();
+    assert!(
+        report.residuals.iter().all(|r| !r.flagged),
+        "{:?}",
+        report.warnings
+    );
+    let e_r: Vec<[f64; 3]> = report
+        .samples
+        .iter()
+        .filter_map(|r| r.interreflection_rgb)
+        .collect();
+    assert_eq!(e_r.len(), 20, "E_r reported for every daylight sample");
+    assert!(e_r.iter().any(|e| e[1] > 0.0), "{e_r:?}");
+    assert_recovered(&report, RADIOSITY_SITE_REL);
 }
 
 #[test]
