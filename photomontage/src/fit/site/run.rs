@@ -306,7 +306,9 @@ pub(super) fn run_fits(
         };
         // In the radiosity mode E_r comes from the photographed state's radiosity solution,
         // solved once with the first pass's weights (that pass fits without E_r) and relit to
-        // each later pass's (`fit::radiosity_interreflection`).
+        // each later pass's, its surfaces' reflectances read off the photos under that pass's
+        // weights where `[render] photo_reflectance` asks for them
+        // (`fit::radiosity_interreflection`).
         let radiosity = gather && doc.site.render.radiosity;
         let points: Vec<GatherPoint<'_>> = day_samples
             .iter()
