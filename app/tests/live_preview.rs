@@ -217,6 +217,7 @@ fn radiosity_mode_relights_the_kept_transfers() {
         .unwrap()
         .clone();
     assert_eq!(built.update, TransferUpdate::Built);
+    assert!(built.build.is_some(), "a build hands its report on");
 
     set_sky(&mut h, "cie_overcast");
     wait(&mut h, "live render after the sky", caught_up);
@@ -230,9 +231,20 @@ fn radiosity_mode_relights_the_kept_transfers() {
         .unwrap()
         .clone();
     assert_eq!(relit.update, TransferUpdate::Relit);
+    assert!(relit.build.is_none());
     h.get_by_label("Render").click();
     steps(&mut h);
     assert!(h.query_by_label_contains("radiosity update").is_some());
+    // The build's report stays shown after the relights (folded).
+    let b = h.state().render_panel().live.last_build().unwrap().clone();
+    assert_eq!(Some(&b), built.build.as_ref());
+    assert!(
+        h.query_by_label_contains(&format!(
+            "Radiosity build: {} / {} elements",
+            b.elements[0], b.elements[1]
+        ))
+        .is_some()
+    );
 
     let doc = h.state().document().unwrap().clone();
     let transfers = h.state().render_panel().live.transfers();

@@ -13,7 +13,8 @@
 //! through `Lighting::radiosity`.
 //!
 //! The tab shows the last egui frame's time (the studio's whole `ui` call), the last radiosity
-//! update's time and kind, and the refinement's pass and tiles.
+//! update's time and kind, the last build's report (folded: element counts, where the natural
+//! surfaces' reflectances came from, its notes), and the refinement's pass and tiles.
 //!
 //! # Known limitations
 //! Every new render decodes the photo again; the re-projected views (planar, cylindrical) are
@@ -27,6 +28,7 @@ use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::{RelightReport, SiteTransfers, TransferUpdate};
 use photomontage::site::photo_reflectance::PhotoView;
 use photomontage::site::render::ViewJob;
+use photomontage::site::render_radiosity::RadiosityReport;
 
 use super::{Quality, RenderPanelError, RenderUpdate};
 use crate::widgets::name_widget;
@@ -59,6 +61,8 @@ pub struct LivePreview {
     pub(super) transfers: SharedTransfers,
     last_frame: Option<Duration>,
     last_relight: Option<RelightReport>,
+    /// The last build's report (element counts, the photos' reflectances, notes).
+    last_build: Option<RadiosityReport>,
     /// Pass of the running render: (index from 1, count).
     pub(super) pass: Option<(u32, u32)>,
     cancelled: usize,
@@ -159,7 +163,16 @@ impl LivePreview {
     }
 
     pub(super) fn relit(&mut self, report: RelightReport) {
+        if let Some(build) = &report.build {
+            self.last_build = Some(build.clone());
+        }
         self.last_relight = Some(report);
+    }
+
+    /// The last build of the transfers: its report.
+    #[must_use]
+    pub fn last_build(&self) -> Option<&RadiosityReport> {
+        self.last_build.as_ref()
     }
 
     /// A render ended: finished (`ok`) or not.
@@ -195,6 +208,9 @@ impl LivePreview {
                 r.seconds * 1e3
             ));
         }
+        if let Some(b) = &self.last_build {
+            build_report_ui(ui, b);
+        }
         if busy && let Some((index, count)) = self.pass {
             let name = if index < count { "coarse" } else { "full" };
             let (done, total) = tiles;
@@ -203,6 +219,29 @@ impl LivePreview {
             ));
         }
     }
+}
+
+/// The transfers' last build: element counts, where the natural surfaces' reflectances came
+/// from, and its notes (other photos left out and why, the sky below the horizon…), folded.
+fn build_report_ui(ui: &mut egui::Ui, b: &RadiosityReport) {
+    egui::CollapsingHeader::new(format!(
+        "Radiosity build: {} / {} elements, {:.2} m",
+        b.elements[0], b.elements[1], b.element_edge_m
+    ))
+    .id_salt("radiosity build report")
+    .show(ui, |ui| {
+        match &b.photo_reflectance {
+            Some(p) => ui.label(format!(
+                "reflectance from the photos on {} of {} natural elements ({} from the site's \
+                 other photos, {} clamped to 1), the others from the material library",
+                p.from_photo, p.elements, p.from_other_photos, p.clamped
+            )),
+            None => ui.label("reflectances from the material library"),
+        };
+        for note in &b.notes {
+            ui.label(note);
+        }
+    });
 }
 
 impl crate::Studio {

@@ -78,6 +78,9 @@ pub struct RelightReport {
     pub update: TransferUpdate,
     /// Wall time of the update (build or relight of both transfers), seconds.
     pub seconds: f64,
+    /// After a build, its report (element counts, the photos' reflectances, notes); `None`
+    /// after a relight.
+    pub build: Option<RadiosityReport>,
 }
 
 /// The diffuse reflectance and emission of each material of `scene`, by name (what a relight
@@ -525,6 +528,7 @@ impl SiteTransfers {
                         RelightReport {
                             update,
                             seconds: start.elapsed().as_secs_f64(),
+                            build: None,
                         },
                     ));
                 }
@@ -539,12 +543,14 @@ impl SiteTransfers {
         let mut built = Self::from_site_inputs(doc, view, inputs, photo, cancel, start)?;
         built.photo_view = photo_view;
         let light = built.light();
+        let build = Some(built.report.clone());
         *slot = Some(built);
         Ok((
             light,
             RelightReport {
                 update: TransferUpdate::Built,
                 seconds: start.elapsed().as_secs_f64(),
+                build,
             },
         ))
     }

@@ -139,6 +139,7 @@ fn update_builds_once_relights_sky_and_colour_and_matches_a_fresh_solve() {
     let built = light;
     let (_, report) = SiteTransfers::update(&mut slot, &doc, &scene, "p1", None, &cancel).unwrap();
     assert_eq!(report.update, TransferUpdate::Unchanged);
+    assert!(report.build.is_none());
 
     // The sky type (Site & light tab) and a material colour (Materials tab).
     doc.site.lighting.sky_model = SkyModelName::CieGeneral(12);
@@ -193,11 +194,22 @@ fn a_build_with_the_photo_takes_its_reflectances_as_the_render_does() {
     };
     let scene = &job.scene.scene;
     let mut slot = None;
-    let (light, _) =
+    let (light, built) =
         SiteTransfers::update(&mut slot, &doc, scene, "p1", Some(&photo), &cancel).unwrap();
     let report = &slot.as_ref().unwrap().report;
+    // The update hands the build's report on (the studio shows it).
+    assert_eq!(built.build.as_ref(), Some(report));
     let count = report.photo_reflectance.unwrap();
     assert!(count.from_photo > 10, "{count:?}");
+    // The fixture's second photo is not solved: named in the notes, as the render's.
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n == "photo reflectance: photo p2 not read: it is not solved"),
+        "{:?}",
+        report.notes
+    );
     let (fresh, fresh_report) =
         site_radiosity_light(&doc, scene, "p1", Some(&photo), &cancel).unwrap();
     assert_eq!(
