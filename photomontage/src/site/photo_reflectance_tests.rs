@@ -262,6 +262,33 @@ fn camera_above() -> Camera {
     }
 }
 
+/// The truth's photo `rendered_photo` with `above_photo` (taken by `above`) as the other photo,
+/// both read with the truth's lighting; `notes` as the loading's.
+fn with_photo_above<'a>(
+    truth: &'a Truth,
+    rendered_photo: &'a Rgb32FImage,
+    above: &'a Camera,
+    above_photo: &'a Rgb32FImage,
+    notes: Vec<String>,
+) -> PhotoViews<'a> {
+    PhotoViews {
+        rendered: PhotoView {
+            camera: &truth.camera,
+            photo_linear: rendered_photo,
+            lighting: &truth.job.lighting,
+        },
+        others: vec![OtherView {
+            id: "above",
+            view: PhotoView {
+                camera: above,
+                photo_linear: above_photo,
+                lighting: &truth.job.lighting,
+            },
+        }],
+        notes,
+    }
+}
+
 /// Recovered relative to true, per channel, as a ratio of exposures: within this of the true
 /// ratio (the median over the points both photos see; the two photos' pixel centres fall on
 /// different points of a shadow edge or an element edge, the median keeps those out).
@@ -274,23 +301,8 @@ fn elements_the_rendered_photo_does_not_see_are_read_off_an_other_photo() {
     let rendered_photo = truth.photo(&truth.camera, 1.0);
     let above = camera_above();
     let above_photo = truth.photo(&above, 1.0);
-    let rendered = PhotoView {
-        camera: &truth.camera,
-        photo_linear: &rendered_photo,
-        lighting: &truth.job.lighting,
-    };
-    let views = PhotoViews {
-        rendered,
-        others: vec![OtherView {
-            id: "above",
-            view: PhotoView {
-                camera: &above,
-                photo_linear: &above_photo,
-                lighting: &truth.job.lighting,
-            },
-        }],
-        notes: Vec::new(),
-    };
+    let views = with_photo_above(&truth, &rendered_photo, &above, &above_photo, Vec::new());
+    let rendered = views.rendered;
     let mesh = truth.mesh();
     let alone = PhotoSamples::new(&mesh, &truth.tracer, &rendered);
     let both = PhotoSamples::from_views(&mesh, &truth.tracer, &views);
@@ -342,22 +354,13 @@ fn an_other_photo_exposed_differently_is_not_read() {
     let above = camera_above();
     let brighter = 1.2;
     let above_photo = truth.photo(&above, brighter);
-    let views = PhotoViews {
-        rendered: PhotoView {
-            camera: &truth.camera,
-            photo_linear: &rendered_photo,
-            lighting: &truth.job.lighting,
-        },
-        others: vec![OtherView {
-            id: "above",
-            view: PhotoView {
-                camera: &above,
-                photo_linear: &above_photo,
-                lighting: &truth.job.lighting,
-            },
-        }],
-        notes: vec!["photo reflectance: photo p3 not read: it is not solved".to_owned()],
-    };
+    let views = with_photo_above(
+        &truth,
+        &rendered_photo,
+        &above,
+        &above_photo,
+        vec!["photo reflectance: photo p3 not read: it is not solved".to_owned()],
+    );
     let both = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &views);
     let read = &both.other_views()[0];
     assert!(!read.accepted);

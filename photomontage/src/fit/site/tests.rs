@@ -572,14 +572,10 @@ fn recovers_the_chosen_lighting_from_the_photo_and_writes_it_back() {
     drop(syn.dir);
 }
 
-/// The radiosity mode: the photo's colours hold the interreflected light of a radiosity
-/// solution built with the true weights; the fit takes E_r from its own solution (built with
-/// its first pass's weights and relit to each later pass's) and recovers the weights. Without
-/// E_r (interreflection off) the same photo gives weights off by more than the tolerance.
-#[test]
-fn weights_are_recovered_with_the_radiosity_interreflection() {
-    let s = synthetic_site_lit(7, None, true, false);
-    let report = fit_site(&s.doc, &SiteFitOptions::default(), None).unwrap();
+/// Fits `doc` (radiosity mode): no sample flagged, E_r reported for all 20 daylight samples,
+/// and the weights recovered within [`RADIOSITY_SITE_REL`].
+fn assert_radiosity_fit_recovers(doc: &SiteDocument) {
+    let report = fit_site(doc, &SiteFitOptions::default(), None).unwrap();
     assert!(
         report.residuals.iter().all(|r| !r.flagged),
         "{:?}",
@@ -593,6 +589,16 @@ fn weights_are_recovered_with_the_radiosity_interreflection() {
     assert_eq!(e_r.len(), 20, "E_r reported for every daylight sample");
     assert!(e_r.iter().any(|e| e[1] > 0.0), "{e_r:?}");
     assert_recovered(&report, RADIOSITY_SITE_REL);
+}
+
+/// The radiosity mode: the photo's colours hold the interreflected light of a radiosity
+/// solution built with the true weights; the fit takes E_r from its own solution (built with
+/// its first pass's weights and relit to each later pass's) and recovers the weights. Without
+/// E_r (interreflection off) the same photo gives weights off by more than the tolerance.
+#[test]
+fn weights_are_recovered_with_the_radiosity_interreflection() {
+    let s = synthetic_site_lit(7, None, true, false);
+    assert_radiosity_fit_recovers(&s.doc);
     let mut off = s.doc.clone();
     off.site.fit_settings.interreflection = false;
     let biased = fit_site(&off, &SiteFitOptions::default(), None).unwrap();
@@ -612,20 +618,7 @@ fn weights_are_recovered_with_the_radiosity_interreflection() {
 fn weights_are_recovered_with_the_reflectances_read_off_the_photo() {
     let s = synthetic_site_lit(7, None, true, true);
     assert!(s.doc.site.render.photo_reflectance);
-    let report = fit_site(&s.doc, &SiteFitOptions::default(), None).unwrap();
-    assert!(
-        report.residuals.iter().all(|r| !r.flagged),
-        "{:?}",
-        report.warnings
-    );
-    let e_r: Vec<[f64; 3]> = report
-        .samples
-        .iter()
-        .filter_map(|r| r.interreflection_rgb)
-        .collect();
-    assert_eq!(e_r.len(), 20, "E_r reported for every daylight sample");
-    assert!(e_r.iter().any(|e| e[1] > 0.0), "{e_r:?}");
-    assert_recovered(&report, RADIOSITY_SITE_REL);
+    assert_radiosity_fit_recovers(&s.doc);
 }
 
 #[test]
