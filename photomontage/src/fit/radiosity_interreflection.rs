@@ -36,17 +36,16 @@ use std::sync::atomic::AtomicBool;
 use nalgebra::{Point3, Vector3};
 
 use crate::bvh::BuildQuality;
-use crate::camera::Camera;
 use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
 use crate::radiosity::{
     GatheredExitance, LightingChange, QueryParams, Transfer, TransferParams, VertexGather,
 };
 use crate::scene::{Scene, SceneTracer};
 use crate::site::SiteDocument;
-use crate::site::other_photos::OtherPhotos;
+use crate::site::other_photos::{LoadedPhoto, OtherPhotos, PhotoCache, cached_photo};
 use crate::site::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS};
 use crate::site::radiosity_lighting::site_transfer_lighting;
-use crate::site::render::{SiteLightingOptions, site_camera, site_lighting, site_photo_linear};
+use crate::site::render::{SiteLightingOptions, site_lighting};
 use crate::site::render_radiosity::{SKY_TOLERANCE, site_solve_params};
 
 use super::interreflection::{GatherPoint, InterreflectionError};
@@ -58,8 +57,7 @@ pub const FALLBACK_GATHER_RAYS: u32 = 4096;
 /// What the photo reflectances read for one photo's transfer: its camera and image, and the
 /// site's other photos under the same sun.
 struct PhotoRead {
-    camera: Camera,
-    photo_linear: image::Rgb32FImage,
+    photo: Arc<LoadedPhoto>,
     others: OtherPhotos,
 }
 
@@ -69,10 +67,11 @@ pub struct RadiosityInterreflection {
     photos: BTreeMap<String, (Transfer, Arc<VertexGather>, Vec<usize>)>,
     /// Per photo, what its reflectances are read from (`[render] photo_reflectance`).
     reads: BTreeMap<String, PhotoRead>,
+    /// The natural scene's tracer, where photos are read.
     /// Each point and its unit normal, world frame.
     points: Vec<(Point3<f64>, Vector3<f64>)>,
     natural: Scene,
-    natural_tracer: SceneTracer,
+    natural_tracer: Option<SceneTracer>,
 }
 
 fn lighting_error(photo: &str, e: &dyn std::fmt::Display) -> InterreflectionError {
@@ -115,17 +114,17 @@ impl RadiosityInterreflection {
         };
         let mut photos = BTreeMap::new();
         let mut reads = BTreeMap::new();
+        // Each photo decoded once, whichever transfers read it.
+        let mut cache = PhotoCache::new();
         for (photo, indices) in by_photo {
             if doc.site.render.photo_reflectance {
-                let camera = site_camera(&doc, &photo).map_err(|e| lighting_error(&photo, &e))?;
-                let photo_linear = site_photo_linear(&doc, &photo, &camera)
+                let loaded = cached_photo(&doc, &photo, &mut cache)
                     .map_err(|e| lighting_error(&photo, &e))?;
-                let others = OtherPhotos::load(&doc, &photo);
+                let others = OtherPhotos::load_cached(&doc, &photo, &mut cache);
                 reads.insert(
                     photo.clone(),
                     PhotoRead {
-                        camera,
-                        photo_linear,
+                        photo: loaded,
                         others,
                     },
                 );
@@ -139,8 +138,14 @@ impl RadiosityInterreflection {
                     .map_err(|e| lighting_error(&photo, &e))?;
             photos.insert(photo, (transfer, Arc::new(gather), indices));
         }
-        let natural_tracer = SceneTracer::new(natural, BuildQuality::Medium)
-            .map_err(|e| InterreflectionError::Scene(e.to_string()))?;
+        let natural_tracer = if reads.is_empty() {
+            None
+        } else {
+            Some(
+                SceneTracer::new(natural, BuildQuality::Medium)
+                    .map_err(|e| InterreflectionError::Scene(e.to_string()))?,
+            )
+        };
         Ok(Self {
             photos,
             reads,
@@ -176,19 +181,19 @@ impl RadiosityInterreflection {
                     ..LightingChange::default()
                 })
                 .map_err(|e| lighting_error(photo, &e))?;
-            if let Some(read) = self.reads.get(photo) {
+            if let (Some(read), Some(tracer)) = (self.reads.get(photo), &self.natural_tracer) {
                 // The photos read under this pass's weights, the transfer refitted to them.
                 let (photo_lighting, _) =
                     site_lighting(&doc, photo, &SiteLightingOptions::default())
                         .map_err(|e| lighting_error(photo, &e))?;
                 let views = read.others.views(PhotoView {
-                    camera: &read.camera,
-                    photo_linear: &read.photo_linear,
+                    camera: &read.photo.camera,
+                    photo_linear: &read.photo.photo_linear,
                     lighting: &photo_lighting,
                 });
                 let mut refit = PhotoRefit::new(PhotoSamples::from_views(
                     &transfer.solution().mesh,
-                    &self.natural_tracer,
+                    tracer,
                     &views,
                 ));
                 for _ in 0..REFIT_ROUNDS {

@@ -19,6 +19,9 @@
 //! sun). Only the rendered photo's own lighting edits (the studio's sun slider) apply: the other
 //! photos are compared with the site's sun for the rendered photo.
 
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
 use image::Rgb32FImage;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -32,11 +35,47 @@ use crate::camera::Camera;
 /// (the sun moves about 0.25° a minute).
 pub const SAME_SUN_DEG: f64 = 0.5;
 
+/// A solved photo decoded: its camera and linear image.
+pub struct LoadedPhoto {
+    /// The photo's solved camera.
+    pub camera: Camera,
+    /// The photo, linear RGB, the camera's size.
+    pub photo_linear: Rgb32FImage,
+}
+
+/// Photos decoded so far, by id (the error's text where that failed): shared by the loads for
+/// several rendered photos, so that each photo is decoded once (the fit reads one transfer per
+/// photo).
+pub type PhotoCache = BTreeMap<String, Result<Arc<LoadedPhoto>, String>>;
+
+fn decode(doc: &SiteDocument, id: &str) -> Result<Arc<LoadedPhoto>, String> {
+    let camera = site_camera(doc, id).map_err(|e| e.to_string())?;
+    let photo_linear = site_photo_linear(doc, id, &camera).map_err(|e| e.to_string())?;
+    Ok(Arc::new(LoadedPhoto {
+        camera,
+        photo_linear,
+    }))
+}
+
+/// Photo `id` of `doc` from `cache`, decoded (and kept there) on first use.
+///
+/// # Errors
+/// The camera's or the photo's error, as text.
+pub fn cached_photo(
+    doc: &SiteDocument,
+    id: &str,
+    cache: &mut PhotoCache,
+) -> Result<Arc<LoadedPhoto>, String> {
+    cache
+        .entry(id.to_owned())
+        .or_insert_with(|| decode(doc, id))
+        .clone()
+}
+
 /// One other photo, loaded.
 struct OtherPhoto {
     id: String,
-    camera: Camera,
-    photo_linear: Rgb32FImage,
+    photo: Arc<LoadedPhoto>,
 }
 
 /// The site's other photos that the photo reflectances can read (module doc), and notes on
@@ -45,6 +84,11 @@ pub struct OtherPhotos {
     photos: Vec<OtherPhoto>,
     /// Per photo left out: its id and why.
     pub notes: Vec<String>,
+}
+
+/// The note for photo `id` left out, and why.
+fn left_out(id: &str, why: &str) -> String {
+    format!("photo reflectance: photo {id} not read: {why}")
 }
 
 /// The sun direction of photo `id` where the site's light needs one.
@@ -60,51 +104,67 @@ impl OtherPhotos {
     /// doc); the others become notes.
     #[must_use]
     pub fn load(doc: &SiteDocument, view: &str) -> Self {
+        Self::load_cached(doc, view, &mut PhotoCache::new())
+    }
+
+    /// [`OtherPhotos::load`] decoding only the photos `cache` does not hold yet (in parallel),
+    /// and keeping them there.
+    #[must_use]
+    pub fn load_cached(doc: &SiteDocument, view: &str, cache: &mut PhotoCache) -> Self {
         let rendered_sun = sun_of(doc, view);
-        let loaded: Vec<Result<OtherPhoto, String>> = doc
+        // Which photos to read (cheap: no decoding), in the site's order.
+        let wanted: Vec<Result<&str, String>> = doc
             .site
             .photos
-            .par_iter()
+            .iter()
             .filter(|p| p.id != view)
             .map(|p| {
                 let id = p.id.as_str();
-                let left_out =
-                    |why: String| format!("photo reflectance: photo {id} not read: {why}");
                 if p.exterior.is_none() {
-                    return Err(left_out("it is not solved".to_owned()));
+                    return Err(left_out(id, "it is not solved"));
                 }
-                let sun = sun_of(doc, id).map_err(|e| left_out(format!("its sun: {e}")))?;
+                let sun = sun_of(doc, id).map_err(|e| left_out(id, &format!("its sun: {e}")))?;
                 match (&rendered_sun, sun) {
                     (Ok(Some(a)), Some(b)) => {
                         let angle_deg = a.angle(&b).to_degrees();
                         if angle_deg > SAME_SUN_DEG {
-                            return Err(left_out(format!(
-                                "its sun is {angle_deg:.2}° from photo {view}'s (taken at \
-                                 another time; only photos within {SAME_SUN_DEG}° are read)"
-                            )));
+                            return Err(left_out(
+                                id,
+                                &format!(
+                                    "its sun is {angle_deg:.2}° from photo {view}'s (taken at \
+                                     another time; only photos within {SAME_SUN_DEG}° are read)"
+                                ),
+                            ));
                         }
                     }
                     (Ok(None), None) => {}
                     (Err(e), _) => {
-                        return Err(left_out(format!("the rendered photo's sun: {e}")));
+                        return Err(left_out(id, &format!("the rendered photo's sun: {e}")));
                     }
                     _ => unreachable!("sun_needed is the site's, the same for every photo"),
                 }
-                let camera = site_camera(doc, id).map_err(|e| left_out(e.to_string()))?;
-                let photo_linear =
-                    site_photo_linear(doc, id, &camera).map_err(|e| left_out(e.to_string()))?;
-                Ok(OtherPhoto {
-                    id: id.to_owned(),
-                    camera,
-                    photo_linear,
-                })
+                Ok(id)
             })
             .collect();
+        let missing: Vec<&str> = wanted
+            .iter()
+            .filter_map(|w| w.as_ref().ok().copied())
+            .filter(|id| !cache.contains_key(*id))
+            .collect();
+        let decoded: Vec<(String, Result<Arc<LoadedPhoto>, String>)> = missing
+            .par_iter()
+            .map(|id| ((*id).to_owned(), decode(doc, id)))
+            .collect();
+        cache.extend(decoded);
         let mut photos = Vec::new();
         let mut notes = Vec::new();
-        for l in loaded {
-            match l {
-                Ok(p) => photos.push(p),
+        for w in wanted {
+            match w.map(|id| (id, &cache[id])) {
+                Ok((id, Ok(photo))) => photos.push(OtherPhoto {
+                    id: id.to_owned(),
+                    photo: Arc::clone(photo),
+                }),
+                Ok((id, Err(e))) => notes.push(left_out(id, e)),
                 Err(note) => notes.push(note),
             }
         }
@@ -126,7 +186,7 @@ impl OtherPhotos {
     /// The rendered photo `rendered` and these, read with the rendered photo's lighting.
     #[must_use]
     pub fn views<'a>(&'a self, rendered: PhotoView<'a>) -> PhotoViews<'a> {
-        self.views_with(rendered, |k| &self.photos[k].photo_linear)
+        self.views_with(rendered, |k| &self.photos[k].photo.photo_linear)
     }
 
     /// As [`OtherPhotos::views`] with each photo's image given by `image` (its linear photo, or
@@ -145,7 +205,7 @@ impl OtherPhotos {
                 .map(|(k, p)| OtherView {
                     id: &p.id,
                     view: PhotoView {
-                        camera: &p.camera,
+                        camera: &p.photo.camera,
                         photo_linear: image(k),
                         lighting: rendered.lighting,
                     },
@@ -157,7 +217,7 @@ impl OtherPhotos {
 
     /// Each loaded photo's linear image, in order.
     pub(super) fn images(&self) -> impl Iterator<Item = &Rgb32FImage> {
-        self.photos.iter().map(|p| &p.photo_linear)
+        self.photos.iter().map(|p| &p.photo.photo_linear)
     }
 }
 
@@ -165,7 +225,7 @@ impl OtherPhotos {
 mod tests {
     #![allow(clippy::unwrap_used)]
 
-    use super::OtherPhotos;
+    use super::{OtherPhotos, PhotoCache, cached_photo};
     use crate::site::Location;
     use crate::site::render::tests::fixture;
 
@@ -244,6 +304,28 @@ mod tests {
             "{:?}",
             others.notes
         );
+    }
+
+    #[test]
+    fn a_shared_cache_decodes_each_photo_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let doc = two_solved(dir.path());
+        let mut cache = PhotoCache::new();
+        assert_eq!(OtherPhotos::load_cached(&doc, "p1", &mut cache).len(), 1);
+        assert_eq!(cache.keys().collect::<Vec<_>>(), ["p2"]);
+        // Both photos are the fixture's one file: gone now, p2 still comes from the cache and
+        // p1, never decoded, is left out with the decoding error.
+        std::fs::remove_file(dir.path().join("p1.png")).unwrap();
+        assert!(cached_photo(&doc, "p2", &mut cache).is_ok());
+        let others = OtherPhotos::load_cached(&doc, "p2", &mut cache);
+        assert!(others.is_empty());
+        assert!(
+            others.notes[0].starts_with("photo reflectance: photo p1 not read: ")
+                && others.notes[0].contains("p1.png"),
+            "{:?}",
+            others.notes
+        );
+        assert!(cached_photo(&doc, "p1", &mut cache).is_err());
     }
 
     #[test]
