@@ -1,6 +1,7 @@
 //! The Materials tab (colour and material design, Tonn & Donath): the scene's materials (from
 //! `site_scene`, so polygons, CAD models, the library and the site's `[[materials]]` all show),
-//! and for the selected one its colour as sRGB hex, CIE L\*a\*b\* or LCh (D65) with a swatch,
+//! and for the selected one its colour as sRGB hex, CIE L\*a\*b\* or LCh (D65) or a RAL Design
+//! code (filled with the nearest code of the current colour) with a swatch,
 //! its LRV, a warning when the colour is outside the sRGB gamut (clamped), the gloss (GGX
 //! roughness, F0) and glass transmittance the renderer supports, and the site's palette
 //! (`[[palette]]`), applied with one click. Every change is one undoable
@@ -16,8 +17,9 @@
 use eframe::egui;
 use photomontage::colour::designer::{
     ColourSpec, hex_from_linear, lab_from_lch, lab_from_linear_srgb, lch_from_lab, parse_colour,
-    srgb8_from_linear,
+    srgb8_from_linear, xyz_from_lab,
 };
+use photomontage::colour::ral_design::RalDesign;
 use photomontage::scene::Material;
 use photomontage::scene::material::Specular;
 use photomontage::site::render::{SiteWarning, site_scene};
@@ -36,6 +38,8 @@ pub struct MaterialsPanel {
     hex: String,
     lab: [f64; 3],
     lch: [f64; 3],
+    /// A RAL Design code (`RAL HHH LL CC`).
+    ral: String,
     gloss: Option<Specular>,
     glass_transmittance: Option<f64>,
     palette_name: String,
@@ -176,6 +180,11 @@ impl MaterialsPanel {
         self.hex = hex_from_linear(rgb);
         self.lab = parse_colour(&colour).map_or_else(|_| lab_from_linear_srgb(rgb), |s| s.lab());
         self.lch = lch_from_lab(self.lab);
+        self.ral = match parse_colour(&colour) {
+            Ok(ColourSpec::RalDesign(code)) => code.to_string(),
+            _ => RalDesign::nearest(xyz_from_lab(self.lab))
+                .map_or_else(String::new, |c| c.to_string()),
+        };
         self.gloss = base.specular;
         self.glass_transmittance = base.glass.map(|g| g.transmittance_rgb[1]);
         self.loaded_for = Some(key);
@@ -253,6 +262,22 @@ impl MaterialsPanel {
         if let Some(text) = triple_row(ui, "LCh", "LCh", ["L*", "C*", "h"], &mut self.lch) {
             actions.extend(self.apply_colour(doc, base, &text));
         }
+        ui.horizontal(|ui| {
+            ui.label("RAL Design");
+            let r = ui.add(egui::TextEdit::singleline(&mut self.ral).desired_width(110.0));
+            name_widget(ui, &r, "RAL Design code");
+            let b = ui.button("Apply RAL Design");
+            name_widget(ui, &b, "Apply RAL Design");
+            if b.clicked() {
+                let text = self.ral.trim().to_owned();
+                actions.extend(self.apply_colour(doc, base, &text));
+            }
+        })
+        .response
+        .on_hover_text(
+            "RAL Design System: hue, lightness, chroma in CIELCh (D65, 10° observer); \
+             filled with the code nearest the current colour",
+        );
         let preview = lab_from_lch(self.lch);
         ui.small(format!(
             "LCh as L*a*b*: ({:.1}, {:.1}, {:.1})",

@@ -211,6 +211,45 @@ fn typed_hex_survives_an_edit_of_another_material() {
 }
 
 #[test]
+fn a_ral_design_code_sets_a_material_colour() {
+    let (_dir, site) = copy_sample();
+    let mut h = harness(&site, common::WINDOW);
+    click(&mut h, "Materials tab");
+    click(&mut h, "Material brick");
+    // The field starts at the code nearest the current colour.
+    let shown = value(&h, "RAL Design code");
+    assert!(
+        shown.starts_with("RAL ") && photomontage::colour::designer::parse_colour(&shown).is_ok(),
+        "{shown}"
+    );
+    let original = site_of(&h);
+    // A RAL Classic code is refused, saying why; nothing changes.
+    set_text(&mut h, "RAL Design code", "RAL 9010");
+    click(&mut h, "Apply RAL Design");
+    assert!(has(&h, "RAL Classic"));
+    assert_eq!(site_of(&h), original);
+    // The grey of lightness 50: Y = (66/116)³ in every channel, shown as its code.
+    set_text(&mut h, "RAL Design code", "RAL 000 50 00");
+    click(&mut h, "Apply RAL Design");
+    h.run();
+    let brick = site_of(&h)
+        .materials
+        .iter()
+        .find(|m| m.material.name == "brick")
+        .cloned()
+        .unwrap();
+    assert_eq!(brick.colour.as_deref(), Some("RAL 000 50 00"));
+    let y = (66.0f64 / 116.0).powi(3);
+    for c in brick.material.diffuse_rgb {
+        assert!((c - y).abs() < 1e-12, "{:?}", brick.material.diffuse_rgb);
+    }
+    assert!(has(&h, "RAL 000 50 00   LRV 18.4"));
+    h.state_mut().undo();
+    h.run();
+    assert_eq!(site_of(&h), original);
+}
+
+#[test]
 fn the_perez_sky_is_set_by_clearness_and_brightness() {
     let (_dir, site) = copy_sample();
     let mut h = open_light_tab(&site);

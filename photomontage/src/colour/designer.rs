@@ -9,10 +9,15 @@
 //! (100, 0, 0). LRV = 100·Y of the reflectance under that white (BS 8300-2:2018 defines LRV as
 //! the CIE Y of the surface, 0 for perfect black to 100 for a perfect white).
 //!
+//! One colour-order system is read: the RAL Design System's codes (`RAL 210 50 15`), which are
+//! CIELCh coordinates by definition ([`super::ral_design`]).
+//!
 //! # Known limitations
-//! No colour-order system (RAL, NCS, Munsell) is built in: no swatch table we found may be
-//! shipped under a licence that allows it (docs/methodology.md, "Colour specification").
+//! No colour system defined only by its swatches (RAL Classic, NCS, Munsell) is built in: no
+//! swatch table we found may be shipped under a licence that allows it (docs/methodology.md,
+//! "Colour systems").
 
+use super::ral_design::RalDesign;
 use super::rgb::{RgbColourSpace, srgb_decode, srgb_encode};
 
 /// A linear channel outside [0, 1] by more than this counts as out of gamut (and is reported);
@@ -43,6 +48,8 @@ pub enum ColourSpec {
     Lab([f64; 3]),
     /// CIE L\*C\*h (D65), hue in degrees.
     Lch([f64; 3]),
+    /// A RAL Design System code (hue, lightness, chroma in CIELCh, D65/10°).
+    RalDesign(RalDesign),
 }
 
 impl std::fmt::Display for ColourSpec {
@@ -51,6 +58,7 @@ impl std::fmt::Display for ColourSpec {
             Self::Hex([r, g, b]) => write!(f, "#{r:02x}{g:02x}{b:02x}"),
             Self::Lab([l, a, b]) => write!(f, "lab({l:.2}, {a:.2}, {b:.2})"),
             Self::Lch([l, c, h]) => write!(f, "lch({l:.2}, {c:.2}, {h:.2})"),
+            Self::RalDesign(code) => write!(f, "{code}"),
         }
     }
 }
@@ -63,8 +71,8 @@ impl std::str::FromStr for ColourSpec {
     }
 }
 
-/// Reads `#rrggbb`, `#rgb`, `lab(L, a, b)` or `lch(L, C, h)` (case-insensitive, commas or
-/// spaces between the numbers).
+/// Reads `#rrggbb`, `#rgb`, `lab(L, a, b)`, `lch(L, C, h)` (case-insensitive, commas or
+/// spaces between the numbers) or a RAL Design code `RAL HHH LL CC` ([`RalDesign::parse`]).
 ///
 /// # Errors
 /// [`ColourSpecError`] naming the text and the problem.
@@ -91,13 +99,18 @@ pub fn parse_colour(text: &str) -> Result<ColourSpec, ColourSpecError> {
             _ => Err(err("a hex colour needs 3 or 6 digits after `#`")),
         };
     }
+    if let Some(code) = t.strip_prefix("ral") {
+        return RalDesign::parse(code)
+            .map(ColourSpec::RalDesign)
+            .map_err(|reason| err(&reason));
+    }
     let (kind, rest) = if let Some(r) = t.strip_prefix("lab") {
         ("lab", r)
     } else if let Some(r) = t.strip_prefix("lch") {
         ("lch", r)
     } else {
         return Err(err(
-            "expected `#rrggbb`, `lab(L, a, b)` or `lch(L, C, h)` (D65)",
+            "expected `#rrggbb`, `lab(L, a, b)` or `lch(L, C, h)` (D65), or `RAL HHH LL CC`",
         ));
     };
     let inner = rest
@@ -138,7 +151,12 @@ pub fn d65_white_xyz() -> [f64; 3] {
 /// CIE XYZ (white Y = 1) → L\*a\*b\* (D65).
 #[must_use]
 pub fn lab_from_xyz(xyz: [f64; 3]) -> [f64; 3] {
-    let w = d65_white_xyz();
+    lab_from_xyz_under(xyz, d65_white_xyz())
+}
+
+/// CIE XYZ → L\*a\*b\* relative to the white `w` (CIE 15:2004 §8.2.1).
+#[must_use]
+pub fn lab_from_xyz_under(xyz: [f64; 3], w: [f64; 3]) -> [f64; 3] {
     let f = |t: f64| {
         if t > CIE_EPSILON {
             t.cbrt()
@@ -153,7 +171,12 @@ pub fn lab_from_xyz(xyz: [f64; 3]) -> [f64; 3] {
 /// L\*a\*b\* (D65) → CIE XYZ (white Y = 1).
 #[must_use]
 pub fn xyz_from_lab(lab: [f64; 3]) -> [f64; 3] {
-    let w = d65_white_xyz();
+    xyz_from_lab_under(lab, d65_white_xyz())
+}
+
+/// L\*a\*b\* relative to the white `w` → CIE XYZ (on the scale of `w`).
+#[must_use]
+pub fn xyz_from_lab_under(lab: [f64; 3], w: [f64; 3]) -> [f64; 3] {
     let fy = (lab[0] + 16.0) / 116.0;
     let fx = fy + lab[1] / 500.0;
     let fz = fy - lab[2] / 200.0;
@@ -251,6 +274,7 @@ impl ColourSpec {
             Self::Hex(rgb8) => linear_from_srgb8(rgb8),
             Self::Lab(lab) => linear_srgb_from_lab(lab),
             Self::Lch(lch) => linear_srgb_from_lab(lab_from_lch(lch)),
+            Self::RalDesign(code) => RgbColourSpace::srgb().from_xyz(code.xyz()),
         }
     }
 
@@ -261,6 +285,7 @@ impl ColourSpec {
             Self::Hex(rgb8) => lab_from_linear_srgb(linear_from_srgb8(rgb8)),
             Self::Lab(lab) => lab,
             Self::Lch(lch) => lab_from_lch(lch),
+            Self::RalDesign(code) => lab_from_xyz(code.xyz()),
         }
     }
 

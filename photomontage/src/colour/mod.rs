@@ -33,6 +33,7 @@
 pub mod cie1931;
 pub mod cie_tables;
 pub mod designer;
+pub mod ral_design;
 pub mod rgb;
 pub mod spectrum;
 pub mod tonemap;
