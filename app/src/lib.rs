@@ -55,6 +55,7 @@ pub mod photo_settings;
 mod photo_view;
 pub mod placing;
 pub mod points;
+pub mod ral_design_page;
 pub mod render_display;
 pub mod render_job;
 pub mod render_panel;

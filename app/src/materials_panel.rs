@@ -1,7 +1,8 @@
 //! The Materials tab (colour and material design, Tonn & Donath): the scene's materials (from
 //! `site_scene`, so polygons, CAD models, the library and the site's `[[materials]]` all show),
 //! and for the selected one its colour as sRGB hex, CIE L\*a\*b\* or LCh (D65) or a RAL Design
-//! code (filled with the nearest code of the current colour) with a swatch,
+//! code (filled with the nearest code of the current colour, or picked from a hue page of the
+//! system, [`crate::ral_design_page`]) with a swatch,
 //! its LRV, a warning when the colour is outside the sRGB gamut (clamped), the gloss (GGX
 //! roughness, F0) and glass transmittance the renderer supports, and the site's palette
 //! (`[[palette]]`), applied with one click. Every change is one undoable
@@ -40,6 +41,8 @@ pub struct MaterialsPanel {
     lch: [f64; 3],
     /// A RAL Design code (`RAL HHH LL CC`).
     ral: String,
+    /// The RAL Design hue page shown.
+    ral_page: crate::ral_design_page::RalDesignPage,
     gloss: Option<Specular>,
     glass_transmittance: Option<f64>,
     palette_name: String,
@@ -262,6 +265,11 @@ impl MaterialsPanel {
         if let Some(text) = triple_row(ui, "LCh", "LCh", ["L*", "C*", "h"], &mut self.lch) {
             actions.extend(self.apply_colour(doc, base, &text));
         }
+        let preview = lab_from_lch(self.lch);
+        ui.small(format!(
+            "LCh as L*a*b*: ({:.1}, {:.1}, {:.1})",
+            preview[0], preview[1], preview[2]
+        ));
         ui.horizontal(|ui| {
             ui.label("RAL Design");
             let r = ui.add(egui::TextEdit::singleline(&mut self.ral).desired_width(110.0));
@@ -278,11 +286,14 @@ impl MaterialsPanel {
             "RAL Design System: hue, lightness, chroma in CIELCh (D65, 10° observer); \
              filled with the code nearest the current colour",
         );
-        let preview = lab_from_lch(self.lch);
-        ui.small(format!(
-            "LCh as L*a*b*: ({:.1}, {:.1}, {:.1})",
-            preview[0], preview[1], preview[2]
-        ));
+        let r = egui::CollapsingHeader::new("RAL Design pages")
+            .id_salt("ral design pages")
+            .show(ui, |ui| self.ral_page.ui(ui));
+        name_widget(ui, &r.header_response, "RAL Design pages");
+        if let Some(code) = r.body_returned.flatten() {
+            self.ral.clone_from(&code);
+            actions.extend(self.apply_colour(doc, base, &code));
+        }
         if let Some(e) = &self.error {
             let r = ui.colored_label(egui::Color32::RED, e);
             name_widget(ui, &r, "Colour error");

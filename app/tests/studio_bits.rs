@@ -247,6 +247,31 @@ fn a_ral_design_code_sets_a_material_colour() {
     h.state_mut().undo();
     h.run();
     assert_eq!(site_of(&h), original);
+    // A chip of a hue page: the page of 210° (the default), its chip RAL 210 50 15.
+    click(&mut h, "RAL Design pages");
+    click(&mut h, "RAL chip RAL 210 50 15");
+    h.run();
+    let brick = |h: &H| {
+        site_of(h)
+            .materials
+            .iter()
+            .find(|m| m.material.name == "brick")
+            .cloned()
+            .unwrap()
+    };
+    assert_eq!(brick(&h).colour.as_deref(), Some("RAL 210 50 15"));
+    let expected = photomontage::colour::designer::parse_colour("RAL 210 50 15")
+        .unwrap()
+        .resolve()
+        .linear_rgb;
+    assert_eq!(brick(&h).material.diffuse_rgb, expected);
+    assert_eq!(value(&h, "RAL Design code"), "RAL 210 50 15");
+    // Another page: the greys.
+    click(&mut h, "RAL Design hue page");
+    click(&mut h, "RAL page 000");
+    click(&mut h, "RAL chip RAL 000 70 00");
+    h.run();
+    assert_eq!(brick(&h).colour.as_deref(), Some("RAL 000 70 00"));
 }
 
 #[test]

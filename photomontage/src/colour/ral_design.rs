@@ -32,6 +32,20 @@ pub const D65_10DEG_WHITE_XYZ: [f64; 3] = [0.948_11, 1.0, 1.073_04];
 /// Below this C\* (after rounding) a colour's code is a grey, `RAL 000 LL 00`.
 const GREY_CHROMA: f64 = 0.5;
 
+/// The hue pages of the fan, degrees: the greys (0), then every 10° from 10 to 360 with 75, 85
+/// and 95 between (the yellows, where a hue step shows most).
+pub const HUE_PAGES_DEG: [u16; 40] = [
+    0, 10, 20, 30, 40, 50, 60, 70, 75, 80, 85, 90, 95, 100, 110, 120, 130, 140, 150, 160, 170, 180,
+    190, 200, 210, 220, 230, 240, 250, 260, 270, 280, 290, 300, 310, 320, 330, 340, 350, 360,
+];
+/// The lightness rows of a chromatic page of [`RalDesign::page`].
+pub const PAGE_LIGHTNESS: [u8; 8] = [20, 30, 40, 50, 60, 70, 80, 90];
+/// The lightness rows of the grey page.
+pub const GREY_PAGE_LIGHTNESS: [u8; 15] =
+    [20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 75, 80, 85, 90];
+/// The chroma columns of a chromatic page of [`RalDesign::page`].
+pub const PAGE_CHROMA: [u8; 12] = [5, 10, 15, 20, 25, 30, 40, 50, 60, 70, 80, 90];
+
 /// A RAL Design System code: hue angle, lightness and chroma as whole numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct RalDesign {
@@ -156,6 +170,51 @@ impl RalDesign {
             lightness: l as u8,
             chroma: if grey { 0 } else { c as u8 },
         })
+    }
+}
+
+impl RalDesign {
+    /// The codes of one hue page of the nominal grid that lie inside the sRGB gamut (within
+    /// [`super::designer::GAMUT_TOLERANCE`]), lightest row first, each row by chroma: on a
+    /// chromatic page the rows [`PAGE_LIGHTNESS`] and columns [`PAGE_CHROMA`], on the grey page
+    /// (hue 0) the greys of [`GREY_PAGE_LIGHTNESS`]. The grid is the system's coordinates; a
+    /// physical fan holds a subset of them (about 1 625 chips). Empty for a hue above 360.
+    #[must_use]
+    pub fn page(hue_deg: u16) -> Vec<Self> {
+        if hue_deg > 360 {
+            return Vec::new();
+        }
+        let codes: Vec<Self> = if hue_deg == 0 {
+            GREY_PAGE_LIGHTNESS
+                .iter()
+                .rev()
+                .map(|&lightness| Self {
+                    hue_deg,
+                    lightness,
+                    chroma: 0,
+                })
+                .collect()
+        } else {
+            PAGE_LIGHTNESS
+                .iter()
+                .rev()
+                .flat_map(|&lightness| {
+                    PAGE_CHROMA.iter().map(move |&chroma| Self {
+                        hue_deg,
+                        lightness,
+                        chroma,
+                    })
+                })
+                .collect()
+        };
+        codes
+            .into_iter()
+            .filter(|code| {
+                !super::designer::ColourSpec::RalDesign(*code)
+                    .resolve()
+                    .out_of_gamut
+            })
+            .collect()
     }
 }
 

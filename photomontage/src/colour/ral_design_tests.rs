@@ -145,3 +145,37 @@ fn bad_codes_say_what_is_wrong() {
         assert!(e.to_string().contains(says), "{bad}: {e}");
     }
 }
+
+#[test]
+fn a_page_holds_the_in_gamut_codes_of_its_hue_lightest_first() {
+    let page = RalDesign::page(210);
+    assert!(!page.is_empty());
+    assert!(page.iter().all(|c| c.hue_deg == 210));
+    // Lightest row first, each row by chroma.
+    assert!(page.windows(2).all(|w| w[0].lightness > w[1].lightness
+        || (w[0].lightness == w[1].lightness && w[0].chroma < w[1].chroma)));
+    // Every code shown is inside the sRGB gamut; the grid's codes left out are outside it.
+    for lightness in PAGE_LIGHTNESS {
+        for chroma in PAGE_CHROMA {
+            let code = RalDesign {
+                hue_deg: 210,
+                lightness,
+                chroma,
+            };
+            let inside = !ColourSpec::RalDesign(code).resolve().out_of_gamut;
+            assert_eq!(page.contains(&code), inside, "{code}");
+        }
+    }
+    // A mid blue of low chroma is in; the most chromatic dark blue-green is not.
+    assert!(page.iter().any(|c| c.to_string() == "RAL 210 50 15"));
+    assert!(!page.iter().any(|c| c.to_string() == "RAL 210 20 90"));
+    // The grey page: every grey of its rows, chroma 0.
+    let greys = RalDesign::page(0);
+    assert_eq!(greys.len(), GREY_PAGE_LIGHTNESS.len());
+    assert!(greys.iter().all(|c| c.chroma == 0 && c.hue_deg == 0));
+    assert_eq!(greys[0].lightness, 90);
+    assert!(RalDesign::page(370).is_empty());
+    // The pages are the fan's: greys, then hues in order.
+    assert!(HUE_PAGES_DEG.windows(2).all(|w| w[0] < w[1]));
+    assert_eq!((HUE_PAGES_DEG[0], HUE_PAGES_DEG[39]), (0, 360));
+}
