@@ -2,6 +2,7 @@
 
 mod calibrate;
 mod calibrate_opencv;
+mod colour;
 mod compare;
 mod elevation;
 mod exchange;
@@ -67,6 +68,9 @@ enum Command {
     Sun(sun::SunArgs),
     /// CIE standard sky: E_h/L_z and a fisheye luminance map.
     Sky(sky::SkyArgs),
+    /// A designer's colour (hex, L*a*b*, LCh or a RAL Design code) as sRGB hex, linear
+    /// reflectance, L*a*b*, LCh, nearest RAL Design code and LRV; with two, their LRV difference.
+    Colour(colour::Args),
     /// Read an IES LM-63 or EULUMDAT file: format, flux, max intensity, symmetry, plot.
     Luminaire(luminaire::LuminaireArgs),
     /// Fit the atmosphere and daylight weights to the site's colour samples (Durisch §4.2–4.3),
@@ -98,7 +102,8 @@ enum Command {
     /// Radiosity on the site's scene: mesh into patches and elements, light by the sun, the sky
     /// and emitting materials as separate groups, solve the interreflection (hierarchical,
     /// progressive or direct); report patches, links, passes, time and residual, optionally
-    /// write the mesh (PLY) and the convergence record (CSV). Not yet used by `render`.
+    /// write the mesh (PLY) and the convergence record (CSV); `render --radiosity` lights the
+    /// montage with the same solve.
     Radiosity(radiosity::Args),
     /// Export the site's solved cameras for Blender (Python script), COLMAP (text model) or
     /// OpenCV (FileStorage YAML); a format that cannot carry a distortion term is refused.
@@ -142,6 +147,7 @@ fn main() -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(&args),
         Command::Resect(args) => resect::run(&args),
         Command::Sun(args) => sun::run(&args),
+        Command::Colour(args) => colour::run(&args),
         Command::Sky(args) => sky::run(&args),
         Command::Luminaire(args) => luminaire::run(&args),
         Command::Fit(args) => fit::run(&args),
