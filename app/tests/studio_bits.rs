@@ -232,16 +232,22 @@ fn a_ral_design_code_sets_a_material_colour() {
     set_text(&mut h, "RAL Design code", "RAL 000 50 00");
     click(&mut h, "Apply RAL Design");
     h.run();
-    let brick = site_of(&h)
-        .materials
-        .iter()
-        .find(|m| m.material.name == "brick")
-        .cloned()
-        .unwrap();
-    assert_eq!(brick.colour.as_deref(), Some("RAL 000 50 00"));
+    let brick = |h: &H| {
+        site_of(h)
+            .materials
+            .iter()
+            .find(|m| m.material.name == "brick")
+            .cloned()
+            .unwrap()
+    };
+    assert_eq!(brick(&h).colour.as_deref(), Some("RAL 000 50 00"));
     let y = (66.0f64 / 116.0).powi(3);
-    for c in brick.material.diffuse_rgb {
-        assert!((c - y).abs() < 1e-12, "{:?}", brick.material.diffuse_rgb);
+    for c in brick(&h).material.diffuse_rgb {
+        assert!(
+            (c - y).abs() < 1e-12,
+            "{:?}",
+            brick(&h).material.diffuse_rgb
+        );
     }
     assert!(has(&h, "RAL 000 50 00   LRV 18.4"));
     h.state_mut().undo();
@@ -251,14 +257,6 @@ fn a_ral_design_code_sets_a_material_colour() {
     click(&mut h, "RAL Design pages");
     click(&mut h, "RAL chip RAL 210 50 15");
     h.run();
-    let brick = |h: &H| {
-        site_of(h)
-            .materials
-            .iter()
-            .find(|m| m.material.name == "brick")
-            .cloned()
-            .unwrap()
-    };
     assert_eq!(brick(&h).colour.as_deref(), Some("RAL 210 50 15"));
     let expected = photomontage::colour::designer::parse_colour("RAL 210 50 15")
         .unwrap()
