@@ -207,11 +207,18 @@ impl SkyTransfer {
                             Some((counts, t, cone)) if usize::from(counts[f]) == rays[f] => {
                                 // All escaped the natural scene; outside the cone towards the
                                 // planned objects they escape the whole scene too.
-                                if cone.is_some_and(|(axis, cos)| axis.dot(dir) < cos) {
-                                    out[f] = counts[f];
-                                    continue;
-                                }
-                                (&t.artificial, Some(t))
+                                let artificial = match &t.artificial {
+                                    Some(a)
+                                        if !cone.is_some_and(|(axis, cos)| axis.dot(dir) < cos) =>
+                                    {
+                                        a
+                                    }
+                                    _ => {
+                                        out[f] = counts[f];
+                                        continue;
+                                    }
+                                };
+                                (artificial, Some(t))
                             }
                             _ => (tracer, None),
                         };

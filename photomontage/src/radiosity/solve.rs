@@ -595,10 +595,11 @@ pub fn solve_on_mesh_twinned(
         locator: std::sync::OnceLock::new(),
         query_geometry: std::sync::OnceLock::new(),
     };
-    // A natural solve lends its form factors with its sky rays (a solve beside one does not).
+    // A natural solve lends its form factors with its sky rays (a solve beside one does not;
+    // one beside its identity twin, another colour of the same scene, does).
     let with_factors = |solution: Solution, sky_rays: Option<SkyRays>| {
         let sky_rays = sky_rays.map(|mut sky| {
-            if hierarchy.is_some() && twin.is_none() {
+            if hierarchy.is_some() && twin.is_none_or(|(t, _)| !t.plans_something()) {
                 sky.factors = Some(Arc::new(NaturalFactors::new(
                     Arc::clone(&solution.mesh),
                     params.form_factors,

@@ -121,7 +121,7 @@ fn escaped_rays(
         #[allow(clippy::cast_possible_truncation)]
         let ray = tracer.ray_from_world(p, dir, DIRECT_RAY_OFFSET_M as f32, DIRECT_RAY_LENGTH_M);
         let blocked = match only_planned {
-            Some(t) => t.artificial.any_hit(&ray),
+            Some(t) => t.artificial.as_ref().is_some_and(|a| a.any_hit(&ray)),
             None => tracer.any_hit(&ray),
         };
         if !visibility || !blocked {

@@ -38,8 +38,9 @@ pub struct Twin {
     pub(super) twin_of: Vec<Option<u32>>,
     /// Per element of the mesh with the planned objects, its direct-light random stream.
     pub(super) streams: Vec<u64>,
-    /// The planned objects alone, in the local frame of the whole scene's tracer.
-    pub(super) artificial: SceneTracer,
+    /// The planned objects alone, in the local frame of the whole scene's tracer; `None` for
+    /// [`Twin::identity`] (nothing planned).
+    pub(super) artificial: Option<SceneTracer>,
     /// Their bounding box, world metres, widened by [`BOX_MARGIN_M`].
     artificial_box_in_world_m: [Point3<f64>; 2],
     /// The centre and radius of the widened box's bounding sphere, world metres.
@@ -95,7 +96,7 @@ impl Twin {
         let mut twin = Self {
             twin_of,
             streams,
-            artificial,
+            artificial: Some(artificial),
             artificial_box_in_world_m: [lo, hi],
             artificial_sphere_in_world_m: (nalgebra::center(&lo, &hi), (hi - lo).norm() / 2.0),
             element_cones: Vec::new(),
@@ -105,6 +106,34 @@ impl Twin {
             .map(|e| twin.cone_from_node(mesh.element_node(e)))
             .collect();
         Ok(Some(twin))
+    }
+
+    /// The twin of a mesh in a solve of the same scene with other colours (a spectral pass
+    /// beside the first, `site::spectral_radiosity`): every element is its own twin and nothing
+    /// is planned, so every sky ray's count and every form factor the first solve computed is
+    /// read, not traced again (the same rays on the same geometry: the same answers). The
+    /// caller checks that the meshes are the same ([`twin_elements`] maps every element to
+    /// itself) and that the tracers share their local frame.
+    #[must_use]
+    pub fn identity(mesh: &Mesh) -> Self {
+        let n = mesh.elements.len();
+        let inf = f64::INFINITY;
+        Self {
+            twin_of: (0..n).map(|e| u32::try_from(e).ok()).collect(),
+            streams: (0..n as u64).collect(),
+            artificial: None,
+            // An empty box: nothing to meet.
+            artificial_box_in_world_m: [Point3::new(inf, inf, inf), Point3::new(-inf, -inf, -inf)],
+            artificial_sphere_in_world_m: (Point3::origin(), 0.0),
+            // A cone no direction enters (its cosine above 1): no ray can meet what is planned.
+            element_cones: vec![Some((Vector3::z(), 2.0)); n],
+        }
+    }
+
+    /// Whether something is planned (false for [`Twin::identity`]).
+    #[must_use]
+    pub(super) fn plans_something(&self) -> bool {
+        self.artificial.is_some()
     }
 
     /// The directions in which a ray from within `radius_m` of `centre_in_world_m` can meet the
@@ -158,6 +187,9 @@ impl Twin {
         origin_in_world_m: &Point3<f64>,
         dir_in_world: &Vector3<f64>,
     ) -> bool {
+        if !self.plans_something() {
+            return false;
+        }
         let [lo, hi] = &self.artificial_box_in_world_m;
         let (mut near, mut far) = (0.0_f64, f64::INFINITY);
         for a in 0..3 {

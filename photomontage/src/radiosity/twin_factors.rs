@@ -151,6 +151,9 @@ impl<'a> FactorReuse<'a> {
     /// Whether a shadow ray between `r` and `s` may meet the planned objects' widened box
     /// (module doc: the two nodes' bounding box, and each node's front half-space).
     fn may_meet_artificial(&self, r: &MeshNode, s: &MeshNode) -> bool {
+        if !self.twin.plans_something() {
+            return false;
+        }
         let [lo, hi] = self.twin.artificial_box_in_world_m();
         let vertices = r.vertices_in_world_m.iter().chain(&s.vertices_in_world_m);
         for a in 0..3 {

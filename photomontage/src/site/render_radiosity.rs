@@ -32,7 +32,8 @@ use super::render_error::SiteRenderError;
 use crate::bvh::BuildQuality;
 use crate::radiosity::twin::{Twin, twin_elements};
 use crate::radiosity::{
-    Mesh, MeshParams, Rgb, SolveParams, TransferLighting, solve_on_mesh_twinned, sun_directions,
+    Mesh, MeshParams, Rgb, SkyRays, SolveParams, TransferLighting, solve_on_mesh_twinned,
+    sun_directions,
 };
 use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::scene::{ObjectKind, Scene, SceneError, SceneTracer};
@@ -144,7 +145,7 @@ pub fn site_radiosity_light(
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
     let others = photo.map(|_| OtherPhotos::load(doc, view));
     let views = photo.zip(others.as_ref()).map(|(p, o)| o.views(*p));
-    let pair = solve_pair(scene, &lighting, &params, views.as_ref(), cancel)?;
+    let pair = solve_pair(scene, &lighting, &params, views.as_ref(), None, cancel)?;
     let report = RadiosityReport {
         element_edge_m,
         elements: [
@@ -170,15 +171,32 @@ pub(super) struct SolvedPair {
     pub photo_reflectance: Option<PhotoReflectanceCount>,
     /// What the other photos gave ([`PhotoSamples::notes`]).
     pub photo_notes: Vec<String>,
+    /// What the photographed state's solve lends a solve of the same scene in other colours.
+    pub(super) reuse: Option<PassReuse>,
+    /// Whether the photographed state's solve read the `reuse` it was given.
+    pub(super) read_reuse: bool,
+}
+
+/// What a solve of the photographed state lends the solves of the same scene in other colours
+/// (the later spectral passes, [`super::spectral_radiosity`]): its mesh, its tracer's local
+/// frame, its sky rays and form factors.
+pub(super) struct PassReuse {
+    mesh: Arc<Mesh>,
+    frame_origin: nalgebra::Point3<f64>,
+    sky: SkyRays,
 }
 
 /// The two solves of [`site_radiosity_light`] for the given lighting and parameters (the
-/// site's, or their colours on one spectral pass, [`super::spectral_radiosity`]).
+/// site's, or their colours on one spectral pass, [`super::spectral_radiosity`]). With `reuse`
+/// (the first pass's) the photographed state's solve reads the sky rays and form factors of
+/// that solve where its mesh is the same ([`Twin::identity`]: the same answers, not traced
+/// again); the returned [`SolvedPair::reuse`] is this solve's, for the passes after it.
 pub(super) fn solve_pair(
     scene: &Scene,
     lighting: &TransferLighting,
     params: &SolveParams,
     photo: Option<&PhotoViews<'_>>,
+    reuse: Option<&PassReuse>,
     cancel: &AtomicBool,
 ) -> Result<SolvedPair, SiteRenderError> {
     let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
@@ -210,6 +228,18 @@ pub(super) fn solve_pair(
         .unwrap_or_default();
     let mut refit = samples.map(PhotoRefit::new);
     let rounds = if refit.is_some() { REFIT_ROUNDS } else { 0 };
+    let frame_origin = natural_tracer.local_origin_in_world_m();
+    let identity = reuse
+        .filter(|r| {
+            r.frame_origin == frame_origin
+                && r.mesh.elements.len() == natural_mesh.elements.len()
+                && twin_elements(&r.mesh, &natural_mesh)
+                    .iter()
+                    .zip(0u32..)
+                    .all(|(t, e)| *t == Some(e))
+        })
+        .map(|r| (Twin::identity(&natural_mesh), &r.sky));
+    let read_reuse = identity.is_some();
     let (without, natural_sky) = solve_on_mesh_twinned(
         natural_mesh,
         &natural_tracer,
@@ -219,7 +249,7 @@ pub(super) fn solve_pair(
         &|_| {},
         &mut |solution: &crate::radiosity::Solution| refit.as_mut().map(|r| r.next_round(solution)),
         rounds,
-        None,
+        identity.as_ref().map(|(t, sky)| (t, *sky)),
     )
     .map_err(|e| radiosity_error(&e))?;
     let mut with_mesh = mesh(scene)?;
@@ -252,11 +282,18 @@ pub(super) fn solve_pair(
         twin.as_ref().zip(natural_sky.as_ref()),
     )
     .map_err(|e| radiosity_error(&e))?;
+    let reuse = natural_sky.map(|sky| PassReuse {
+        mesh: Arc::clone(&without.mesh),
+        frame_origin,
+        sky,
+    });
     Ok(SolvedPair {
         with,
         without,
         photo_reflectance: refit.as_ref().and_then(PhotoRefit::count),
         photo_notes,
+        reuse,
+        read_reuse,
     })
 }
 

@@ -30,7 +30,9 @@ use super::other_photos::OtherPhotos;
 use super::photo_reflectance::{PhotoReflectanceCount, PhotoView};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
-use super::render_radiosity::{RadiosityReport, radiosity_error, site_solve_params, solve_pair};
+use super::render_radiosity::{
+    PassReuse, RadiosityReport, radiosity_error, site_solve_params, solve_pair,
+};
 use crate::colour::SampleSet;
 use crate::radiosity::{SolveParams, TransferLighting};
 use crate::render::SpectralPasses;
@@ -116,6 +118,8 @@ pub fn site_spectral_radiosity(
     let mut lights: Vec<Arc<RadiosityLight>> = Vec::with_capacity(passes.count());
     let mut elements = [0, 0];
     let mut photo_reflectance: Option<PhotoReflectanceCount> = None;
+    let mut first_pass: Option<PassReuse> = None;
+    let mut reused_passes = 0;
     for pass in 0..passes.count() {
         let pass_photo_lighting = photo
             .map(|p| passes.lighting(pass, p.lighting))
@@ -135,13 +139,19 @@ pub fn site_spectral_radiosity(
                     |k| &other_photos[k][pass],
                 )
             });
-        let pair = solve_pair(
+        let mut pair = solve_pair(
             &pass_scene(&passes, pass, scene),
             &pass_transfer_lighting(&passes, pass, &lighting),
             &pass_solve_params(&passes, pass, &params),
             pass_photo.as_ref(),
+            first_pass.as_ref(),
             cancel,
         )?;
+        // The first pass's sky rays and form factors serve every later pass (the same mesh).
+        if first_pass.is_none() {
+            first_pass = pair.reuse.take();
+        }
+        reused_passes += usize::from(pair.read_reuse);
         elements = [
             pair.with.mesh.elements.len(),
             pair.without.mesh.elements.len(),
@@ -161,8 +171,10 @@ pub fn site_spectral_radiosity(
         lights.push(Arc::new(light));
     }
     notes.push(format!(
-        "spectral radiosity: solved on {} passes of {sample_set:?}",
-        passes.count()
+        "spectral radiosity: solved on {} passes of {sample_set:?}; {} of the later passes read the \
+         first pass's sky rays and form factors",
+        passes.count(),
+        reused_passes
     ));
     let report = RadiosityReport {
         element_edge_m,

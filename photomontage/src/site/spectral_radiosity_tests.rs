@@ -10,6 +10,7 @@ use std::sync::atomic::AtomicBool;
 use super::*;
 use crate::render::spectral::SpectralError;
 use crate::scene::Material;
+use crate::site::radiosity_lighting::site_transfer_lighting;
 use crate::site::render::tests::fixture;
 use crate::site::render_photo::{RenderPlan, RenderRequest};
 use crate::site::render_radiosity::site_radiosity_light;
@@ -281,4 +282,56 @@ fn each_band_of_a_coloured_enclosure_meets_the_enclosure_identity() {
         .fold(0.0, f64::max);
     eprintln!("enclosure: spectral {spectral_rgb:?} against RGB mode {rgb_mode:?}");
     assert!(worst > 0.05, "{spectral_rgb:?} against {rgb_mode:?}");
+}
+
+#[test]
+fn a_later_pass_reads_the_first_pass_to_the_same_solutions() {
+    // A later spectral pass solves the same mesh in other colours: reading the first pass's
+    // sky rays and form factors (`Twin::identity`) must give the solutions of solving it alone,
+    // bit for bit.
+    let dir = tempfile::tempdir().unwrap();
+    let doc = fixture(dir.path());
+    let job = crate::site::render::prepare_view(&doc, "p1").unwrap();
+    let scene = &job.scene.scene;
+    let passes = SpectralPasses::new(SampleSet::Durisch9).unwrap();
+    let (lighting, _) = site_transfer_lighting(&doc, scene, "p1").unwrap();
+    let (params, _) = site_solve_params(&doc, scene).unwrap();
+    let cancel = AtomicBool::new(false);
+    let solve = |pass: usize, reuse: Option<&PassReuse>| {
+        solve_pair(
+            &pass_scene(&passes, pass, scene),
+            &pass_transfer_lighting(&passes, pass, &lighting),
+            &pass_solve_params(&passes, pass, &params),
+            None,
+            reuse,
+            &cancel,
+        )
+        .unwrap()
+    };
+    let first = solve(0, None);
+    assert!(!first.read_reuse);
+    let reuse = first
+        .reuse
+        .as_ref()
+        .expect("the photographed state lends its rays");
+    for pass in 1..passes.count() {
+        let alone = solve(pass, None);
+        let beside = solve(pass, Some(reuse));
+        assert!(beside.read_reuse, "pass {pass} read the first");
+        for (a, b) in [
+            (&alone.with, &beside.with),
+            (&alone.without, &beside.without),
+        ] {
+            assert_eq!(a.mesh.elements.len(), b.mesh.elements.len());
+            assert_eq!(a.groups.len(), b.groups.len());
+            for (ga, gb) in a.groups.iter().zip(&b.groups) {
+                assert_eq!(
+                    ga.direct_irradiance_rgb, gb.direct_irradiance_rgb,
+                    "{}",
+                    ga.name
+                );
+                assert_eq!(ga.radiosity_rgb, gb.radiosity_rgb, "{}", ga.name);
+            }
+        }
+    }
 }
