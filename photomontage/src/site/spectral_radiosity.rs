@@ -13,13 +13,18 @@
 //!
 //! The meshes (the geometry and the sun's shadow edges) are the same on every pass, so the
 //! vertex gathers of the first pass (their traced rays) serve all of them
-//! ([`RadiosityLight::relit`]).
+//! ([`RadiosityLight::relit`]), and the photographed state's solve of every later pass reads
+//! the first pass's sky rays and form factors ([`crate::radiosity::twin::Twin::identity`],
+//! [`super::render_radiosity::PassReuse`]): the same rays and factors, not traced again, so the
+//! solutions are those of solving the pass alone, bit for bit (test); the solve with the
+//! planned objects reads them from its own pass's photographed state, as in RGB.
 //!
 //! # Known limitations
-//! Each pass is a full solve: its form factors are computed again (the same links come out,
-//! the geometry being the same, but the BF refinement reads the pass's light, so a link may be
-//! refined on one pass and not on another). A spectral radiosity render so costs about the
-//! passes' count times the RGB precompute. The studio's live preview keeps RGB transfers only.
+//! A later pass still builds its meshes, samples the photos, runs its own BF refinement (it
+//! reads the pass's light, so a link may be refined on one pass and not on another: those
+//! links' factors are computed) and solves; on the street site a spectral radiosity precompute
+//! takes about 2.7 times the RGB one (docs/benchmarks.md). The studio's live preview keeps RGB
+//! transfers only.
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
