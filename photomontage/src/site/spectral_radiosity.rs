@@ -15,7 +15,7 @@
 //! vertex gathers of the first pass (their traced rays) serve all of them
 //! ([`RadiosityLight::relit`]), and the photographed state's solve of every later pass reads
 //! the first pass's sky rays and form factors ([`crate::radiosity::twin::Twin::identity`],
-//! [`super::render_radiosity::PassReuse`]): the same rays and factors, not traced again, so the
+//! `PassReuse` of `render_radiosity`): the same rays and factors, not traced again, so the
 //! solutions are those of solving the pass alone, bit for bit (test); the solve with the
 //! planned objects reads them from its own pass's photographed state, as in RGB.
 //!
