@@ -32,6 +32,7 @@
 
 pub mod cie1931;
 pub mod cie_tables;
+pub mod cielab;
 pub mod designer;
 pub mod ral_design;
 pub mod rgb;

@@ -22,9 +22,11 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::designer::{
-    d65_white_xyz, lab_from_lch, lab_from_xyz_under, lch_from_lab, xyz_from_lab_under,
+use super::cielab::{
+    GAMUT_TOLERANCE, d65_white_xyz, lab_from_lch, lab_from_xyz_under, lch_from_lab,
+    xyz_from_lab_under,
 };
+use super::rgb::RgbColourSpace;
 
 /// XYZ of illuminant D65 for the CIE 1964 10° observer, Y = 1 (ASTM E308, Table 5).
 pub const D65_10DEG_WHITE_XYZ: [f64; 3] = [0.948_11, 1.0, 1.073_04];
@@ -72,7 +74,7 @@ impl RalDesign {
     /// `2105015`. Returns why not otherwise (a four-digit RAL Classic code is named as such).
     ///
     /// # Errors
-    /// The reason, for [`super::designer::ColourSpecError`].
+    /// The reason, for the colour parser's error.
     pub fn parse(code: &str) -> Result<Self, String> {
         let groups: Vec<&str> = code
             .split(|c: char| c.is_whitespace() || c == '-')
@@ -175,7 +177,7 @@ impl RalDesign {
 
 impl RalDesign {
     /// The codes of one hue page of the nominal grid that lie inside the sRGB gamut (within
-    /// [`super::designer::GAMUT_TOLERANCE`]), lightest row first, each row by chroma: on a
+    /// [`GAMUT_TOLERANCE`]), lightest row first, each row by chroma: on a
     /// chromatic page the rows [`PAGE_LIGHTNESS`] and columns [`PAGE_CHROMA`], on the grey page
     /// (hue 0) the greys of [`GREY_PAGE_LIGHTNESS`]. The grid is the system's coordinates; a
     /// physical fan holds a subset of them (about 1 625 chips). Empty for a hue above 360.
@@ -210,9 +212,10 @@ impl RalDesign {
         codes
             .into_iter()
             .filter(|code| {
-                !super::designer::ColourSpec::RalDesign(*code)
-                    .resolve()
-                    .out_of_gamut
+                RgbColourSpace::srgb()
+                    .from_xyz(code.xyz())
+                    .iter()
+                    .all(|c| (-GAMUT_TOLERANCE..=1.0 + GAMUT_TOLERANCE).contains(c))
             })
             .collect()
     }
