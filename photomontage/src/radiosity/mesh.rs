@@ -32,6 +32,7 @@ use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
 
+use super::mesh_grading::Grading;
 use super::{RadiosityError, Rgb, check_positive};
 use crate::bvh::BuildQuality;
 use crate::scene::{ObjectId, Scene, SceneTracer};
@@ -62,6 +63,9 @@ pub struct MeshParams {
     /// overhangs; [`super::corner_refinement`]) down to this edge, metres; `None` leaves corners
     /// at the element size.
     pub corner_element_m: Option<f64>,
+    /// Sizes that grow away from the cameras and the planned objects
+    /// ([`super::mesh_grading`]); `None` meshes at the sizes above everywhere.
+    pub grading: Option<Grading>,
 }
 
 impl Default for MeshParams {
@@ -75,6 +79,7 @@ impl Default for MeshParams {
             max_elements: 200_000,
             shadow_edge_element_m: None,
             corner_element_m: None,
+            grading: None,
         }
     }
 }
@@ -238,6 +243,19 @@ impl std::fmt::Debug for Refinement<'_> {
 /// Deepest level a refinement may reach (edges 2⁻²⁴ of the scene triangle's).
 const MAX_LEVEL: u32 = 24;
 
+/// How one scene triangle is subdivided (module doc).
+struct Subdivision<'a> {
+    /// Element and patch edges of the triangle's object, metres.
+    element_edge_m: f64,
+    patch_edge_m: f64,
+    /// The global element edge the grading factor is measured against, metres.
+    global_edge_m: f64,
+    grading: Option<&'a Grading>,
+    refinement: Option<&'a Refinement<'a>>,
+    /// Past this many elements no node is split (the build then fails on the budget).
+    max_elements: usize,
+}
+
 impl Mesh {
     /// Meshes every triangle of `scene` (see the module doc), refined at corners when
     /// [`MeshParams::corner_element_m`] is set.
@@ -324,6 +342,9 @@ impl Mesh {
         }
         check_positive("max_patch_edge_m", params.max_patch_edge_m)?;
         check_positive("max_element_edge_m", params.max_element_edge_m)?;
+        if let Some(g) = &params.grading {
+            g.validate()?;
+        }
         let object_names: Vec<String> = scene.objects().iter().map(|o| o.name.clone()).collect();
         for (name, &size) in params
             .object_element_edge_m
@@ -406,9 +427,11 @@ impl Mesh {
                 .get(&object_name)
                 .copied()
                 .unwrap_or(params.max_patch_edge_m);
-            let patch_levels = levels_for(longest, patch_edge_m).min(element_levels);
             let new_elements = 1usize << (2 * element_levels.min(31));
-            if element_levels > 15 || mesh.elements.len() + new_elements > params.max_elements {
+            // Graded, the count is known only after the subdivision, which stops at the budget.
+            let ungraded_over = params.grading.is_none()
+                && mesh.elements.len() + new_elements > params.max_elements;
+            if element_levels > 15 || ungraded_over {
                 return Err(RadiosityError::TooManyElements {
                     limit: params.max_elements,
                     object: object_name,
@@ -426,13 +449,21 @@ impl Mesh {
                 reflectance_rgb,
                 emission_rgb,
             });
+            let subdivision = Subdivision {
+                element_edge_m,
+                patch_edge_m,
+                global_edge_m: params.max_element_edge_m,
+                grading: params.grading.as_ref(),
+                refinement,
+                max_elements: params.max_elements,
+            };
             mesh.add_subtree(
                 v,
                 cross / (2.0 * area_m2),
                 surface,
-                0,
-                [patch_levels, element_levels],
-                refinement,
+                (0, longest),
+                false,
+                &subdivision,
             );
             if mesh.elements.len() > params.max_elements {
                 return Err(RadiosityError::TooManyElements {
@@ -453,16 +484,18 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Adds the node for `v` at `level` and its subtree; returns its id.
+    /// Adds the node for `v` at `level` and its subtree; returns its id. `nominal_m` is the
+    /// scene triangle's longest edge halved once per level (exact in `f64`, so the sizes are
+    /// compared as [`levels_for`] does); `under_patch` whether an ancestor is a patch.
     #[allow(clippy::cast_possible_truncation)] // the element budget keeps ids far below 2³²
     fn add_subtree(
         &mut self,
         v: [Point3<f64>; 3],
         normal_in_world: Vector3<f64>,
         surface: u32,
-        level: u32,
-        [patch_level, element_level]: [u32; 2],
-        refinement: Option<&Refinement<'_>>,
+        (level, nominal_m): (u32, f64),
+        under_patch: bool,
+        sub: &Subdivision<'_>,
     ) -> u32 {
         let id = self.nodes.len() as u32;
         let area_m2 = 0.5 * (v[1] - v[0]).cross(&(v[2] - v[0])).norm();
@@ -475,13 +508,18 @@ impl Mesh {
             element: None,
             open_fraction: 1.0,
         });
-        if level == patch_level {
+        let grow = sub.grading.map_or(1.0, |g| g.factor(&v, sub.global_edge_m));
+        let element_size = nominal_m <= sub.element_edge_m * grow;
+        let patch = !under_patch && (element_size || nominal_m <= sub.patch_edge_m * grow);
+        if patch {
             self.patches.push(id);
         }
-        if level >= element_level {
+        if element_size || self.elements.len() >= sub.max_elements {
             let split = level < MAX_LEVEL
-                && refinement.is_some_and(|r| {
-                    longest_edge_m(&v) > r.min_element_edge_m && (r.split)(&v, &normal_in_world)
+                && self.elements.len() < sub.max_elements
+                && sub.refinement.is_some_and(|r| {
+                    longest_edge_m(&v) > r.min_element_edge_m * grow
+                        && (r.split)(&v, &normal_in_world)
                 });
             if !split {
                 Arc::make_mut(&mut self.nodes)[id as usize].element =
@@ -498,9 +536,9 @@ impl Mesh {
                 child,
                 normal_in_world,
                 surface,
-                level + 1,
-                [patch_level, element_level],
-                refinement,
+                (level + 1, nominal_m * 0.5),
+                under_patch || patch,
+                sub,
             )
         });
         Arc::make_mut(&mut self.nodes)[id as usize].children = Some(children);

@@ -52,6 +52,7 @@ pub mod form_factor;
 mod gather_avx2;
 pub mod hierarchical;
 pub mod mesh;
+pub mod mesh_grading;
 pub mod mesh_sizing;
 pub mod progressive;
 pub mod query;
