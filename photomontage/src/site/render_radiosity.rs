@@ -350,3 +350,41 @@ pub fn site_radiosity_arc(
 ) -> Result<(Arc<RadiosityLight>, RadiosityReport), SiteRenderError> {
     site_radiosity_light(doc, scene, view, photo, cancel).map(|(l, r)| (Arc::new(l), r))
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use super::*;
+    use crate::site::render::prepare_view;
+    use crate::site::render::tests::fixture;
+
+    /// The site's solves are graded around the solved photos' cameras and the planned objects'
+    /// box; the fits' solve of the photographed state around the cameras alone; a site with
+    /// neither is meshed at one size.
+    #[test]
+    fn the_mesh_is_graded_around_the_cameras_and_the_planned_objects() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut doc = fixture(dir.path());
+        let scene = prepare_view(&doc, "p1").unwrap().scene.scene;
+        let camera = Point3::new(0.5, -10.0, 1.5);
+        let planned = artificial_part(&scene)
+            .unwrap()
+            .bounding_box_in_world_m()
+            .unwrap();
+        let (params, _) = site_solve_params(&doc, &scene).unwrap();
+        let grading = params.mesh.grading.unwrap();
+        assert!((grading.tan_angle - GRADING_TAN_ANGLE).abs() < f64::EPSILON);
+        // p2 is not solved: p1's camera and the box.
+        assert_eq!(grading.focus_in_world_m, vec![[camera; 2], planned]);
+        let natural = natural_part(&scene).unwrap();
+        let (fits, _) = site_solve_params(&doc, &natural).unwrap();
+        assert_eq!(
+            fits.mesh.grading.unwrap().focus_in_world_m,
+            vec![[camera; 2]]
+        );
+        doc.site.photos[0].exterior = None;
+        let (none, _) = site_solve_params(&doc, &natural).unwrap();
+        assert!(none.mesh.grading.is_none());
+    }
+}
