@@ -117,33 +117,12 @@ mod tests {
     use super::*;
     use crate::radiosity::mesh::{Mesh, MeshParams, longest_edge_m};
     use crate::radiosity::test_scenes;
-    use crate::scene::Scene;
-
-    /// A 1 km ground with a 20 m house in its middle (the street site's proportions).
-    fn site() -> Scene {
-        let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
-        let mut scene = Scene::new();
-        let f = 500.0;
-        test_scenes::add(
-            &mut scene,
-            "ground",
-            test_scenes::quad(p(-f, -f), p(f, -f), p(f, f), p(-f, f)),
-            test_scenes::grey("grey", 0.2),
-        );
-        test_scenes::add(
-            &mut scene,
-            "house",
-            test_scenes::block(Point3::new(-10.0, -10.0, 0.0), Point3::new(10.0, 10.0, 8.0)),
-            test_scenes::grey("white", 0.6),
-        );
-        scene
-    }
 
     /// Near the focus the graded mesh is the ungraded one node for node; far out its elements
     /// are as coarse as the grading allows and no coarser, and there are far fewer of them.
     #[test]
     fn a_graded_mesh_keeps_the_focus_and_coarsens_with_distance() {
-        let scene = site();
+        let scene = test_scenes::kilometre_site();
         let ungraded = MeshParams {
             max_patch_edge_m: 32.0,
             max_element_edge_m: 8.0,
@@ -210,7 +189,7 @@ mod tests {
     /// the ungraded mesh first.
     #[test]
     fn a_graded_mesh_past_the_budget_is_refused() {
-        let scene = site();
+        let scene = test_scenes::kilometre_site();
         let params = MeshParams {
             max_patch_edge_m: 4.0,
             max_element_edge_m: 0.05,

@@ -89,30 +89,11 @@ mod tests {
     use crate::radiosity::test_scenes;
     use nalgebra::Point3;
 
-    fn site() -> Scene {
-        let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
-        let mut scene = Scene::new();
-        let (n, f) = (10.0, 500.0);
-        test_scenes::add(
-            &mut scene,
-            "ground",
-            test_scenes::quad(p(-f, -f), p(f, -f), p(f, f), p(-f, f)),
-            test_scenes::grey("grey", 0.2),
-        );
-        test_scenes::add(
-            &mut scene,
-            "house",
-            test_scenes::block(Point3::new(-n, -n, 0.0), Point3::new(n, n, 8.0)),
-            test_scenes::grey("white", 0.6),
-        );
-        scene
-    }
-
     /// The 1 km ground of a site at 1 m would be 4 million elements and the mesh is refused; the
     /// sized parameters give it its own edge, keep the house at 1 m, and mesh within budget.
     #[test]
     fn a_large_ground_gets_its_own_edge_and_the_mesh_fits() {
-        let scene = site();
+        let scene = test_scenes::kilometre_site();
         let params = MeshParams::default();
         assert!(
             Mesh::build(&scene, &params).is_err(),

@@ -36,6 +36,27 @@ pub fn grey(name: &str, reflectance: f64) -> Material {
     Material::diffuse(name, [reflectance; 3])
 }
 
+/// A site's proportions: a 1 km "ground" square (ρ 0.2) with a 20 × 20 × 8 m "house" (ρ 0.6)
+/// in its middle.
+pub fn kilometre_site() -> Scene {
+    let g = |x: f64, y: f64| p(x, y, 0.0);
+    let mut scene = Scene::new();
+    let (n, f) = (10.0, 500.0);
+    add(
+        &mut scene,
+        "ground",
+        quad(g(-f, -f), g(f, -f), g(f, f), g(-f, f)),
+        grey("grey", 0.2),
+    );
+    add(
+        &mut scene,
+        "house",
+        block(p(-n, -n, 0.0), p(n, n, 8.0)),
+        grey("white", 0.6),
+    );
+    scene
+}
+
 /// Two directly opposed squares of side `side_m`, `gap_m` apart: "emitter" in z = 0 facing +z,
 /// "receiver" in z = gap facing −z.
 pub fn squares_parallel(side_m: f64, gap_m: f64) -> Scene {
