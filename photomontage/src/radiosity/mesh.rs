@@ -11,6 +11,13 @@
 //! **elements** (leaves, the unknowns of the progressive and the direct solver). The subdivision
 //! is deterministic (no randomness): the same scene and parameters give the same mesh.
 //!
+//! **Grading** ([`MeshParams::grading`], [`super::mesh_grading`]): every size is multiplied by a
+//! factor g ≥ 1 that grows with the node's distance from the places a montage looks at, so the
+//! levels are decided node by node: a node is a patch where its edge first falls to the patch
+//! size times its g, an element where it falls to the element size times its g. Sizes are
+//! compared on the scene triangle's longest edge halved once per level, as without grading, so
+//! g = 1 gives the ungraded mesh exactly.
+//!
 //! [`Mesh::ply`] writes the elements as binary-free ASCII PLY with their radiosity as vertex-free
 //! face colours, for inspection in MeshLab or Blender.
 //!
