@@ -154,15 +154,17 @@ mod tests {
         }
         // Every element is within its graded size, and its parent was not (no element is
         // split further than the grading asks): the ground's nodes halve a 1414 m edge.
+        let mut parent_of = vec![None; mesh.nodes.len()];
+        for (id, n) in mesh.nodes.iter().enumerate() {
+            for c in n.children.into_iter().flatten() {
+                parent_of[c as usize] = Some(id);
+            }
+        }
         for (&e, v) in mesh.elements.iter().zip(&graded_elements) {
             let g = grading.factor(v, 8.0);
             let edge = longest_edge_m(v);
             assert!(edge <= 8.0 * g * (1.0 + 1e-9), "{edge} m at g = {g}");
-            let parent = mesh
-                .nodes
-                .iter()
-                .find(|n| n.children.is_some_and(|c| c.contains(&e)));
-            if let Some(parent) = parent {
+            if let Some(parent) = parent_of[e as usize].map(|p| &mesh.nodes[p]) {
                 let gp = grading.factor(&parent.vertices_in_world_m, 8.0);
                 assert!(
                     longest_edge_m(&parent.vertices_in_world_m) > 8.0 * gp,
@@ -170,8 +172,19 @@ mod tests {
                 );
             }
         }
-        // Patches tile every scene triangle: areas add up, and each element has one patch
-        // above it (or is one).
+        // Patches tile every scene triangle: each element has exactly one patch above it (or
+        // is one), and the areas add up.
+        let mut patches_above = vec![0_u32; mesh.nodes.len()];
+        let mut stack: Vec<u32> = mesh.patches.clone();
+        while let Some(n) = stack.pop() {
+            patches_above[n as usize] += 1;
+            stack.extend(mesh.nodes[n as usize].children.into_iter().flatten());
+        }
+        assert!(
+            mesh.elements
+                .iter()
+                .all(|&e| patches_above[e as usize] == 1)
+        );
         let area = |m: &Mesh, ids: &[u32]| ids.iter().map(|&i| m.nodes[i as usize].area_m2).sum();
         let total: f64 = area(&mesh, &mesh.elements);
         let patches: f64 = area(&mesh, &mesh.patches);
