@@ -15,7 +15,8 @@
 //!
 //! The surfaces reflect as in the renderer's solution: with `[render] photo_reflectance` (the
 //! default), the natural elements the photo sees take their ρ_d from it, those it does not see
-//! from the site's other solved photos under the same sun, the rest the library's
+//! from the site's other solved photos (each read under the sun of its capture time, against
+//! the transfer relit to that sun), the rest the library's
 //! ([`crate::site::photo_reflectance`], [`crate::site::other_photos`]). The photo's ρ_d depends
 //! on the lighting it is read under (ρ_d = π·L₀ / E_nat), so at each pass, after the relight to
 //! the pass's weights, the photos are read again under those weights and the transfer refitted
@@ -43,7 +44,9 @@ use crate::radiosity::{
 use crate::scene::{Scene, SceneTracer};
 use crate::site::SiteDocument;
 use crate::site::other_photos::{LoadedPhoto, OtherPhotos, PhotoCache, cached_photo};
-use crate::site::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS};
+use crate::site::photo_reflectance::{
+    PhotoRefit, PhotoSamples, PhotoView, REFIT_ROUNDS, refit_transfer,
+};
 use crate::site::radiosity_lighting::site_transfer_lighting;
 use crate::site::render::{SiteLightingOptions, site_lighting};
 use crate::site::render_radiosity::{SKY_TOLERANCE, site_solve_params};
@@ -55,7 +58,7 @@ use super::interreflection::{GatherPoint, InterreflectionError};
 pub const FALLBACK_GATHER_RAYS: u32 = 4096;
 
 /// What the photo reflectances read for one photo's transfer: its camera and image, and the
-/// site's other photos under the same sun.
+/// site's other photos.
 struct PhotoRead {
     photo: Arc<LoadedPhoto>,
     others: OtherPhotos,
@@ -186,22 +189,25 @@ impl RadiosityInterreflection {
                 let (photo_lighting, _) =
                     site_lighting(&doc, photo, &SiteLightingOptions::default())
                         .map_err(|e| lighting_error(photo, &e))?;
-                let views = read.others.views(PhotoView {
-                    camera: &read.photo.camera,
-                    photo_linear: &read.photo.photo_linear,
-                    lighting: &photo_lighting,
-                });
+                let suns = read
+                    .others
+                    .sun_lights(&doc, &self.natural, &photo_lighting)
+                    .map_err(|e| lighting_error(photo, &e))?;
+                let views = read.others.views(
+                    PhotoView {
+                        camera: &read.photo.camera,
+                        photo_linear: &read.photo.photo_linear,
+                        lighting: &photo_lighting,
+                    },
+                    &suns.reading,
+                );
                 let mut refit = PhotoRefit::new(PhotoSamples::from_views(
                     &transfer.solution().mesh,
                     tracer,
                     &views,
                 ));
-                for _ in 0..REFIT_ROUNDS {
-                    let rho = refit.next_round(transfer.solution());
-                    transfer
-                        .set_element_reflectances(&rho)
-                        .map_err(|e| lighting_error(photo, &e))?;
-                }
+                refit_transfer(transfer, &mut refit, &suns.transfer, REFIT_ROUNDS)
+                    .map_err(|e| lighting_error(photo, &e))?;
             }
             let solution = transfer.solution();
             let gathered =

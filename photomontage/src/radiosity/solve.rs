@@ -78,6 +78,10 @@ pub struct LightGroup {
     /// the sky transfer of this sky (module `sky_transfer`) instead of tracing the clusters,
     /// which still light the ground below the horizon and point queries.
     pub sky: Option<SkyLight>,
+    /// Whether its light takes part in the hierarchical solver's link refinement (true as
+    /// built); a group carried on links refined for other groups' light says false (another
+    /// sun the site's photo reflectances read, `site::render_radiosity`).
+    pub refines_links: bool,
 }
 
 /// A sky as a transfer relights it: its model, the sun it follows and its weight.
@@ -104,6 +108,7 @@ impl LightGroup {
             points: Vec::new(),
             emission: false,
             sky: None,
+            refines_links: true,
         }
     }
 
@@ -116,6 +121,7 @@ impl LightGroup {
             points: Vec::new(),
             emission: false,
             sky: None,
+            refines_links: true,
         }
     }
 
@@ -128,6 +134,7 @@ impl LightGroup {
             points: Vec::new(),
             emission: true,
             sky: None,
+            refines_links: true,
         }
     }
 
@@ -140,6 +147,7 @@ impl LightGroup {
             points: vec![source],
             emission: false,
             sky: None,
+            refines_links: true,
         }
     }
 }
@@ -317,6 +325,27 @@ impl Solution {
         Self {
             mesh: Arc::clone(&self.mesh),
             groups,
+            interactions: self.interactions,
+            refinement: self.refinement.clone(),
+            warnings: self.warnings.clone(),
+            locator: std::sync::OnceLock::new(),
+            query_geometry: self.query_geometry.clone(),
+        }
+    }
+
+    /// The solution of the groups whose indices `keep` keeps (in order), on the same mesh and
+    /// links: a solve that carried several lightings as groups, read one lighting at a time.
+    #[must_use]
+    pub fn groups_where(&self, keep: impl Fn(usize) -> bool) -> Self {
+        Self {
+            mesh: Arc::clone(&self.mesh),
+            groups: self
+                .groups
+                .iter()
+                .enumerate()
+                .filter(|(g, _)| keep(*g))
+                .map(|(_, g)| g.clone())
+                .collect(),
             interactions: self.interactions,
             refinement: self.refinement.clone(),
             warnings: self.warnings.clone(),
@@ -504,7 +533,9 @@ pub fn solve_on_mesh_twinned(
             });
             direct
         } else {
-            group_direct(&engine, group, g as u64, ground.as_ref(), None, None)?
+            // A later sky reads the first sky's rays, as a transfer's relight does.
+            let first_sky = sky_rays.as_ref().map(|s| &s.transfer);
+            group_direct(&engine, group, g as u64, ground.as_ref(), None, first_sky)?
         };
         b0s.push(initial_exitance(&mesh, &direct, group.emission));
         directs.push(direct);
@@ -531,8 +562,15 @@ pub fn solve_on_mesh_twinned(
             interactions = cache.rows_computed * n as u64;
         }
         Solver::Hierarchical(h) => {
+            // The links are refined for the light of the groups that refine them (all, where
+            // none says so).
+            let refining = groups.iter().any(|g| g.refines_links);
             let mut b0_all = vec![[0.0; 3]; n];
-            for b0 in &b0s {
+            for (_, b0) in groups
+                .iter()
+                .zip(&b0s)
+                .filter(|(g, _)| g.refines_links || !refining)
+            {
                 for (t, b) in b0_all.iter_mut().zip(b0) {
                     for c in 0..3 {
                         t[c] += b[c];

@@ -389,6 +389,7 @@ fn bad_input_and_cancel() {
         points: Vec::new(),
         emission: false,
         sky: None,
+        refines_links: true,
     }];
     let err = solve(
         &scene,

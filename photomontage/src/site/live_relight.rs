@@ -38,8 +38,10 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
-use super::other_photos::OtherPhotos;
-use super::photo_reflectance::{PhotoRefit, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS};
+use super::other_photos::other_photos_for;
+use super::photo_reflectance::{
+    PhotoRefit, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS, refit_transfer,
+};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
 use super::render_radiosity::{
@@ -347,7 +349,8 @@ impl SiteTransfers {
     }
 
     /// [`SiteTransfers::from_inputs`] with `photo` and, as `site_radiosity_light` reads them,
-    /// the site's other photos under the same sun where `photo` does not see.
+    /// the site's other photos where `photo` does not see, each under the sun of its capture
+    /// time.
     fn from_site_inputs(
         doc: &SiteDocument,
         view: &str,
@@ -356,14 +359,24 @@ impl SiteTransfers {
         cancel: &AtomicBool,
         start: Instant,
     ) -> Result<Self, SiteRenderError> {
-        let others = photo.map(|_| OtherPhotos::load(doc, view));
-        let views = photo.zip(others.as_ref()).map(|(p, o)| o.views(*p));
-        Self::from_inputs(inputs, views.as_ref(), cancel, start)
+        let others = other_photos_for(doc, &inputs.scenes[0], view, photo)?;
+        let views = photo
+            .zip(others.as_ref())
+            .map(|(p, (o, l))| (o.views(*p, &l.reading), &l.transfer[..]));
+        Self::from_inputs(
+            inputs,
+            views.as_ref().map(|(v, suns)| (v, *suns)),
+            cancel,
+            start,
+        )
     }
 
+    /// The transfers of `inputs`; with `photo`, the photo reflectances read off its views,
+    /// those taken under other suns against the natural transfer relit to each of the given
+    /// lightings ([`refit_transfer`]).
     fn from_inputs(
         inputs: Inputs,
-        photo: Option<&PhotoViews<'_>>,
+        photo: Option<(&PhotoViews<'_>, &[TransferLighting])>,
         cancel: &AtomicBool,
         start: Instant,
     ) -> Result<Self, SiteRenderError> {
@@ -402,21 +415,21 @@ impl SiteTransfers {
         // As `site_radiosity_light`: the natural elements the photo sees take its ρ_d, refitted
         // on the photographed state, then carried to the same elements with the objects.
         let mut photo_reflectance = None;
-        if let Some(view) = photo {
+        if let Some((view, other_suns)) = photo {
             let samples = PhotoSamples::from_views(
                 &without_artificial.transfer.solution().mesh,
                 &natural_tracer,
                 view,
             );
-            notes.extend(samples.notes());
             let mut refit = PhotoRefit::new(samples);
-            for _ in 0..REFIT_ROUNDS {
-                let rho = refit.next_round(without_artificial.transfer.solution());
-                without_artificial
-                    .transfer
-                    .set_element_reflectances(&rho)
-                    .map_err(|e| radiosity_error(&e))?;
-            }
+            refit_transfer(
+                &mut without_artificial.transfer,
+                &mut refit,
+                other_suns,
+                REFIT_ROUNDS,
+            )
+            .map_err(|e| radiosity_error(&e))?;
+            notes.extend(refit.notes());
             photo_reflectance = refit.count();
             if photo_reflectance.is_some_and(|c| c.from_photo > 0) {
                 let rho = same_elements(

@@ -7,7 +7,7 @@ use nalgebra::Point3;
 use super::*;
 use crate::radiosity::{NamedLuminaire, PointSource, RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL};
 use crate::site::render::site_scene;
-use crate::site::render::tests::fixture;
+use crate::site::render::tests::{fixture, fixture_with_photo_from_above};
 use crate::site::render_radiosity::site_radiosity_light;
 use crate::site::{SiteMaterial, SkyModelName, SunManual};
 
@@ -329,3 +329,102 @@ fn a_studio_sun_move_is_each_transfers_own_relight_bit_for_bit() {
         }
     }
 }
+
+#[test]
+fn a_photo_taken_at_another_time_is_read_under_its_sun_by_the_render_and_the_studio_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let cancel = AtomicBool::new(false);
+    let read = |doc: &SiteDocument| {
+        let job = crate::site::render::prepare_view(doc, "p1").unwrap();
+        let photo = crate::site::photo_reflectance::PhotoView {
+            camera: &job.camera,
+            photo_linear: &job.photo_linear,
+            lighting: &job.lighting,
+        };
+        let scene = &job.scene.scene;
+        let (render, report) =
+            site_radiosity_light(doc, scene, "p1", Some(&photo), &cancel).unwrap();
+        let mut slot = None;
+        let (studio, _) =
+            SiteTransfers::update(&mut slot, doc, scene, "p1", Some(&photo), &cancel).unwrap();
+        let studio_report = slot.unwrap().report;
+        (render, report, studio, studio_report)
+    };
+    // Low in the west (≈ 20° up) where p1 has it ≈ 40° up in the south-east.
+    let afternoon = fixture_with_photo_from_above(dir.path(), "18:14");
+    let (render, report, studio, studio_report) = read(&afternoon);
+    let count = report.photo_reflectance.unwrap();
+    println!("{count:?}; {:?}", report.notes);
+    assert!(count.from_other_photos > 5, "{count:?}");
+    let note = "photo reflectance: photo p2 read on ";
+    let p2_note = report.notes.iter().find(|n| n.starts_with(note)).unwrap();
+    assert!(
+        p2_note.contains("(read under the sun of its own capture time); exposure not checked"),
+        "{p2_note}"
+    );
+    // The studio reads p2 against its transfer relit to p2's sun: the same elements, the same
+    // values within the relight tolerances.
+    assert_eq!(
+        studio_report.photo_reflectance.unwrap().from_other_photos,
+        count.from_other_photos
+    );
+    assert!(
+        studio_report.notes.contains(p2_note),
+        "{:?}",
+        studio_report.notes
+    );
+    let rho = |s: &Solution| s.mesh.element_reflectance_overrides();
+    let (render_rho, studio_rho) = (
+        rho(&render.without_artificial),
+        rho(&studio.without_artificial),
+    );
+    let mut largest = 0.0_f64;
+    for (a, b) in render_rho.iter().zip(&studio_rho) {
+        assert_eq!(a.is_some(), b.is_some());
+        if let (Some(a), Some(b)) = (a, b) {
+            for c in 0..3 {
+                largest = largest.max((a[c] / b[c] - 1.0).abs());
+            }
+        }
+    }
+    println!("largest relative difference of ρ_d, render against studio: {largest:.2e}");
+    assert!(largest < STUDIO_RHO_REL_TOL, "{largest}");
+    assert_matches_fresh_solve(
+        "without",
+        &studio.without_artificial,
+        &render.without_artificial,
+    );
+    // The photographed state carries the rendered photo's light only.
+    assert_eq!(
+        render.without_artificial.groups.len(),
+        studio.without_artificial.groups.len()
+    );
+
+    // Read as if taken at p1's time, the elements only p2 sees take other values: p2's sun
+    // lights them otherwise (the test can fail).
+    let (same, same_report, _, _) = read(&fixture_with_photo_from_above(dir.path(), "10:44"));
+    let note = same_report
+        .notes
+        .iter()
+        .find(|n| n.starts_with("photo reflectance: photo p2 read on "))
+        .unwrap();
+    assert!(!note.contains("its own capture time"), "{note}");
+    let same_rho = rho(&same.without_artificial);
+    let moved = render_rho
+        .iter()
+        .zip(&same_rho)
+        .filter(|(a, b)| match (a, b) {
+            (Some(a), Some(b)) => (a[0] / b[0] - 1.0).abs() > 0.05,
+            _ => false,
+        })
+        .count();
+    assert!(
+        moved * 2 > count.from_other_photos,
+        "{moved} of {}",
+        count.from_other_photos
+    );
+}
+
+/// ρ_d read against the studio's relit transfer and the render's solve: both solves' fixed
+/// points agree within the relight tolerances (≈ 1 %), which reach ρ_d through E_rad.
+const STUDIO_RHO_REL_TOL: f64 = 0.02;

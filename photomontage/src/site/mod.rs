@@ -26,6 +26,7 @@ pub mod photo_points;
 pub mod photo_reflectance;
 #[cfg(test)]
 mod photo_reflectance_tests;
+mod photo_views;
 pub mod radiosity_lighting;
 pub mod render;
 pub mod render_error;

@@ -19,79 +19,69 @@
 //! - An element with at least [`MIN_SEEN_SAMPLES`] counted samples takes, per channel, the median
 //!   of its samples' ρ_d, clamped to [0, 1].
 //! - An element the rendered photo sees at fewer points takes its samples from the first of the
-//!   site's other solved photos taken under the same sun ([`super::other_photos`]) that sees it at
-//!   enough ([`PhotoSamples::from_views`]), read with the rendered view's lighting. Such a photo
-//!   is read only if its exposure agrees: at the sample points both photos see, the median ratio
-//!   of its true colours to the rendered photo's is within [`EXPOSURE_TOLERANCE`] of 1 in every
-//!   channel (a Lambertian surface shows one radiance to every camera). The other elements keep
-//!   the library's value.
+//!   site's other solved photos ([`super::other_photos`]) that sees it at enough
+//!   ([`PhotoSamples::from_views`]). Each photo is read in the light it was taken in: its own
+//!   sun's shadow rays, and E_rad from the solution for its sun (photos taken at another time
+//!   are read against a solution lit by the sun of their capture time,
+//!   [`super::render_radiosity`], [`refit_transfer`]). Such a photo is read only if its exposure
+//!   agrees: at the sample points both photos see, the median ratio of the reflectance it reads
+//!   to the rendered photo's is within [`EXPOSURE_TOLERANCE`] of 1 in every channel (a
+//!   Lambertian surface has one ρ_d, whatever the light and the camera; under the same sun this
+//!   is the ratio of their true colours). The other elements keep the library's value.
 //!
 //! E_nat's interreflected part depends on the surroundings' ρ_d, so the solve is refitted
 //! ([`crate::radiosity::solve_on_mesh_refitting`]): solved with the library's values, then
 //! [`REFIT_ROUNDS`] times with the photo's. The samples (rays, photo colours, sun) are taken
-//! once; a round only reads the new solution.
+//! once; a round only reads the new solutions, and checks the exposures again against them.
 //!
 //! # Known limitations
-//! Photos taken under another sun are not read ([`super::other_photos`]). An element seen by
-//! both the rendered photo and an other takes the rendered photo's samples only. What the model
-//! lacks (a parked car, a tree in front of a wall) is read as the surface behind it; the median
-//! over the samples keeps a small intrusion out. The element's sky and interreflected light is
-//! its mean, not the value at the sample.
+//! An element seen by both the rendered photo and an other takes the rendered photo's samples
+//! only. What the model lacks (a parked car, a tree in front of a wall) is read as the surface
+//! behind it; the median over the samples keeps a small intrusion out. The element's sky and
+//! interreflected light is its mean, not the value at the sample; the mesh follows the shadow
+//! edges of the rendered photo's sun only, so under another sun an element across its shadow
+//! edge has the mean of both sides (the sun itself is traced exactly at every sample).
 
-use image::Rgb32FImage;
-use nalgebra::{Point2, Point3, Vector3};
 use rayon::prelude::*;
 
-use crate::camera::Camera;
-use crate::radiosity::{Mesh, Solution};
-use crate::render::Lighting;
+use crate::radiosity::{
+    LightingChange, Mesh, RadiosityError, Solution, Transfer, TransferLighting,
+};
 use crate::render::differential::radiosity_light::RadiosityLight;
-use crate::render::differential::true_colour_rgb;
-use crate::render::illumination::{diffuse_reflectance_from_true_colour, natural_irradiance_rgb};
+use crate::render::illumination::diffuse_reflectance_from_true_colour;
 use crate::scene::SceneTracer;
+
+use super::photo_views::{ElementRead, Sample, read_element};
+pub use super::photo_views::{
+    MIN_SEEN_SAMPLES, OtherView, PhotoView, PhotoViews, SAMPLES_PER_AXIS, SEEN_TOLERANCE_M,
+};
 
 type Rgb = [f64; 3];
 
-/// Sample points per element along each axis of the unit square (Shirley's warp onto the
-/// triangle).
-pub const SAMPLES_PER_AXIS: usize = 3;
-/// An element takes its ρ_d from the photo when at least this many of its samples are seen:
-/// more than half, so that an element mostly hidden or out of frame keeps the library's.
-pub const MIN_SEEN_SAMPLES: usize = 5;
-/// A sample is seen when the camera's ray to it first meets the natural geometry no nearer than
-/// this (plus 10⁻⁴ of the distance: the `f32` hit) before it, metres.
-pub const SEEN_TOLERANCE_M: f64 = 0.02;
 /// Solves with the photo's reflectances after the first (the second moves ρ_d by well under 1 %
 /// on the street site: docs/methodology.md).
 pub const REFIT_ROUNDS: usize = 2;
 
-/// What the photo gives one sample: its true colour and the part of E_nat that does not depend
-/// on the solution (the sun through its shadow ray, and the ambient term).
-#[derive(Debug, Clone, Copy)]
-struct Sample {
-    true_colour: Rgb,
-    fixed_irradiance: Rgb,
-}
-
-/// The photo as the estimate reads it.
-#[derive(Debug, Clone, Copy)]
-pub struct PhotoView<'a> {
-    /// The photo's solved camera.
-    pub camera: &'a Camera,
-    /// The photo, linear RGB, the camera's size.
-    pub photo_linear: &'a Rgb32FImage,
-    /// The view's lighting (daylight, atmosphere).
-    pub lighting: &'a Lighting,
-}
-
 /// The samples of every element of a photographed-state mesh (module doc).
 #[derive(Debug, Clone)]
 pub struct PhotoSamples {
-    /// Per element, its seen samples (empty when fewer than [`MIN_SEEN_SAMPLES`]).
-    per_element: Vec<Vec<Sample>>,
-    /// Per element, the view its samples are from: 0 the rendered photo, k the k-th other.
+    /// Per element, the rendered photo's seen samples (empty when fewer than
+    /// [`MIN_SEEN_SAMPLES`]).
+    rendered: Vec<Vec<Sample>>,
+    /// Per element the rendered photo does not see, each other view that sees it at enough
+    /// points, in order, with its samples.
+    candidates: Vec<Vec<(usize, Vec<Sample>)>>,
+    /// Per other view, the points it and the rendered photo both see: the element, the
+    /// rendered photo's sample and its own.
+    common: Vec<Vec<(usize, Sample, Sample)>>,
+    /// Per other view, its sun ([`OtherView::sun`]).
+    view_sun: Vec<usize>,
+    /// Suns the views were taken under ([`PhotoViews::suns`]).
+    suns: usize,
+    /// Per element, the view its samples are from: 0 the rendered photo, k the k-th other (as
+    /// of the last [`PhotoSamples::reflectances`]).
     source: Vec<Option<usize>>,
-    /// What each other photo gave.
+    /// What each other photo gave (as of the last [`PhotoSamples::reflectances`]).
     others: Vec<OtherViewRead>,
     /// What the loading of the other photos found.
     load_notes: Vec<String>,
@@ -114,7 +104,7 @@ pub struct PhotoReflectanceCount {
 }
 
 /// The refit's rounds (module doc) for the render's solve and the studio's transfers alike: each
-/// round reads ρ_d off the samples against the latest solution and keeps the count to report,
+/// round reads ρ_d off the samples against the latest solutions and keeps the count to report,
 /// with the change since the round before.
 #[derive(Debug, Clone)]
 pub struct PhotoRefit {
@@ -134,9 +124,12 @@ impl PhotoRefit {
         }
     }
 
-    /// ρ_d per element from `solution` ([`PhotoSamples::reflectances`]).
-    pub fn next_round(&mut self, solution: &Solution) -> Vec<Option<Rgb>> {
-        let (rho, mut count) = self.samples.reflectances(solution);
+    /// ρ_d per element from `solutions`, one per sun ([`PhotoSamples::reflectances`]).
+    ///
+    /// # Panics
+    /// When `solutions` has not one solution per sun of the samples.
+    pub fn next_round(&mut self, solutions: &[&Solution]) -> Vec<Option<Rgb>> {
+        let (rho, mut count) = self.samples.reflectances(solutions);
         if let Some(before) = &self.previous {
             count.mean_change_rel = mean_change_rel(before, &rho);
         }
@@ -150,6 +143,69 @@ impl PhotoRefit {
     pub fn count(&self) -> Option<PhotoReflectanceCount> {
         self.count
     }
+
+    /// The samples' notes as of the last round ([`PhotoSamples::notes`]).
+    #[must_use]
+    pub fn notes(&self) -> Vec<String> {
+        self.samples.notes()
+    }
+
+    /// Suns the samples were taken under ([`PhotoViews::suns`]).
+    #[must_use]
+    pub fn suns(&self) -> usize {
+        self.samples.suns
+    }
+}
+
+/// The lighting change that puts the sun and sky of `lighting` on a transfer.
+fn sun_and_sky_of(lighting: &TransferLighting) -> LightingChange {
+    LightingChange {
+        sun: Some(lighting.sun),
+        sky: Some(lighting.sky.clone()),
+        ..LightingChange::default()
+    }
+}
+
+/// `rounds` of `refit` on `transfer` (the photographed state, lit for the rendered photo): in
+/// each, the transfer is relit to the sun and sky of every other sun of `other_suns` (the
+/// transfer's links and sky rays, [`Transfer::relight`]) for that sun's solution, relit back,
+/// and its elements set to the round's reflectances ([`Transfer::set_element_reflectances`]).
+/// The studio's transfers and the fit's use it; the render's solve reads the other suns as
+/// extra light groups of one solve ([`super::render_radiosity`]).
+///
+/// # Errors
+/// A relight error; [`RadiosityError::InvalidParameter`] when `other_suns` does not give one
+/// lighting per other sun of `refit`.
+pub fn refit_transfer(
+    transfer: &mut Transfer,
+    refit: &mut PhotoRefit,
+    other_suns: &[TransferLighting],
+    rounds: usize,
+) -> Result<(), RadiosityError> {
+    if other_suns.len() + 1 != refit.suns() {
+        return Err(RadiosityError::InvalidParameter {
+            name: "other suns",
+            value: other_suns.len() as f64,
+            reason: "the photo reflectances need one lighting per other sun",
+        });
+    }
+    let home = sun_and_sky_of(transfer.lighting());
+    for _ in 0..rounds {
+        let mut relit = Vec::with_capacity(other_suns.len());
+        for lighting in other_suns {
+            transfer.relight_in_place(&sun_and_sky_of(lighting))?;
+            relit.push(transfer.solution().clone());
+        }
+        if !other_suns.is_empty() {
+            transfer.relight_in_place(&home)?;
+        }
+        let solutions: Vec<&Solution> = std::iter::once(transfer.solution())
+            .chain(relit.iter())
+            .collect();
+        let rho = refit.next_round(&solutions);
+        transfer.set_element_reflectances(&rho)?;
+    }
+    Ok(())
 }
 
 /// The mean over elements valued in both of the largest relative change of a channel from
@@ -175,78 +231,33 @@ fn mean_change_rel(before: &[Option<Rgb>], after: &[Option<Rgb>]) -> f64 {
     }
 }
 
-/// One of the site's other solved photos as the estimate reads it ([`PhotoSamples::from_views`]).
-#[derive(Debug, Clone, Copy)]
-pub struct OtherView<'a> {
-    /// The photo's id, for the notes.
-    pub id: &'a str,
-    /// Its camera and photo; the lighting is the rendered view's (the photo was taken under the
-    /// same sun, [`super::other_photos`]).
-    pub view: PhotoView<'a>,
-}
-
-/// The rendered photo and the site's other solved photos taken under the same light.
-#[derive(Debug, Clone)]
-pub struct PhotoViews<'a> {
-    /// The photo being rendered: read first.
-    pub rendered: PhotoView<'a>,
-    /// The others, read in this order where the rendered photo does not see an element.
-    pub others: Vec<OtherView<'a>>,
-    /// What the loading of the others found (a photo not solved, under another sun, unreadable).
-    pub notes: Vec<String>,
-}
-
-impl<'a> PhotoViews<'a> {
-    /// The rendered photo alone.
-    #[must_use]
-    pub fn single(rendered: PhotoView<'a>) -> Self {
-        Self {
-            rendered,
-            others: Vec::new(),
-            notes: Vec::new(),
-        }
-    }
-}
-
-/// What one other photo gave ([`PhotoSamples::from_views`]).
+/// What one other photo gave ([`PhotoSamples::reflectances`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct OtherViewRead {
     /// The photo's id.
     pub id: String,
+    /// Its sun ([`OtherView::sun`]).
+    pub sun: usize,
     /// Sample points both it and the rendered photo see.
     pub common_samples: usize,
-    /// Per channel, the median over those points of its true colour over the rendered photo's
-    /// (`None` with fewer than [`MIN_COMMON_SAMPLES`]).
+    /// Per channel, the median over those points of the reflectance it reads over the rendered
+    /// photo's (`None` with fewer than [`MIN_COMMON_SAMPLES`] points, or before the first
+    /// round).
     pub exposure_ratio: Option<Rgb>,
-    /// Whether its samples are used ([`EXPOSURE_TOLERANCE`]).
+    /// Whether its samples are used ([`EXPOSURE_TOLERANCE`]; none before the first round).
     pub accepted: bool,
     /// Elements that take their samples from it.
     pub elements: usize,
 }
 
-/// An other photo is read only when its true colours agree with the rendered photo's at the
-/// points both see within this, per channel (median ratio): the model reads ρ_d = π·L₀ / E_nat
-/// with one lighting, so a photo exposed or white-balanced differently would bring its own scale.
+/// An other photo is read only when the reflectances it reads agree with the rendered photo's at
+/// the points both see within this, per channel (median ratio): a photo exposed or
+/// white-balanced differently would bring its own scale.
 pub const EXPOSURE_TOLERANCE: f64 = 0.05;
 /// The exposure check needs this many sample points seen by both photos; with fewer the other
 /// photo is read unchecked (a note says so), as the daylight fit reads every photo with one set
 /// of weights.
 pub const MIN_COMMON_SAMPLES: usize = 100;
-/// True colours below this (linear, per channel) are left out of the exposure ratios.
-const MIN_RATIO_COLOUR: f64 = 1e-3;
-
-/// What one element's sample points gave in every view.
-#[derive(Default)]
-struct ElementRead {
-    /// The rendered photo's samples.
-    rendered: Vec<Sample>,
-    /// Per other view with enough seen samples (where the rendered photo has too few): its
-    /// index in `others` and its samples.
-    candidates: Vec<(usize, Vec<Sample>)>,
-    /// Per point seen by the rendered photo and an other: the other's index and the ratio of
-    /// their true colours.
-    ratios: Vec<(usize, Rgb)>,
-}
 
 impl PhotoSamples {
     /// Samples the elements of `mesh` (the photographed state: natural objects only, traced by
@@ -257,67 +268,49 @@ impl PhotoSamples {
     }
 
     /// Samples the elements of `mesh` in the rendered photo of `views`, and where it sees an
-    /// element at fewer than [`MIN_SEEN_SAMPLES`] points, in the first other photo (in order)
-    /// that sees it at enough, if that photo's exposure agrees with the rendered one's
-    /// ([`EXPOSURE_TOLERANCE`]) at the points both see.
+    /// element at fewer than [`MIN_SEEN_SAMPLES`] points, in every other photo that sees it at
+    /// enough; which of those is read (the first whose exposure agrees with the rendered
+    /// photo's, [`EXPOSURE_TOLERANCE`]) is decided by each [`PhotoSamples::reflectances`],
+    /// which has the solutions the check needs.
     #[must_use]
     pub fn from_views(mesh: &Mesh, natural: &SceneTracer, views: &PhotoViews<'_>) -> Self {
-        let lighting = views.rendered.lighting;
         let reads: Vec<ElementRead> = (0..mesh.elements.len())
             .into_par_iter()
-            .map(|e| read_element(mesh, e, natural, lighting, views))
+            .map(|e| read_element(mesh, e, natural, views))
             .collect();
-        let mut others: Vec<OtherViewRead> = views
+        let mut common: Vec<Vec<(usize, Sample, Sample)>> = vec![Vec::new(); views.others.len()];
+        let mut rendered = Vec::with_capacity(reads.len());
+        let mut candidates = Vec::with_capacity(reads.len());
+        for (e, r) in reads.into_iter().enumerate() {
+            for (k, a, b) in r.common {
+                common[k].push((e, a, b));
+            }
+            rendered.push(r.rendered);
+            candidates.push(r.candidates);
+        }
+        let source = rendered
+            .iter()
+            .map(|s| (!s.is_empty()).then_some(0))
+            .collect();
+        let others = views
             .others
             .iter()
-            .enumerate()
-            .map(|(k, other)| {
-                let ratios: Vec<Rgb> = reads
-                    .iter()
-                    .flat_map(|r| r.ratios.iter().filter(|(v, _)| *v == k).map(|(_, q)| *q))
-                    .collect();
-                let exposure_ratio = (ratios.len() >= MIN_COMMON_SAMPLES).then(|| {
-                    let mut column: Vec<f64> = Vec::with_capacity(ratios.len());
-                    std::array::from_fn(|c| {
-                        column.clear();
-                        column.extend(ratios.iter().map(|q| q[c]));
-                        column.sort_by(f64::total_cmp);
-                        column[column.len() / 2]
-                    })
-                });
-                OtherViewRead {
-                    id: other.id.to_owned(),
-                    common_samples: ratios.len(),
-                    exposure_ratio,
-                    accepted: exposure_ratio
-                        .is_none_or(|q| q.iter().all(|r| (r - 1.0).abs() <= EXPOSURE_TOLERANCE)),
-                    elements: 0,
-                }
-            })
-            .collect();
-        let mut source = Vec::with_capacity(reads.len());
-        let per_element = reads
-            .into_iter()
-            .map(|r| {
-                if !r.rendered.is_empty() {
-                    source.push(Some(0));
-                    return r.rendered;
-                }
-                match r.candidates.into_iter().find(|(k, _)| others[*k].accepted) {
-                    Some((k, samples)) => {
-                        others[k].elements += 1;
-                        source.push(Some(k + 1));
-                        samples
-                    }
-                    None => {
-                        source.push(None);
-                        Vec::new()
-                    }
-                }
+            .zip(&common)
+            .map(|(o, c)| OtherViewRead {
+                id: o.id.to_owned(),
+                sun: o.sun,
+                common_samples: c.len(),
+                exposure_ratio: None,
+                accepted: false,
+                elements: 0,
             })
             .collect();
         Self {
-            per_element,
+            rendered,
+            candidates,
+            common,
+            view_sun: views.others.iter().map(|o| o.sun).collect(),
+            suns: views.suns(),
             source,
             others,
             load_notes: views.notes.clone(),
@@ -325,20 +318,22 @@ impl PhotoSamples {
     }
 
     /// Per element, the view its samples are from: `Some(0)` the rendered photo, `Some(k)` the
-    /// k-th other photo, `None` where none sees it at enough points.
+    /// k-th other photo, `None` where none sees it at enough points (or, before the first
+    /// [`PhotoSamples::reflectances`], none but the rendered photo is read).
     #[must_use]
     pub fn sources(&self) -> &[Option<usize>] {
         &self.source
     }
 
-    /// What each other photo gave.
+    /// What each other photo gave (as of the last [`PhotoSamples::reflectances`]).
     #[must_use]
     pub fn other_views(&self) -> &[OtherViewRead] {
         &self.others
     }
 
     /// The notes for the report: what the loading of the other photos found, and per other
-    /// photo what it gave or why it was not read.
+    /// photo what it gave or why it was not read (as of the last
+    /// [`PhotoSamples::reflectances`]).
     #[must_use]
     pub fn notes(&self) -> Vec<String> {
         let mut notes = self.load_notes.clone();
@@ -352,14 +347,19 @@ impl PhotoSamples {
                 },
                 |q| {
                     format!(
-                        "its true colours over the rendered photo's {:.3}, {:.3}, {:.3} (median over {} points both see)",
+                        "the reflectances it reads over the rendered photo's {:.3}, {:.3}, {:.3} (median over {} points both see)",
                         q[0], q[1], q[2], o.common_samples
                     )
                 },
             );
+            let sun = if o.sun > 0 {
+                " (read under the sun of its own capture time)"
+            } else {
+                ""
+            };
             notes.push(if o.accepted {
                 format!(
-                    "photo reflectance: photo {} read on {} elements the rendered photo does not see; {ratio}",
+                    "photo reflectance: photo {} read on {} elements the rendered photo does not see{sun}; {ratio}",
                     o.id, o.elements
                 )
             } else {
@@ -373,27 +373,98 @@ impl PhotoSamples {
         notes
     }
 
-    /// Elements with enough seen samples.
+    /// Elements with enough seen samples in the photos read (as of the last
+    /// [`PhotoSamples::reflectances`]).
     #[must_use]
     pub fn seen_elements(&self) -> usize {
-        self.per_element.iter().filter(|s| !s.is_empty()).count()
+        self.source.iter().filter(|s| s.is_some()).count()
     }
 
-    /// ρ_d per element of `solution` (the photographed state solved on the sampled mesh): the
-    /// median over its samples of π·L₀ / (E_fixed + E_rad), E_rad the element's sky and
-    /// interreflected irradiance; `None` where the photo does not see the element or no light
-    /// reaches it.
-    #[must_use]
-    pub fn reflectances(&self, solution: &Solution) -> (Vec<Option<Rgb>>, PhotoReflectanceCount) {
-        let sky_and_bounce = sky_and_bounce_per_element(solution);
-        let rho: Vec<Option<(Rgb, bool)>> = (0..self.per_element.len())
+    /// Checks every other photo's exposure against `e_rad` (per sun, per element) and decides
+    /// which view each element's samples come from (module doc).
+    fn decide(&mut self, e_rad: &[Vec<Rgb>]) {
+        for (k, o) in self.others.iter_mut().enumerate() {
+            let sun = self.view_sun[k];
+            let ratios: Vec<Rgb> = self.common[k]
+                .iter()
+                .filter_map(|(e, r, s)| {
+                    let q: [Option<f64>; 3] = std::array::from_fn(|c| {
+                        let e_r = r.fixed_irradiance[c] + e_rad[0][*e][c];
+                        let e_s = s.fixed_irradiance[c] + e_rad[sun][*e][c];
+                        (e_r > 0.0 && e_s > 0.0)
+                            .then(|| (s.true_colour[c] / e_s) / (r.true_colour[c] / e_r))
+                    });
+                    Some([q[0]?, q[1]?, q[2]?])
+                })
+                .collect();
+            o.exposure_ratio = (ratios.len() >= MIN_COMMON_SAMPLES).then(|| {
+                let mut column: Vec<f64> = Vec::with_capacity(ratios.len());
+                std::array::from_fn(|c| {
+                    column.clear();
+                    column.extend(ratios.iter().map(|q| q[c]));
+                    column.sort_by(f64::total_cmp);
+                    column[column.len() / 2]
+                })
+            });
+            o.accepted = o
+                .exposure_ratio
+                .is_none_or(|q| q.iter().all(|r| (r - 1.0).abs() <= EXPOSURE_TOLERANCE));
+            o.elements = 0;
+        }
+        for (e, source) in self.source.iter_mut().enumerate() {
+            *source = if self.rendered[e].is_empty() {
+                self.candidates[e]
+                    .iter()
+                    .find(|(k, _)| self.others[*k].accepted)
+                    .map(|(k, _)| {
+                        self.others[*k].elements += 1;
+                        k + 1
+                    })
+            } else {
+                Some(0)
+            };
+        }
+    }
+
+    /// The samples element `e` is read from ([`PhotoSamples::sources`]) and their sun.
+    fn samples_of(&self, e: usize) -> Option<(&[Sample], usize)> {
+        match self.source[e]? {
+            0 => Some((&self.rendered[e], 0)),
+            k => self.candidates[e]
+                .iter()
+                .find(|(c, _)| *c == k - 1)
+                .map(|(_, s)| (s.as_slice(), self.view_sun[k - 1])),
+        }
+    }
+
+    /// ρ_d per element from `solutions` (the photographed state solved on the sampled mesh, one
+    /// solution per sun: the rendered photo's first, [`PhotoViews::suns`]): the median over its
+    /// samples of π·L₀ / (E_fixed + E_rad), E_rad the element's sky and interreflected
+    /// irradiance under the samples' sun; `None` where no photo read sees the element or no
+    /// light reaches it. Each call checks the other photos' exposures again
+    /// ([`PhotoSamples::from_views`]).
+    ///
+    /// # Panics
+    /// When `solutions` has not one solution per sun.
+    pub fn reflectances(
+        &mut self,
+        solutions: &[&Solution],
+    ) -> (Vec<Option<Rgb>>, PhotoReflectanceCount) {
+        assert_eq!(
+            solutions.len(),
+            self.suns,
+            "one solution per sun of the photos read"
+        );
+        let e_rad: Vec<Vec<Rgb>> = solutions
+            .iter()
+            .map(|s| sky_and_bounce_per_element(s))
+            .collect();
+        self.decide(&e_rad);
+        let rho: Vec<Option<(Rgb, bool)>> = (0..self.rendered.len())
             .into_par_iter()
             .map(|e| {
-                let samples = &self.per_element[e];
-                if samples.is_empty() {
-                    return None;
-                }
-                let e_rad = sky_and_bounce[e];
+                let (samples, sun) = self.samples_of(e)?;
+                let e_rad = e_rad[sun][e];
                 let values: Vec<Rgb> = samples
                     .iter()
                     .filter_map(|s| {
@@ -434,109 +505,6 @@ impl PhotoSamples {
     }
 }
 
-/// The samples of element `e` of `mesh` in every view of `views` (module doc,
-/// [`PhotoSamples::from_views`]).
-fn read_element(
-    mesh: &Mesh,
-    e: usize,
-    natural: &SceneTracer,
-    lighting: &Lighting,
-    views: &PhotoViews<'_>,
-) -> ElementRead {
-    let node = mesh.element_node(e);
-    let normal = node.normal_in_world;
-    let step = 1.0 / SAMPLES_PER_AXIS as f64;
-    let mut read = ElementRead::default();
-    let mut other_samples: Vec<Vec<Sample>> = vec![Vec::new(); views.others.len()];
-    for i in 0..SAMPLES_PER_AXIS {
-        for j in 0..SAMPLES_PER_AXIS {
-            let point = node.point_at((i as f64 + 0.5) * step, (j as f64 + 0.5) * step);
-            // The sun's shadow ray, once per point for every view that sees it.
-            let mut fixed: Option<Rgb> = None;
-            let mut fixed_irradiance = || {
-                *fixed.get_or_insert_with(|| fixed_irradiance(natural, lighting, &point, &normal))
-            };
-            let rendered = true_colour_seen(&views.rendered, natural, &point, &normal);
-            if let Some(true_colour) = rendered {
-                read.rendered.push(Sample {
-                    true_colour,
-                    fixed_irradiance: fixed_irradiance(),
-                });
-            }
-            for (k, other) in views.others.iter().enumerate() {
-                let Some(true_colour) = true_colour_seen(&other.view, natural, &point, &normal)
-                else {
-                    continue;
-                };
-                if let Some(t0) = rendered.filter(|t0| {
-                    (0..3).all(|c| t0[c] > MIN_RATIO_COLOUR && true_colour[c] > MIN_RATIO_COLOUR)
-                }) {
-                    read.ratios
-                        .push((k, std::array::from_fn(|c| true_colour[c] / t0[c])));
-                }
-                other_samples[k].push(Sample {
-                    true_colour,
-                    fixed_irradiance: fixed_irradiance(),
-                });
-            }
-        }
-    }
-    if read.rendered.len() < MIN_SEEN_SAMPLES {
-        read.rendered.clear();
-        read.candidates = other_samples
-            .into_iter()
-            .enumerate()
-            .filter(|(_, s)| s.len() >= MIN_SEEN_SAMPLES)
-            .collect();
-    }
-    read
-}
-
-/// The true colour `view`'s photo shows at `point` (normal `normal`) where it faces the camera,
-/// projects inside the photo and is the first natural surface on the camera's ray (module doc).
-fn true_colour_seen(
-    view: &PhotoView<'_>,
-    natural: &SceneTracer,
-    point: &Point3<f64>,
-    normal: &Vector3<f64>,
-) -> Option<Rgb> {
-    let centre = view.camera.pose.camera_center_in_world;
-    let to_camera = centre - point;
-    let distance_m = to_camera.norm();
-    if normal.dot(&to_camera) <= 0.0 || distance_m <= 0.0 {
-        return None;
-    }
-    let pixel = view.camera.project(point)?;
-    let (width, height) = view.photo_linear.dimensions();
-    let rgb = photo_pixel(view.photo_linear, pixel, width, height)?;
-    if !seen(natural, &centre, point, distance_m) {
-        return None;
-    }
-    Some(true_colour_rgb(view.lighting, rgb, distance_m))
-}
-
-/// The part of E_nat at `point` that does not depend on the solution: the sun through its
-/// shadow ray against the natural geometry, and the ambient term.
-fn fixed_irradiance(
-    natural: &SceneTracer,
-    lighting: &Lighting,
-    point: &Point3<f64>,
-    normal: &Vector3<f64>,
-) -> Rgb {
-    let daylight = &lighting.daylight;
-    let origin = point + normal * crate::radiosity::shadow_refinement::SURFACE_OFFSET_M;
-    let sun_visible = daylight.sun.as_ref().is_some_and(|s| {
-        s.dir_in_world.dot(normal) > 0.0
-            && !natural.any_hit(&natural.ray_from_world(
-                &origin,
-                &s.dir_in_world,
-                0.0,
-                f32::INFINITY,
-            ))
-    });
-    natural_irradiance_rgb(daylight, normal, sun_visible, |_| false)
-}
-
 /// The sky and interreflected irradiance per element of `solution`: every group's irradiance
 /// with the direct light of the groups the renderer traces itself (the sun, the luminaires)
 /// taken out, as case D's E_rad,without.
@@ -552,25 +520,4 @@ pub fn sky_and_bounce_per_element(solution: &Solution) -> Vec<Rgb> {
         }
     }
     sum
-}
-
-/// The photo's linear colour at continuous pixel position `pixel` (pixel (x, y) covers
-/// [x, x+1) × [y, y+1), as the renderer's primary rays); `None` outside the photo.
-fn photo_pixel(photo: &Rgb32FImage, pixel: Point2<f64>, width: u32, height: u32) -> Option<Rgb> {
-    let (x, y) = (pixel.x.floor(), pixel.y.floor());
-    if !(x >= 0.0 && y >= 0.0 && x < f64::from(width) && y < f64::from(height)) {
-        return None;
-    }
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let p = photo.get_pixel(x as u32, y as u32).0;
-    Some(p.map(f64::from))
-}
-
-/// Whether the camera's ray to `point` meets no natural surface before it (module doc).
-fn seen(natural: &SceneTracer, centre: &Point3<f64>, point: &Point3<f64>, distance_m: f64) -> bool {
-    let dir = (point - centre) / distance_m;
-    let ray = natural.ray_from_world(centre, &dir, 0.0, f32::INFINITY);
-    natural
-        .closest_hit(&ray)
-        .is_some_and(|h| f64::from(h.hit.t) >= distance_m - SEEN_TOLERANCE_M - 1e-4 * distance_m)
 }

@@ -11,17 +11,19 @@ use image::Rgb32FImage;
 use nalgebra::Point2;
 
 use super::photo_reflectance::{
-    MIN_COMMON_SAMPLES, OtherView, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS,
-    sky_and_bounce_per_element,
+    EXPOSURE_TOLERANCE, MIN_COMMON_SAMPLES, OtherView, PhotoRefit, PhotoSamples, PhotoView,
+    PhotoViews, REFIT_ROUNDS, sky_and_bounce_per_element,
 };
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render::prepare_view;
 use super::render::tests::fixture;
-use super::render_radiosity::{SKY_TOLERANCE, natural_part, site_solve_params};
+use super::render_radiosity::{
+    SKY_TOLERANCE, natural_part, refit_round_per_sun, site_solve_params,
+};
 use crate::bvh::BuildQuality;
 use crate::camera::{Camera, Intrinsics};
 use crate::radiosity::{
-    Mesh, Rgb, Solution, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
+    LightGroup, Mesh, Rgb, Solution, solve_on_mesh, solve_on_mesh_refitting, sun_directions,
 };
 use crate::render::illumination::natural_irradiance_rgb;
 use crate::scene::SceneTracer;
@@ -119,7 +121,39 @@ impl Truth {
     /// The photo `camera` takes: each pixel centre's natural hit, L = ρ_true/π · E_nat, times
     /// `exposure`.
     fn photo(&self, camera: &Camera, exposure: f64) -> Rgb32FImage {
-        let daylight = &self.job.lighting.daylight;
+        self.photo_under(
+            camera,
+            exposure,
+            &self.job.lighting.daylight,
+            &self.truth,
+            &self.e_rad,
+        )
+    }
+
+    /// The truth's mesh (its reflectances) solved under `groups`, and its E_rad per element.
+    fn solved_under(&self, groups: &[LightGroup]) -> (Solution, Vec<Rgb>) {
+        let solution = solve_on_mesh(
+            (*self.truth.mesh).clone(),
+            &self.tracer,
+            groups,
+            &self.params,
+            &AtomicBool::new(false),
+            &|_| {},
+        )
+        .unwrap();
+        let e_rad = sky_and_bounce_per_element(&solution);
+        (solution, e_rad)
+    }
+
+    /// [`Truth::photo`] under `daylight` (its sun by shadow rays) with E_rad from `truth`.
+    fn photo_under(
+        &self,
+        camera: &Camera,
+        exposure: f64,
+        daylight: &crate::render::Daylight,
+        truth: &Solution,
+        e_rad: &[Rgb],
+    ) -> Rgb32FImage {
         let tracer = &self.tracer;
         let (w, h) = (
             camera.intrinsics.image_size_px[0],
@@ -137,7 +171,7 @@ impl Truth {
             let [a, b, c] =
                 self.scene.triangles()[hit.hit.triangle_id as usize].vertices_in_world_m;
             let normal = (b - a).cross(&(c - a)).normalize();
-            let Some(sample) = self.truth.irradiance_at(&point, &normal) else {
+            let Some(sample) = truth.irradiance_at(&point, &normal) else {
                 return image::Rgb([0.0; 3]);
             };
             let e = sample.element.unwrap();
@@ -154,24 +188,47 @@ impl Truth {
             let fixed = natural_irradiance_rgb(daylight, &normal, sun_visible, |_| false);
             #[allow(clippy::cast_possible_truncation)]
             image::Rgb(std::array::from_fn(|k| {
-                (exposure * self.rho_true[e][k] / std::f64::consts::PI
-                    * (fixed[k] + self.e_rad[e][k])) as f32
+                (exposure * self.rho_true[e][k] / std::f64::consts::PI * (fixed[k] + e_rad[e][k]))
+                    as f32
             }))
         })
     }
 
-    /// The refitted solve's last reflectances from `samples` (library values first).
+    /// The refitted solve's reflectances of every round from `samples` (library values first).
     fn refit(&self, samples: &PhotoSamples) -> Vec<Vec<Option<Rgb>>> {
+        self.refit_suns(samples, &[])
+    }
+
+    /// [`Truth::refit`] with photos taken under a second sun, lit by `other_groups`: one solve
+    /// carries both suns' groups, as the render's ([`refit_round_per_sun`]).
+    fn refit_suns(
+        &self,
+        samples: &PhotoSamples,
+        other_groups: &[LightGroup],
+    ) -> Vec<Vec<Option<Rgb>>> {
         let mut rounds: Vec<Vec<Option<Rgb>>> = Vec::new();
+        let mut photo_refit = PhotoRefit::new(samples.clone());
+        let groups: Vec<LightGroup> = self
+            .groups
+            .iter()
+            .cloned()
+            .chain(other_groups.iter().map(|g| LightGroup {
+                refines_links: false,
+                ..g.clone()
+            }))
+            .collect();
+        let group_sun: Vec<usize> = (0..groups.len())
+            .map(|g| usize::from(g >= self.groups.len()))
+            .collect();
         let mut refit = |s: &Solution| {
-            let (rho, _) = samples.reflectances(s);
+            let rho = refit_round_per_sun(&mut photo_refit, s, &group_sun);
             rounds.push(rho.clone());
             Some(rho)
         };
         let solved = solve_on_mesh_refitting(
             self.mesh(),
             &self.tracer,
-            &self.groups,
+            &groups,
             &self.params,
             &AtomicBool::new(false),
             &|_| {},
@@ -284,6 +341,7 @@ fn with_photo_above<'a>(
                 photo_linear: above_photo,
                 lighting: &truth.job.lighting,
             },
+            sun: 0,
         }],
         notes,
     }
@@ -304,8 +362,12 @@ fn elements_the_rendered_photo_does_not_see_are_read_off_an_other_photo() {
     let views = with_photo_above(&truth, &rendered_photo, &above, &above_photo, Vec::new());
     let rendered = views.rendered;
     let mesh = truth.mesh();
-    let alone = PhotoSamples::new(&mesh, &truth.tracer, &rendered);
-    let both = PhotoSamples::from_views(&mesh, &truth.tracer, &views);
+    let mut alone = PhotoSamples::new(&mesh, &truth.tracer, &rendered);
+    let mut both = PhotoSamples::from_views(&mesh, &truth.tracer, &views);
+    // Which photo each element is read from is decided against a solution.
+    assert!(!both.other_views()[0].accepted);
+    let (_, count) = both.reflectances(&[&truth.truth]);
+    alone.reflectances(&[&truth.truth]);
     // Where the rendered photo sees an element, its samples are kept.
     for (e, s) in alone.sources().iter().enumerate() {
         if s.is_some() {
@@ -341,7 +403,6 @@ fn elements_the_rendered_photo_does_not_see_are_read_off_an_other_photo() {
     assert_eq!(n, n_above);
     assert!(median < MEDIAN_REL_TOL, "median {median}");
     assert!(p95 < ELEMENT_REL_TOL, "95th percentile {p95}");
-    let (_, count) = both.reflectances(&truth.truth);
     assert_eq!(count.from_other_photos, n_above);
     assert_eq!(count.from_photo, both.seen_elements());
 }
@@ -361,7 +422,8 @@ fn an_other_photo_exposed_differently_is_not_read() {
         &above_photo,
         vec!["photo reflectance: photo p3 not read: it is not solved".to_owned()],
     );
-    let both = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &views);
+    let mut both = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &views);
+    both.reflectances(&[&truth.truth]);
     let read = &both.other_views()[0];
     assert!(!read.accepted);
     assert_eq!(read.elements, 0);
@@ -376,9 +438,122 @@ fn an_other_photo_exposed_differently_is_not_read() {
     let notes = both.notes();
     assert_eq!(notes[0], views.notes[0]);
     assert!(
-        notes[1].starts_with("photo reflectance: photo above not read: its true colours over the rendered photo's 1.2"),
+        notes[1].starts_with("photo reflectance: photo above not read: the reflectances it reads over the rendered photo's 1.2"),
         "{}",
         notes[1]
     );
     assert!(notes[1].contains("exposure or white balance differs"));
+}
+
+/// The photo from above taken under another sun (afternoon, 225° / 30°, where the truth's is
+/// 135° / 40°): the elements only it sees come back as the rendered photo's do when it is read
+/// against the solution for its own sun, and not when it is read as if taken under the
+/// rendered photo's.
+#[test]
+fn an_other_photo_taken_under_another_sun_is_read_under_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = Truth::new(dir.path());
+    let mut doc = fixture(dir.path());
+    doc.site.lighting.sun_manual = Some(crate::site::SunManual {
+        azimuth_deg: 225.0,
+        elevation_deg: 30.0,
+    });
+    let mut afternoon = prepare_view(&doc, "p1").unwrap().lighting;
+    afternoon.atmosphere = None;
+    let (lighting, _) = site_transfer_lighting(&doc, &truth.job.scene.scene, "p1").unwrap();
+    let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
+    let (groups, _) = lighting.light_groups(&dome, SKY_TOLERANCE).unwrap();
+    let afternoon_groups: Vec<LightGroup> = groups
+        .into_iter()
+        .filter(|g| !g.name.starts_with("luminaire"))
+        .collect();
+    let (afternoon_truth, afternoon_e_rad) = truth.solved_under(&afternoon_groups);
+    let rendered_photo = truth.photo(&truth.camera, 1.0);
+    let above = camera_above();
+    let above_photo = truth.photo_under(
+        &above,
+        1.0,
+        &afternoon.daylight,
+        &afternoon_truth,
+        &afternoon_e_rad,
+    );
+    // The suns really differ where the photo from above looks: the test can fail.
+    let morning_sun = truth.job.lighting.daylight.sun.unwrap().dir_in_world;
+    let afternoon_sun = afternoon.daylight.sun.unwrap().dir_in_world;
+    assert!(morning_sun.angle(&afternoon_sun).to_degrees() > 60.0);
+
+    let views = PhotoViews {
+        rendered: PhotoView {
+            camera: &truth.camera,
+            photo_linear: &rendered_photo,
+            lighting: &truth.job.lighting,
+        },
+        others: vec![OtherView {
+            id: "above",
+            view: PhotoView {
+                camera: &above,
+                photo_linear: &above_photo,
+                lighting: &afternoon,
+            },
+            sun: 1,
+        }],
+        notes: Vec::new(),
+    };
+    assert_eq!(views.suns(), 2);
+    let samples = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &views);
+    // Against the true solutions the exposures agree (the same ρ_d under both suns).
+    let mut probe = samples.clone();
+    let (_, count) = probe.reflectances(&[&truth.truth, &afternoon_truth]);
+    let read = &probe.other_views()[0];
+    println!("{read:?}; notes {:?}", probe.notes());
+    assert!(read.accepted);
+    assert!(read.common_samples >= MIN_COMMON_SAMPLES);
+    let ratio = read.exposure_ratio.unwrap();
+    assert!(
+        ratio.iter().all(|r| (r - 1.0).abs() < EXPOSURE_RATIO_TOL),
+        "{ratio:?}"
+    );
+    assert!(probe.notes()[0].contains("read under the sun of its own capture time"));
+    let from_above: Vec<bool> = probe.sources().iter().map(|s| *s == Some(1)).collect();
+    let n_above = from_above.iter().filter(|&&a| a).count();
+    assert!(
+        n_above > 30,
+        "{n_above} elements read off the photo from above"
+    );
+    assert_eq!(count.from_other_photos, n_above);
+
+    // The refitted solve carrying both suns recovers them.
+    let rounds = truth.refit_suns(&samples, &afternoon_groups);
+    let recovered = rounds.last().unwrap();
+    let (n, median, p95) = truth.quantiles(recovered, |e| from_above[e]);
+    println!(
+        "{n} elements from the afternoon photo: relative error median {median:.4}, 95th percentile {p95:.4}"
+    );
+    assert_eq!(n, n_above);
+    assert!(median < MEDIAN_REL_TOL, "median {median}");
+    assert!(p95 < ELEMENT_REL_TOL, "95th percentile {p95}");
+
+    // Read as if taken under the rendered photo's sun, those elements come back wrong.
+    let mut as_if_morning = views.clone();
+    as_if_morning.others[0].view.lighting = &truth.job.lighting;
+    as_if_morning.others[0].sun = 0;
+    let mut wrong = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &as_if_morning);
+    let (rho, _) = wrong.reflectances(&[&truth.truth]);
+    let wrong_read = wrong.other_views()[0].clone();
+    println!("as if under the rendered photo's sun: {wrong_read:?}");
+    if wrong_read.accepted {
+        let (_, wrong_median, _) = truth.quantiles(&rho, |e| from_above[e]);
+        assert!(
+            wrong_median > 10.0 * MEDIAN_REL_TOL,
+            "median {wrong_median}"
+        );
+    } else {
+        // Refused by the exposure check, which found other reflectances than the rendered
+        // photo's at the points both see.
+        let ratio = wrong_read.exposure_ratio.unwrap();
+        assert!(
+            ratio.iter().any(|r| (r - 1.0).abs() > EXPOSURE_TOLERANCE),
+            "{ratio:?}"
+        );
+    }
 }

@@ -29,7 +29,7 @@ use std::time::Instant;
 use nalgebra::Point3;
 
 use super::SiteDocument;
-use super::other_photos::OtherPhotos;
+use super::other_photos::other_photos_for;
 use super::photo_reflectance::{
     PhotoRefit, PhotoReflectanceCount, PhotoSamples, PhotoView, PhotoViews, REFIT_ROUNDS,
 };
@@ -39,8 +39,8 @@ use crate::bvh::BuildQuality;
 use crate::radiosity::mesh_grading::Grading;
 use crate::radiosity::twin::{Twin, twin_elements};
 use crate::radiosity::{
-    Mesh, MeshParams, Rgb, SkyRays, SolveParams, TransferLighting, solve_on_mesh_twinned,
-    sun_directions,
+    LightGroup, Mesh, MeshParams, Rgb, SkyRays, Solution, SolveParams, TransferLighting,
+    solve_on_mesh_twinned, sun_directions,
 };
 use crate::render::differential::radiosity_light::RadiosityLight;
 use crate::scene::{ObjectKind, Scene, SceneError, SceneTracer};
@@ -155,8 +155,8 @@ fn mesh_focus(doc: &SiteDocument, scene: &Scene) -> Vec<[Point3<f64>; 2]> {
 /// Solves the site scene `scene` (natural and artificial objects, as rendered) with and without
 /// its artificial objects under the lighting of photo `view` (module doc). With `photo`, the
 /// natural elements it sees take their ρ_d from it ([`super::photo_reflectance`]), in both
-/// solves; those it does not see, from the site's other solved photos taken under the same sun
-/// ([`super::other_photos`]).
+/// solves; those it does not see, from the site's other solved photos, each read under the sun
+/// of its capture time ([`super::other_photos`], [`solve_pair`]).
 ///
 /// # Errors
 /// The lighting's errors; a solve error (a scene too large, a bad source) as
@@ -171,9 +171,21 @@ pub fn site_radiosity_light(
     let start = Instant::now();
     let (lighting, notes) = site_transfer_lighting(doc, scene, view)?;
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
-    let others = photo.map(|_| OtherPhotos::load(doc, view));
-    let views = photo.zip(others.as_ref()).map(|(p, o)| o.views(*p));
-    let pair = solve_pair(scene, &lighting, &params, views.as_ref(), None, cancel)?;
+    let others = other_photos_for(doc, scene, view, photo)?;
+    let views = photo
+        .zip(others.as_ref())
+        .map(|(p, (o, l))| o.views(*p, &l.reading));
+    let pair = solve_pair(
+        scene,
+        &SunLightings {
+            rendered: &lighting,
+            others: others.as_ref().map_or(&[], |(_, l)| &l.transfer),
+        },
+        &params,
+        views.as_ref(),
+        None,
+        cancel,
+    )?;
     let report = RadiosityReport {
         element_edge_m,
         elements: [
@@ -197,7 +209,7 @@ pub(super) struct SolvedPair {
     pub without: crate::radiosity::Solution,
     /// Natural elements whose ρ_d came from the photo.
     pub photo_reflectance: Option<PhotoReflectanceCount>,
-    /// What the other photos gave ([`PhotoSamples::notes`]).
+    /// What the other photos gave ([`super::photo_reflectance::PhotoSamples::notes`]).
     pub photo_notes: Vec<String>,
     /// What the photographed state's solve lends a solve of the same scene in other colours.
     pub(super) reuse: Option<PassReuse>,
@@ -214,14 +226,29 @@ pub(super) struct PassReuse {
     sky: SkyRays,
 }
 
+/// The lighting of [`solve_pair`]: the rendered photo's, and that of each other sun the photo
+/// reflectances read ([`super::other_photos`]).
+pub(super) struct SunLightings<'a> {
+    /// The rendered photo's lighting (both solves).
+    pub rendered: &'a TransferLighting,
+    /// Per other sun, the site's lighting at its time (the photographed state's solve only).
+    pub others: &'a [TransferLighting],
+}
+
 /// The two solves of [`site_radiosity_light`] for the given lighting and parameters (the
-/// site's, or their colours on one spectral pass, [`super::spectral_radiosity`]). With `reuse`
+/// site's, or their colours on one spectral pass, [`super::spectral_radiosity`]). Where the
+/// photo reflectances read photos taken under other suns, the photographed state's solve also
+/// carries each other sun's natural light groups (its sun and sky: more groups on the links
+/// refined for the rendered photo's light, the sky from the same sky rays), so that each refit
+/// round reads every photo against the solution for its own sun; the solution returned keeps
+/// the rendered photo's groups only.
+/// With `reuse`
 /// (the first pass's) the photographed state's solve reads the sky rays and form factors of
 /// that solve where its mesh is the same ([`Twin::identity`]: the same answers, not traced
 /// again); the returned [`SolvedPair::reuse`] is this solve's, for the passes after it.
 pub(super) fn solve_pair(
     scene: &Scene,
-    lighting: &TransferLighting,
+    lighting: &SunLightings<'_>,
     params: &SolveParams,
     photo: Option<&PhotoViews<'_>>,
     reuse: Option<&PassReuse>,
@@ -229,6 +256,7 @@ pub(super) fn solve_pair(
 ) -> Result<SolvedPair, SiteRenderError> {
     let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath())?;
     let (groups, _warnings) = lighting
+        .rendered
         .light_groups(&dome, SKY_TOLERANCE)
         .map_err(|e| radiosity_error(&e))?;
     let natural = natural_part(scene)?;
@@ -243,17 +271,30 @@ pub(super) fn solve_pair(
             .map_err(|e| radiosity_error(&e))
     };
     // The photographed state has none of the project's luminaires.
-    let natural_groups: Vec<_> = groups
-        .iter()
-        .filter(|g| !g.name.starts_with("luminaire"))
-        .cloned()
-        .collect();
+    let natural_only = |g: &LightGroup| !g.name.starts_with("luminaire");
+    let mut natural_groups: Vec<LightGroup> =
+        groups.iter().filter(|g| natural_only(g)).cloned().collect();
+    let rendered_groups = natural_groups.len();
+    // Each other sun's groups after the rendered photo's (module doc), with their sun.
+    let mut group_sun = vec![0; rendered_groups];
+    if photo.is_some() {
+        for (k, other) in lighting.others.iter().enumerate() {
+            let (other_groups, _) = other
+                .light_groups(&dome, SKY_TOLERANCE)
+                .map_err(|e| radiosity_error(&e))?;
+            for g in other_groups.into_iter().filter(natural_only) {
+                // Carried on the links refined for the rendered photo's light, so that its
+                // solution is the one it would be without the other suns.
+                natural_groups.push(LightGroup {
+                    refines_links: false,
+                    ..g
+                });
+                group_sun.push(k + 1);
+            }
+        }
+    }
     let natural_mesh = mesh(&natural)?;
     let samples = photo.map(|p| PhotoSamples::from_views(&natural_mesh, &natural_tracer, p));
-    let photo_notes = samples
-        .as_ref()
-        .map(PhotoSamples::notes)
-        .unwrap_or_default();
     let mut refit = samples.map(PhotoRefit::new);
     let rounds = if refit.is_some() { REFIT_ROUNDS } else { 0 };
     let frame_origin = natural_tracer.local_origin_in_world_m();
@@ -275,11 +316,21 @@ pub(super) fn solve_pair(
         params,
         cancel,
         &|_| {},
-        &mut |solution: &crate::radiosity::Solution| refit.as_mut().map(|r| r.next_round(solution)),
+        &mut |solution: &Solution| {
+            refit
+                .as_mut()
+                .map(|r| refit_round_per_sun(r, solution, &group_sun))
+        },
         rounds,
         identity.as_ref().map(|(t, sky)| (t, *sky)),
     )
     .map_err(|e| radiosity_error(&e))?;
+    let without = if natural_groups.len() > rendered_groups {
+        without.groups_where(|g| g < rendered_groups)
+    } else {
+        without
+    };
+    let photo_notes = refit.as_ref().map(PhotoRefit::notes).unwrap_or_default();
     let mut with_mesh = mesh(scene)?;
     let twin_of = twin_elements(&without.mesh, &with_mesh);
     if without.mesh.node_reflectance_rgb.is_some() {
@@ -323,6 +374,23 @@ pub(super) fn solve_pair(
         reuse,
         read_reuse,
     })
+}
+
+/// One refit round ([`PhotoRefit::next_round`]) on `solution`, a solve whose group `g` carries
+/// the light of sun `group_sun[g]` (0 the rendered photo's; [`solve_pair`]): each sun's
+/// solution is its groups'.
+pub(super) fn refit_round_per_sun(
+    refit: &mut PhotoRefit,
+    solution: &Solution,
+    group_sun: &[usize],
+) -> Vec<Option<Rgb>> {
+    if refit.suns() == 1 {
+        return refit.next_round(&[solution]);
+    }
+    let per_sun: Vec<Solution> = (0..refit.suns())
+        .map(|k| solution.groups_where(|g| group_sun[g] == k))
+        .collect();
+    refit.next_round(&per_sun.iter().collect::<Vec<_>>())
 }
 
 /// The per-element reflectances of `from` carried to the elements of another mesh whose twins

@@ -26,6 +26,38 @@ const DIRECTION_TOL: f64 = 1e-12;
 const BOX_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
 
+/// Zürich (47.37° N, 8.54° E, 400 m), no CRS, no time zone.
+pub(crate) fn zurich() -> Location {
+    Location {
+        latitude_deg: 47.37,
+        longitude_deg: 8.54,
+        elevation_m: 400.0,
+        crs: None,
+        grid_convergence_deg: 0.0,
+        time_zone: None,
+    }
+}
+
+/// The fixture lit by the sun of Zürich on 2024-08-21, p1 taken at 10:44 and p2 at `p2_time`,
+/// p2 solved 4 m above the ground south of p1's frame, looking straight down: it sees ground p1
+/// does not, and nothing p1 sees (so its exposure is not checked against p1's).
+pub(crate) fn fixture_with_photo_from_above(dir: &std::path::Path, p2_time: &str) -> SiteDocument {
+    let mut doc = fixture(dir);
+    doc.site.render.radiosity = true;
+    doc.site.lighting.sun_manual = None;
+    doc.site.location = Some(zurich());
+    doc.site.photos[0].taken_at = Some("2024-08-21T10:44:00+02:00".into());
+    doc.site.photos[1].taken_at = Some(format!("2024-08-21T{p2_time}:00+02:00"));
+    doc.site.photos[1].exterior = Some(crate::site::Exterior {
+        camera_center: [0.5, -8.5, 4.0],
+        rotation_world_from_camera: [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]],
+        rms_px: 0.1,
+        sigma_center_m: [0.0; 3],
+        solved_by: "resection".into(),
+    });
+    doc
+}
+
 /// A 64 × 48 photo looking north from (0, −10, 1.5) at a unit box on a 20 m ground square.
 pub(crate) fn fixture(dir: &Path) -> SiteDocument {
     image::RgbImage::from_pixel(64, 48, image::Rgb([120, 110, 100]))

@@ -31,12 +31,12 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use super::SiteDocument;
-use super::other_photos::OtherPhotos;
+use super::other_photos::other_photos_for;
 use super::photo_reflectance::{PhotoReflectanceCount, PhotoView};
 use super::radiosity_lighting::site_transfer_lighting;
 use super::render_error::SiteRenderError;
 use super::render_radiosity::{
-    PassReuse, RadiosityReport, radiosity_error, site_solve_params, solve_pair,
+    PassReuse, RadiosityReport, SunLightings, radiosity_error, site_solve_params, solve_pair,
 };
 use crate::colour::SampleSet;
 use crate::radiosity::{SolveParams, TransferLighting};
@@ -112,12 +112,11 @@ pub fn site_spectral_radiosity(
     let (lighting, mut notes) = site_transfer_lighting(doc, scene, view)?;
     let (params, element_edge_m) = site_solve_params(doc, scene)?;
     let photos = photo.map(|p| passes.photos(p.photo_linear));
-    // The site's other photos under the same sun ([`super::other_photos`]), each as every
-    // pass's image.
-    let others = photo.map(|_| OtherPhotos::load(doc, view));
+    // The site's other photos ([`super::other_photos`]), each as every pass's image.
+    let others = other_photos_for(doc, scene, view, photo)?;
     let other_photos: Vec<Vec<_>> = others
         .iter()
-        .flat_map(OtherPhotos::images)
+        .flat_map(|(o, _)| o.images())
         .map(|image| passes.photos(image))
         .collect();
     let mut lights: Vec<Arc<RadiosityLight>> = Vec::with_capacity(passes.count());
@@ -130,23 +129,40 @@ pub fn site_spectral_radiosity(
             .map(|p| passes.lighting(pass, p.lighting))
             .transpose()
             .map_err(|e| spectrum_error(&e))?;
+        // Each other sun's lightings, converted on every pass as the site's are.
+        let sun_lights = others.as_ref().map(|(_, l)| l);
+        let pass_reading = sun_lights
+            .iter()
+            .flat_map(|l| &l.reading)
+            .map(|l| passes.lighting(pass, l))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| spectrum_error(&e))?;
         let pass_photo = photo
             .zip(photos.as_ref())
             .zip(pass_photo_lighting.as_ref())
             .zip(others.as_ref())
-            .map(|(((p, photos), lighting), others)| {
+            .map(|(((p, photos), lighting), (others, _))| {
                 others.views_with(
                     PhotoView {
                         camera: p.camera,
                         photo_linear: &photos[pass],
                         lighting,
                     },
+                    &pass_reading,
                     |k| &other_photos[k][pass],
                 )
             });
+        let pass_others: Vec<TransferLighting> = sun_lights
+            .iter()
+            .flat_map(|l| &l.transfer)
+            .map(|l| pass_transfer_lighting(&passes, pass, l))
+            .collect();
         let mut pair = solve_pair(
             &pass_scene(&passes, pass, scene),
-            &pass_transfer_lighting(&passes, pass, &lighting),
+            &SunLightings {
+                rendered: &pass_transfer_lighting(&passes, pass, &lighting),
+                others: &pass_others,
+            },
             &pass_solve_params(&passes, pass, &params),
             pass_photo.as_ref(),
             first_pass.as_ref(),

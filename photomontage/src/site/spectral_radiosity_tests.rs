@@ -300,7 +300,10 @@ fn a_later_pass_reads_the_first_pass_to_the_same_solutions() {
     let solve = |pass: usize, reuse: Option<&PassReuse>| {
         solve_pair(
             &pass_scene(&passes, pass, scene),
-            &pass_transfer_lighting(&passes, pass, &lighting),
+            &SunLightings {
+                rendered: &pass_transfer_lighting(&passes, pass, &lighting),
+                others: &[],
+            },
             &pass_solve_params(&passes, pass, &params),
             None,
             reuse,
@@ -334,4 +337,49 @@ fn a_later_pass_reads_the_first_pass_to_the_same_solutions() {
             }
         }
     }
+}
+
+#[test]
+fn a_photo_taken_at_another_time_is_read_under_its_sun_on_every_pass() {
+    // The spectral passes read the other photo as the RGB solve does: under its own sun, on
+    // the same elements.
+    let dir = tempfile::tempdir().unwrap();
+    let doc = crate::site::render::tests::fixture_with_photo_from_above(dir.path(), "18:14");
+    let job = crate::site::render::prepare_view(&doc, "p1").unwrap();
+    let photo = crate::site::photo_reflectance::PhotoView {
+        camera: &job.camera,
+        photo_linear: &job.photo_linear,
+        lighting: &job.lighting,
+    };
+    let scene = &job.scene.scene;
+    let cancel = AtomicBool::new(false);
+    let (_, rgb) = site_radiosity_light(&doc, scene, "p1", Some(&photo), &cancel).unwrap();
+    let (spectral, report) = site_spectral_radiosity(
+        &doc,
+        scene,
+        "p1",
+        Some(&photo),
+        SampleSet::Durisch9,
+        &cancel,
+    )
+    .unwrap();
+    let count = report.photo_reflectance.unwrap();
+    assert!(count.from_other_photos > 5, "{count:?}");
+    assert_eq!(
+        count.from_other_photos,
+        rgb.photo_reflectance.unwrap().from_other_photos
+    );
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.starts_with("photo reflectance: photo p2 read on ")
+                && n.contains("(read under the sun of its own capture time)")),
+        "{:?}",
+        report.notes
+    );
+    assert_eq!(
+        spectral.passes.len(),
+        SpectralPasses::new(SampleSet::Durisch9).unwrap().count()
+    );
 }

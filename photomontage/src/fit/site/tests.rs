@@ -11,8 +11,7 @@ use crate::scene::{ObjectKind, Scene, SceneObject};
 use crate::site::render::site_sun_dir;
 use crate::site::stored_camera;
 use crate::site::{
-    ControlPoint, Exterior, HorizonSample, Interior, Location, Photo, Polygon, Sample,
-    SunShadowPair,
+    ControlPoint, Exterior, HorizonSample, Interior, Photo, Polygon, Sample, SunShadowPair,
 };
 use crate::sky_dome::durisch_facets::durisch_dome;
 use image::{Rgb, Rgb32FImage};
@@ -117,14 +116,7 @@ fn geometry() -> Vec<(&'static str, Vec<[f64; 3]>)> {
 
 pub(crate) fn base_site() -> Site {
     let mut site = Site {
-        location: Some(Location {
-            latitude_deg: 47.37,
-            longitude_deg: 8.54,
-            elevation_m: 400.0,
-            crs: None,
-            grid_convergence_deg: 0.0,
-            time_zone: None,
-        }),
+        location: Some(crate::site::render::tests::zurich()),
         ..Site::default()
     };
     site.lighting.time = Some("2024-06-21T10:30:00+02:00".into());
