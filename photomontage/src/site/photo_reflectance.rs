@@ -352,10 +352,13 @@ impl PhotoSamples {
                     )
                 },
             );
-            let sun = if o.sun > 0 {
-                " (read under the sun of its own capture time)"
+            let (sun, differs) = if o.sun > 0 {
+                (
+                    " (read under the sun of its own capture time)",
+                    "exposure, white balance or capture time differs",
+                )
             } else {
-                ""
+                ("", "exposure or white balance differs")
             };
             notes.push(if o.accepted {
                 format!(
@@ -364,7 +367,7 @@ impl PhotoSamples {
                 )
             } else {
                 format!(
-                    "photo reflectance: photo {} not read: {ratio}, more than {:.0} % from 1 (exposure or white balance differs)",
+                    "photo reflectance: photo {} not read: {ratio}, more than {:.0} % from 1 ({differs})",
                     o.id,
                     100.0 * EXPOSURE_TOLERANCE
                 )

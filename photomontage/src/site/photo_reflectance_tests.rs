@@ -556,4 +556,25 @@ fn an_other_photo_taken_under_another_sun_is_read_under_its_own() {
             "{ratio:?}"
         );
     }
+
+    // The afternoon photo exposed 1.2 × brighter (or its clock wrong): refused, and the note
+    // names the capture time among the causes.
+    let brighter = truth.photo_under(
+        &above,
+        1.2,
+        &afternoon.daylight,
+        &afternoon_truth,
+        &afternoon_e_rad,
+    );
+    let mut views = views.clone();
+    views.others[0].view.photo_linear = &brighter;
+    let mut refused = PhotoSamples::from_views(&truth.mesh(), &truth.tracer, &views);
+    refused.reflectances(&[&truth.truth, &afternoon_truth]);
+    assert!(!refused.other_views()[0].accepted);
+    let note = &refused.notes()[0];
+    assert!(
+        note.starts_with("photo reflectance: photo above not read: the reflectances it reads over the rendered photo's 1.2")
+            && note.ends_with("(exposure, white balance or capture time differs)"),
+        "{note}"
+    );
 }
