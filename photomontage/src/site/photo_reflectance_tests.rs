@@ -445,15 +445,13 @@ fn an_other_photo_exposed_differently_is_not_read() {
     assert!(notes[1].contains("exposure or white balance differs"));
 }
 
-/// The photo from above taken under another sun (afternoon, 225° / 30°, where the truth's is
-/// 135° / 40°): the elements only it sees come back as the rendered photo's do when it is read
-/// against the solution for its own sun, and not when it is read as if taken under the
-/// rendered photo's.
-#[test]
-fn an_other_photo_taken_under_another_sun_is_read_under_its_own() {
-    let dir = tempfile::tempdir().unwrap();
-    let truth = Truth::new(dir.path());
-    let mut doc = fixture(dir.path());
+/// The fixture's light under an afternoon sun (225° / 30°; the truth's is 135° / 40°): the
+/// renderer's lighting (no atmosphere, as the truth's) and the natural light groups.
+fn afternoon_light(
+    dir: &std::path::Path,
+    truth: &Truth,
+) -> (crate::render::Lighting, Vec<LightGroup>) {
+    let mut doc = fixture(dir);
     doc.site.lighting.sun_manual = Some(crate::site::SunManual {
         azimuth_deg: 225.0,
         elevation_deg: 30.0,
@@ -463,10 +461,72 @@ fn an_other_photo_taken_under_another_sun_is_read_under_its_own() {
     let (lighting, _) = site_transfer_lighting(&doc, &truth.job.scene.scene, "p1").unwrap();
     let dome = IcosahedralDome::new(&IcosahedralParams::tonn_donath()).unwrap();
     let (groups, _) = lighting.light_groups(&dome, SKY_TOLERANCE).unwrap();
-    let afternoon_groups: Vec<LightGroup> = groups
+    let groups = groups
         .into_iter()
         .filter(|g| !g.name.starts_with("luminaire"))
         .collect();
+    (afternoon, groups)
+}
+
+/// Groups carried on links refined for the others' light (`refines_links = false`, as the
+/// render's solve carries another sun) leave those others' solutions bit for bit as they are
+/// without them.
+#[test]
+fn groups_carried_on_the_links_leave_the_others_solutions_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = Truth::new(dir.path());
+    let (_, afternoon_groups) = afternoon_light(dir.path(), &truth);
+    let solve = |groups: &[LightGroup]| {
+        solve_on_mesh(
+            truth.mesh(),
+            &truth.tracer,
+            groups,
+            &truth.params,
+            &AtomicBool::new(false),
+            &|_| {},
+        )
+        .unwrap()
+    };
+    let alone = solve(&truth.groups);
+    let carried_groups: Vec<LightGroup> = truth
+        .groups
+        .iter()
+        .cloned()
+        .chain(afternoon_groups.iter().map(|g| LightGroup {
+            refines_links: false,
+            ..g.clone()
+        }))
+        .collect();
+    let carried = solve(&carried_groups);
+    assert_eq!(
+        carried.groups.len(),
+        truth.groups.len() + afternoon_groups.len()
+    );
+    assert_eq!(carried.interactions, alone.interactions);
+    let first = carried.groups_where(|g| g < truth.groups.len());
+    for (a, b) in alone.groups.iter().zip(&first.groups) {
+        assert_eq!(a.name, b.name);
+        assert_eq!(a.radiosity_rgb, b.radiosity_rgb, "{}", a.name);
+        assert_eq!(
+            a.direct_irradiance_rgb, b.direct_irradiance_rgb,
+            "{}",
+            a.name
+        );
+    }
+    // Refined for all of them, the links differ (the test can fail).
+    let refined = solve(&[truth.groups.clone(), afternoon_groups].concat());
+    assert_ne!(refined.interactions, alone.interactions);
+}
+
+/// The photo from above taken under another sun (afternoon, 225° / 30°, where the truth's is
+/// 135° / 40°): the elements only it sees come back as the rendered photo's do when it is read
+/// against the solution for its own sun, and not when it is read as if taken under the
+/// rendered photo's.
+#[test]
+fn an_other_photo_taken_under_another_sun_is_read_under_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = Truth::new(dir.path());
+    let (afternoon, afternoon_groups) = afternoon_light(dir.path(), &truth);
     let (afternoon_truth, afternoon_e_rad) = truth.solved_under(&afternoon_groups);
     let rendered_photo = truth.photo(&truth.camera, 1.0);
     let above = camera_above();

@@ -241,11 +241,10 @@ pub(super) struct SunLightings<'a> {
 /// carries each other sun's natural light groups (its sun and sky: more groups on the links
 /// refined for the rendered photo's light, the sky from the same sky rays), so that each refit
 /// round reads every photo against the solution for its own sun; the solution returned keeps
-/// the rendered photo's groups only.
-/// With `reuse`
-/// (the first pass's) the photographed state's solve reads the sky rays and form factors of
-/// that solve where its mesh is the same ([`Twin::identity`]: the same answers, not traced
-/// again); the returned [`SolvedPair::reuse`] is this solve's, for the passes after it.
+/// the rendered photo's groups only. With `reuse` (the first pass's) the photographed state's
+/// solve reads the sky rays and form factors of that solve where its mesh is the same
+/// ([`Twin::identity`]: the same answers, not traced again); the returned
+/// [`SolvedPair::reuse`] is this solve's, for the passes after it.
 pub(super) fn solve_pair(
     scene: &Scene,
     lighting: &SunLightings<'_>,
