@@ -224,11 +224,22 @@ impl OtherPhotos {
                 Err(note) => notes.push(note),
             }
         }
-        // A sun whose photos could not be decoded keeps its place (the numbering is the
-        // loading's); its solution is read by no sample.
+        // A sun none of whose photos could be decoded is dropped, the others numbered again in
+        // order: every sun is some loaded photo's.
+        let mut renumbered = vec![0; suns.len() + 1];
+        let mut kept = Vec::new();
+        for (k, sun) in suns.into_iter().enumerate() {
+            if photos.iter().any(|p| p.sun == k + 1) {
+                kept.push(sun);
+                renumbered[k + 1] = kept.len();
+            }
+        }
+        for p in &mut photos {
+            p.sun = renumbered[p.sun];
+        }
         Self {
             photos,
-            suns,
+            suns: kept,
             sun_weight: doc.site.lighting.sun_weight,
             notes,
         }
@@ -459,9 +470,27 @@ mod tests {
             vec![site_transfer_lighting(&later, scene, "p2").unwrap().0]
         );
         // Three suns: p2 and p3 an hour apart.
-        let three = doc_at(&doc, ["10:44", "11:44", "12:44"]);
+        let mut three = doc_at(&doc, ["10:44", "11:44", "12:44"]);
         let others = OtherPhotos::load(&three, "p1");
         assert_eq!(others.sun_photos().collect::<Vec<_>>(), ["p2", "p3"]);
+        // A sun whose photo cannot be read is dropped, the next one taking its number.
+        three.site.photos[1].file = "missing.png".into();
+        let others = OtherPhotos::load(&three, "p1");
+        assert_eq!(others.sun_photos().collect::<Vec<_>>(), ["p3"]);
+        let lightings = others.reading_lightings(&job.lighting);
+        let views = others.views(rendered, &lightings);
+        assert_eq!((views.suns(), views.others[0].sun), (2, 1));
+        assert!(others.notes[0].starts_with("photo reflectance: photo p2 not read: "));
+        three.site.photos[1].file = "p1.png".into();
+        three.site.photos[2].file = "missing.png".into();
+        let others = OtherPhotos::load(&three, "p1");
+        assert_eq!(others.sun_photos().collect::<Vec<_>>(), ["p2"]);
+        assert_eq!(
+            others
+                .views(rendered, &others.reading_lightings(&job.lighting))
+                .suns(),
+            2
+        );
         // At night: left out, named.
         let night = doc_at(&doc, ["10:44", "11:44", "23:30"]);
         let others = OtherPhotos::load(&night, "p1");
