@@ -528,9 +528,7 @@ fn choose_patches(
                 gain / patch_links[p].max(1) as f64
             })
             .collect();
-        let mut order: Vec<usize> = (0..n).filter(|&p| worth[p] > 0.0).collect();
-        order.sort_unstable_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
-        for p in order {
+        for p in best_first(&worth) {
             if need.iter().all(|&v| v <= 0.0) {
                 break;
             }
@@ -550,11 +548,7 @@ fn choose_patches(
     let worth: Vec<f64> = (0..n)
         .map(|p| score[p] / patch_links[p].max(1) as f64)
         .collect();
-    let mut order: Vec<usize> = (0..n).filter(|&p| score[p] > 0.0).collect();
-    // Ties are broken by the patch index, a strict total order: the unstable sort gives the one
-    // order a stable sort would.
-    order.sort_unstable_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
-    for p in order {
+    for p in best_first(&worth) {
         if left <= keep {
             break;
         }
@@ -564,5 +558,46 @@ fn choose_patches(
     shot
 }
 
+/// The patches of positive `worth`, best first, ties broken by the patch index (a strict total
+/// order, so the unstable sort gives the one order a stable sort would). Sorted on one key per
+/// patch, not through the indices: a positive `f64`'s bits rise with its value, so the key
+/// (`u64::MAX` − bits, index) orders by falling worth, then rising index.
+fn best_first(worth: &[f64]) -> impl Iterator<Item = usize> {
+    let mut keys: Vec<(u64, u32)> = worth
+        .iter()
+        .enumerate()
+        .filter(|&(_, &w)| w > 0.0)
+        .map(|(p, &w)| {
+            let p = u32::try_from(p).expect("patch indices fit in u32");
+            (u64::MAX - w.to_bits(), p)
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.into_iter().map(|(_, p)| p as usize)
+}
+
 #[path = "shooting_blocks.rs"]
 mod blocks;
+
+#[cfg(test)]
+mod tests {
+    use super::best_first;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The keyed sort gives the order of the comparator it replaced: falling worth, ties by
+        /// rising index, patches of no worth left out (mutation checked: `u64::MAX −` dropped
+        /// or the index ignored fails it).
+        #[test]
+        fn best_first_orders_as_the_comparator(
+            worth in prop::collection::vec(
+                prop_oneof![Just(0.0), Just(0.25), Just(1.0), 1e-300..1e3_f64, -1.0..0.0_f64],
+                0..200,
+            )
+        ) {
+            let mut order: Vec<usize> = (0..worth.len()).filter(|&p| worth[p] > 0.0).collect();
+            order.sort_by(|&a, &c| worth[c].total_cmp(&worth[a]).then(a.cmp(&c)));
+            prop_assert_eq!(best_first(&worth).collect::<Vec<_>>(), order);
+        }
+    }
+}

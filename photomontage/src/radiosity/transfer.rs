@@ -871,16 +871,6 @@ impl Transfer {
                 continue;
             }
             let emitted = emission.then(|| self.topology.element_emissions(&self.solution.mesh));
-            let b0_new =
-                initial_exitance_from(new_rho, &group.direct_irradiance_rgb, emitted.as_deref());
-            if b0_new.iter().flatten().all(|&v| v == 0.0) {
-                // A dark group (sun down, sky off, light off): B = 0 exactly.
-                group.radiosity_rgb.clone_from(&b0_new);
-                group.convergence.clear();
-                self.b0s[g] = b0_new;
-                self.unshot[g].clear();
-                continue;
-            }
             let carry = if linear {
                 scale.unwrap_or([1.0; 3])
             } else {
@@ -898,9 +888,14 @@ impl Transfer {
             let pass_on = !kept.is_empty()
                 && power(kept, areas)
                     > self.params.solve.stop.residual * power(&group.radiosity_rgb, areas);
-            let (start, unshot): (Vec<Rgb>, Vec<Rgb>) = (0..b0_new.len())
+            // The new initial exitance (as `initial_exitance_from`) in the same pass.
+            let direct = &group.direct_irradiance_rgb;
+            let (b0_new, (start, unshot)): (Vec<Rgb>, (Vec<Rgb>, Vec<Rgb>)) = (0..new_rho.len())
                 .into_par_iter()
                 .map(|e| {
+                    let emitted = emitted.as_deref().map_or([0.0; 3], |m| m[e]);
+                    let b0_new: Rgb =
+                        std::array::from_fn(|c| new_rho[e][c] * direct[e][c] + emitted[c]);
                     let (b, b0_old) = (group.radiosity_rgb[e], self.b0s[g][e]);
                     let rho_old = old_rho.as_ref().map_or(new_rho[e], |r| r[e]);
                     let left = if pass_on { kept[e] } else { [0.0; 3] };
@@ -909,7 +904,7 @@ impl Transfer {
                     for c in 0..3 {
                         let gathered = b[c] - b0_old[c];
                         let k = rho_ratio(new_rho[e][c], rho_old[c]);
-                        start[c] = b0_new[e][c] + k * carry[c] * gathered;
+                        start[c] = b0_new[c] + k * carry[c] * gathered;
                         let d = if start[c].to_bits() == b[c].to_bits() {
                             0.0
                         } else {
@@ -917,9 +912,17 @@ impl Transfer {
                         };
                         unshot[c] = d + k * carry[c] * left[c];
                     }
-                    (start, unshot)
+                    (b0_new, (start, unshot))
                 })
                 .unzip();
+            if b0_new.iter().flatten().all(|&v| v == 0.0) {
+                // A dark group (sun down, sky off, light off): B = 0 exactly.
+                group.radiosity_rgb.clone_from(&b0_new);
+                group.convergence.clear();
+                self.b0s[g] = b0_new;
+                self.unshot[g].clear();
+                continue;
+            }
             pending.push(Pending {
                 g,
                 b0_new,
