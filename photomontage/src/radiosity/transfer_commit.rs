@@ -1,0 +1,300 @@
+//! Applying a traced relight ([`Transfer::commit_relight`]): scalings, the sun step through the
+//! axis responses, and the warm-started iteration of every group a change touches (the module
+//! doc of `transfer.rs`).
+
+use super::*;
+
+/// A group a relight iterates: its index, new initial exitance, warm start, the shooting's
+/// unshot part, the ratio its gathered part was carried with, and whether the kept remainder is
+/// in the unshot part.
+struct Pending {
+    g: usize,
+    b0_new: Vec<Rgb>,
+    start: Vec<Rgb>,
+    unshot: Vec<Rgb>,
+    carry: Rgb,
+    pass_on: bool,
+}
+
+/// ρ′/ρ, the factor an element's gathered light (and kept remainder) is carried over with; 0
+/// where ρ was 0 (nothing was gathered).
+fn rho_ratio(new: f64, old: f64) -> f64 {
+    if old > 0.0 { new / old } else { 0.0 }
+}
+
+impl Transfer {
+    /// Applies a relight traced by [`Transfer::prepare_relight`] on this transfer (its solves).
+    pub fn commit_relight(&mut self, prepared: PreparedRelight) {
+        let PreparedRelight {
+            lighting,
+            reflectance,
+            element_mesh,
+            new_groups,
+            warnings,
+            mut actions,
+            mut retraced,
+            sun_counts,
+        } = prepared;
+        self.material_table = None;
+        let material_changed = reflectance.is_some() || element_mesh.is_some();
+        let linear = self.params.strategy == RelightStrategy::LinearResponses;
+        // A sun step through the axis responses (sun_basis.rs): the sun group is done here and
+        // kept by the loop below.
+        let by_axes = (linear && self.params.sweep == Sweep::Shooting && !material_changed)
+            .then(|| sun_basis::axes_source(&self.kinds, &new_groups))
+            .flatten()
+            .filter(|(g, _)| actions[*g] == Action::Retrace && retraced[*g].is_some());
+        if by_axes.is_none() || sun_counts.is_none() {
+            self.settle_sun_axes();
+        }
+        if material_changed {
+            self.sun_basis = None;
+        }
+        if let (Some((g, source)), Some(counts)) = (by_axes, sun_counts.as_ref()) {
+            // The group's composed remainder and initial exitance are written when something
+            // other than a sun step reads them (`settle_sun_axes`).
+            let direct = retraced[g].take().unwrap_or_default();
+            let rows = self.relight_sun_by_axes(g, &source, counts);
+            let group = &mut self.solution.groups[g];
+            group.direct_irradiance_rgb = direct;
+            group.convergence = rows;
+            actions[g] = Action::Keep;
+        }
+        if let Some(mesh) = element_mesh {
+            self.solution.mesh = Arc::new(mesh);
+        }
+        if let Some(rho) = reflectance {
+            let mesh = Arc::make_mut(&mut self.solution.mesh);
+            for (s, r) in mesh.surfaces.iter_mut().zip(rho) {
+                s.reflectance_rgb = r;
+            }
+        }
+        let old_rho: Option<Vec<Rgb>> = material_changed.then(|| {
+            let new = self.topology.element_reflectances(&self.solution.mesh);
+            std::mem::replace(&mut self.element_rho, new)
+        });
+        let new_rho = &self.element_rho;
+        let mut solution_warnings: Vec<LightWarning> = self
+            .solution
+            .warnings
+            .iter()
+            .filter(|w| !matches!(w, LightWarning::SunBelowHorizon { .. }))
+            .cloned()
+            .collect();
+        solution_warnings.extend(warnings);
+        // Groups to iterate: index, new initial exitance, warm start, unshot part.
+        let mut pending: Vec<Pending> = Vec::new();
+        for (g, action) in actions.into_iter().enumerate() {
+            let emission = self.groups[g].emission;
+            let group = &mut self.solution.groups[g];
+            let scale = match &action {
+                Action::Scale(k) => Some(*k),
+                _ => None,
+            };
+            if let Some(direct) = retraced[g].take() {
+                group.direct_irradiance_rgb = direct;
+            } else if let Some(k) = scale {
+                for d in &mut group.direct_irradiance_rgb {
+                    for c in 0..3 {
+                        d[c] *= k[c];
+                    }
+                }
+            }
+            if action == Action::Keep && !material_changed {
+                continue;
+            }
+            if let (Some(k), true, false) = (scale, linear, material_changed) {
+                // The response is linear in the group's sources: scale it, exactly.
+                for (b, b0) in group.radiosity_rgb.iter_mut().zip(&mut self.b0s[g]) {
+                    for c in 0..3 {
+                        b[c] *= k[c];
+                        b0[c] *= k[c];
+                    }
+                }
+                for u in &mut self.unshot[g] {
+                    for c in 0..3 {
+                        u[c] *= k[c];
+                    }
+                }
+                group.convergence.clear();
+                continue;
+            }
+            let emitted = emission.then(|| self.topology.element_emissions(&self.solution.mesh));
+            let carry = if linear {
+                scale.unwrap_or([1.0; 3])
+            } else {
+                [1.0; 3]
+            };
+            // Each element on its own, in parallel: the same values on any number of threads.
+            // With the warm start, the shooting's unshot part: D = start − old (bit-equal values
+            // pass nothing on), plus the group's kept remainder, carried over as the gathered
+            // part is, once that carries more than the stop rule's residual of the group's
+            // power. Until then it is only kept (scaled after the shooting), so a step shoots
+            // what it changed and the solution stays within twice the stop rule of its fixed
+            // point however long the series.
+            let kept = &self.unshot[g];
+            let areas = &self.topology.areas;
+            let pass_on = !kept.is_empty()
+                && power(kept, areas)
+                    > self.params.solve.stop.residual * power(&group.radiosity_rgb, areas);
+            // The new initial exitance (as `initial_exitance_from`) in the same pass.
+            let direct = &group.direct_irradiance_rgb;
+            let (b0_new, (start, unshot)): (Vec<Rgb>, (Vec<Rgb>, Vec<Rgb>)) = (0..new_rho.len())
+                .into_par_iter()
+                .map(|e| {
+                    let emitted = emitted.as_deref().map_or([0.0; 3], |m| m[e]);
+                    let b0_new: Rgb =
+                        std::array::from_fn(|c| new_rho[e][c] * direct[e][c] + emitted[c]);
+                    let (b, b0_old) = (group.radiosity_rgb[e], self.b0s[g][e]);
+                    let rho_old = old_rho.as_ref().map_or(new_rho[e], |r| r[e]);
+                    let left = if pass_on { kept[e] } else { [0.0; 3] };
+                    let mut start = [0.0; 3];
+                    let mut unshot = [0.0; 3];
+                    for c in 0..3 {
+                        let gathered = b[c] - b0_old[c];
+                        let k = rho_ratio(new_rho[e][c], rho_old[c]);
+                        start[c] = b0_new[c] + k * carry[c] * gathered;
+                        let d = if start[c].to_bits() == b[c].to_bits() {
+                            0.0
+                        } else {
+                            start[c] - b[c]
+                        };
+                        unshot[c] = d + k * carry[c] * left[c];
+                    }
+                    (b0_new, (start, unshot))
+                })
+                .unzip();
+            if b0_new.iter().flatten().all(|&v| v == 0.0) {
+                // A dark group (sun down, sky off, light off): B = 0 exactly.
+                group.radiosity_rgb.clone_from(&b0_new);
+                group.convergence.clear();
+                self.b0s[g] = b0_new;
+                self.unshot[g].clear();
+                continue;
+            }
+            pending.push(Pending {
+                g,
+                b0_new,
+                start,
+                unshot,
+                carry,
+                pass_on,
+            });
+        }
+        if self.params.sweep == Sweep::Shooting && !pending.is_empty() {
+            // Shooting passes on D = start − old, which holds only if the old solution's
+            // interreflected part scales with ρ. Where a channel's ρ was 0 and is not now, the
+            // old solution kept nothing of the light that element gathers: those groups are
+            // shot cold, from B₀′ with nothing old (the old solution of a dark scene, B = 0).
+            let lit_from_zero = old_rho.as_ref().is_some_and(|old| {
+                old.par_iter()
+                    .zip(new_rho.par_iter())
+                    .any(|(o, n)| (0..3).any(|c| o[c] == 0.0 && n[c] != 0.0))
+            });
+            let zeros: Vec<Rgb> = if lit_from_zero {
+                vec![[0.0; 3]; new_rho.len()]
+            } else {
+                Vec::new()
+            };
+            let shot: Vec<ShotGroup<'_>> = pending
+                .iter_mut()
+                .map(
+                    |Pending {
+                         g,
+                         b0_new,
+                         start,
+                         unshot,
+                         ..
+                     }| {
+                        let name = &self.solution.groups[*g].name;
+                        if lit_from_zero {
+                            ShotGroup {
+                                keep_unshot: true,
+                                ..ShotGroup::against(name, &zeros, b0_new.clone())
+                            }
+                        } else {
+                            ShotGroup {
+                                name,
+                                old: &[],
+                                start: std::mem::take(start),
+                                unshot: Some(std::mem::take(unshot)),
+                                keep_unshot: true,
+                            }
+                        }
+                    },
+                )
+                .collect();
+            let results = shoot(
+                &self.topology,
+                &self.source_rows,
+                new_rho,
+                shot,
+                &self.params.solve.stop,
+                &self.patch_links,
+                &mut self.scratch,
+            );
+            for (p, shot) in pending.into_iter().zip(results) {
+                let g = p.g;
+                let group = &mut self.solution.groups[g];
+                group.radiosity_rgb = shot.radiosity;
+                group.convergence = shot.rows;
+                self.b0s[g] = p.b0_new;
+                let remainder = shot.unshot.unwrap_or_default();
+                if p.pass_on || lit_from_zero || self.unshot[g].len() != remainder.len() {
+                    self.unshot[g] = remainder;
+                } else {
+                    // Kept, not passed on: scaled as the gathered part, plus this remainder.
+                    let old_rho = old_rho.as_deref();
+                    self.unshot[g]
+                        .par_iter_mut()
+                        .zip(remainder)
+                        .enumerate()
+                        .for_each(|(e, (u, r))| {
+                            let rho_old = old_rho.map_or(new_rho[e], |o| o[e]);
+                            for c in 0..3 {
+                                let k = rho_ratio(new_rho[e][c], rho_old[c]);
+                                u[c] = k * p.carry[c] * u[c] + r[c];
+                            }
+                        });
+                }
+            }
+        } else {
+            for Pending {
+                g, b0_new, start, ..
+            } in pending
+            {
+                self.unshot[g].clear();
+                let group = &mut self.solution.groups[g];
+                let (radiosity, rows) = iterate(
+                    &self.solution.mesh,
+                    &self.rows,
+                    &self.topology,
+                    new_rho,
+                    &b0_new,
+                    &start,
+                    &group.name,
+                    &self.params.solve.stop,
+                    self.params.sweep,
+                );
+                group.radiosity_rgb = radiosity;
+                group.convergence = rows;
+                self.b0s[g] = b0_new;
+            }
+        }
+        self.groups = new_groups;
+        self.lighting = lighting;
+        self.solution.warnings = solution_warnings;
+        self.solution.locator = std::sync::OnceLock::new();
+        // The kept ρ is derived state: in test builds, check it bit for bit against the mesh's
+        // own lookup.
+        debug_assert!(
+            (0..self.element_rho.len()).all(|e| self.element_rho[e].map(f64::to_bits)
+                == self
+                    .solution
+                    .mesh
+                    .element_reflectance_rgb(e)
+                    .map(f64::to_bits)),
+            "the transfer's ρ per element follows its mesh"
+        );
+    }
+}
