@@ -1,6 +1,6 @@
 //! ΔB shooting on the stored links: the relight of [`super::transfer::Sweep::Shooting`].
 //!
-//! A relight starts warm at S = B₀′ + (ρ′/ρ)·(B − B₀) (transfer.rs). With the old solution B
+//! A relight starts warm at S = B₀′ + (ρ′/ρ)·(B − B₀) (`transfer_commit.rs`). With the old solution B
 //! at its fixed point (B − B₀ = ρ·F·B), the residual of S is ρ′·F·(S − B): only the difference
 //! D = S − B has not been passed on. D is zero wherever neither ρ nor the direct light changed,
 //! so for a material change it lives on that material's elements only. The exact answer is
