@@ -172,7 +172,7 @@ fn sun_l1(a: &Solution, b: &Solution) -> f64 {
     for (e, (x, y)) in a.groups[0]
         .radiosity_rgb
         .iter()
-        .zip(&b.groups[0].radiosity_rgb)
+        .zip(b.groups[0].radiosity_rgb.iter())
         .enumerate()
     {
         let w = b.mesh.element_node(e).area_m2;

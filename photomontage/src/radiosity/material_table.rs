@@ -31,6 +31,8 @@
 //! from any solution. Building the table costs about [`TABLE_NODES`] material relights at the
 //! tightened stop rule, once per material edited.
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
 use super::{LightingChange, Transfer, initial_exitance_from};
@@ -223,7 +225,7 @@ impl Transfer {
                 self.solution
                     .groups
                     .iter()
-                    .map(|g| g.radiosity_rgb.clone())
+                    .map(|g| g.radiosity_rgb.to_vec())
                     .collect(),
             );
         }
@@ -298,8 +300,7 @@ impl Transfer {
                 &group.direct_irradiance_rgb,
                 emitted.as_deref(),
             );
-            group
-                .radiosity_rgb
+            Arc::make_mut(&mut group.radiosity_rgb)
                 .par_iter_mut()
                 .zip(coeffs.par_chunks_exact(TABLE_NODES * 3))
                 .for_each(|(b, c)| {

@@ -26,7 +26,7 @@ pub(super) fn sun_l1_rel(a: &Solution, reference: &Solution) -> f64 {
     );
     assert_eq!(reference.groups[0].name, "sun");
     let (mut diff, mut norm) = (0.0, 0.0);
-    for (e, (p, q)) in x.iter().zip(y).enumerate() {
+    for (e, (p, q)) in x.iter().zip(y.iter()).enumerate() {
         let w = reference.mesh.element_node(e).area_m2;
         diff += luminance(&std::array::from_fn(|c| (p[c] - q[c]).abs())) * w;
         norm += luminance(&q.map(f64::abs)) * w;

@@ -101,6 +101,33 @@ pub(super) struct ShootScratch {
     un: Vec<f32>,
     /// Per node, what it gathered in the round.
     acc: Vec<f32>,
+    /// Per-element buffers a relight gave back ([`ShootScratch::give_rgb`]), for its next warm
+    /// start and the groups' next solutions: a relight then writes into pages it has used before
+    /// (a fresh 1.2 MB buffer of the city block costs its page faults again at every relight).
+    spare: Vec<Vec<Rgb>>,
+}
+
+/// At most this many spare per-element buffers are kept.
+const SPARE_BUFFERS: usize = 16;
+
+impl ShootScratch {
+    /// A buffer of `n` values whose contents are unspecified (the caller writes every one): a
+    /// spare one when there is one.
+    pub(super) fn take_rgb(&mut self, n: usize) -> Vec<Rgb> {
+        let mut v = self.spare.pop().unwrap_or_default();
+        if v.len() != n {
+            v.clear();
+            v.resize(n, [0.0; 3]);
+        }
+        v
+    }
+
+    /// Keeps `v` for a later [`ShootScratch::take_rgb`] (up to [`SPARE_BUFFERS`]).
+    pub(super) fn give_rgb(&mut self, v: Vec<Rgb>) {
+        if self.spare.len() < SPARE_BUFFERS && v.capacity() > 0 {
+            self.spare.push(v);
+        }
+    }
 }
 
 impl Clone for ShootScratch {
@@ -201,7 +228,7 @@ pub(super) fn shoot(
     } else {
         (Vec::new(), Vec::new())
     };
-    let ShootScratch { b, u, un, acc } = scratch;
+    let ShootScratch { b, u, un, acc, .. } = scratch;
     let (b, u): (&mut [f64], &mut [f64]) = if in_place {
         (own_b.as_flattened_mut(), own_u.as_flattened_mut())
     } else {

@@ -157,10 +157,13 @@ impl LightGroup {
 pub struct GroupSolution {
     /// The group's name.
     pub name: String,
-    /// Direct irradiance (shadowed), per element.
-    pub direct_irradiance_rgb: Vec<Rgb>,
-    /// Radiosity (exitance, emission included), per element.
-    pub radiosity_rgb: Vec<Rgb>,
+    /// Direct irradiance (shadowed), per element. Shared, copied on write (`Arc::make_mut`):
+    /// a cloned solution (the one [`crate::radiosity::Transfer::relight`] returns) copies no
+    /// element until one of the two changes.
+    pub direct_irradiance_rgb: Arc<Vec<Rgb>>,
+    /// Radiosity (exitance, emission included), per element; shared as
+    /// `direct_irradiance_rgb`.
+    pub radiosity_rgb: Arc<Vec<Rgb>>,
     /// How the solve converged.
     pub convergence: Vec<ConvergenceRow>,
 }
@@ -232,7 +235,7 @@ impl Solution {
         let n = self.mesh.elements.len();
         let mut total = vec![[0.0; 3]; n];
         for g in &self.groups {
-            for (t, b) in total.iter_mut().zip(&g.radiosity_rgb) {
+            for (t, b) in total.iter_mut().zip(g.radiosity_rgb.iter()) {
                 for c in 0..3 {
                     t[c] += b[c];
                 }
@@ -306,7 +309,7 @@ impl Solution {
                     return g.clone();
                 }
                 // Each element on its own: the same values on any number of threads.
-                let radiosity_rgb = (0..mesh.elements.len())
+                let radiosity_rgb: Vec<Rgb> = (0..mesh.elements.len())
                     .into_par_iter()
                     .map(|e| {
                         std::array::from_fn(|c| {
@@ -316,8 +319,8 @@ impl Solution {
                     .collect();
                 GroupSolution {
                     name: g.name.clone(),
-                    direct_irradiance_rgb: vec![[0.0; 3]; mesh.elements.len()],
-                    radiosity_rgb,
+                    direct_irradiance_rgb: Arc::new(vec![[0.0; 3]; mesh.elements.len()]),
+                    radiosity_rgb: Arc::new(radiosity_rgb),
                     convergence: g.convergence.clone(),
                 }
             })
@@ -621,8 +624,8 @@ pub fn solve_on_mesh_twinned(
             .map(
                 |((group, direct), (radiosity, convergence))| GroupSolution {
                     name: group.name.clone(),
-                    direct_irradiance_rgb: direct,
-                    radiosity_rgb: radiosity,
+                    direct_irradiance_rgb: Arc::new(direct),
+                    radiosity_rgb: Arc::new(radiosity),
                     convergence,
                 },
             )

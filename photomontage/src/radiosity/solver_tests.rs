@@ -276,7 +276,7 @@ fn bit_identical_on_one_and_two_threads() {
         let bits = |s: &Solution| -> Vec<u64> {
             s.groups
                 .iter()
-                .flat_map(|g| g.radiosity_rgb.iter().chain(&g.direct_irradiance_rgb))
+                .flat_map(|g| g.radiosity_rgb.iter().chain(g.direct_irradiance_rgb.iter()))
                 .flat_map(|v| v.map(f64::to_bits))
                 .collect()
         };

@@ -30,6 +30,8 @@
 //! group as before. Each element is composed on its own and the shootings are
 //! thread-count independent, so the result is the same on any number of threads.
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
 use super::{GroupKind, Transfer, initial_exitance_from, power};
@@ -179,7 +181,7 @@ impl Transfer {
         compose(
             &basis.radiosity,
             source,
-            &mut self.solution.groups[g].radiosity_rgb,
+            Arc::make_mut(&mut self.solution.groups[g].radiosity_rgb),
         );
         basis.pending = Some((g, *source));
         self.sun_basis = Some(basis);

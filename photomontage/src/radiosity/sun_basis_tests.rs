@@ -135,7 +135,7 @@ fn sun_steps_through_the_axes_are_the_same_on_one_and_two_threads() {
     let (one, two) = (run(1), run(2));
     assert!(
         one.iter()
-            .zip(&two)
+            .zip(two.iter())
             .all(|(a, b)| a.map(f64::to_bits) == b.map(f64::to_bits))
     );
 }

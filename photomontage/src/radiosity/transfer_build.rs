@@ -158,8 +158,8 @@ impl Transfer {
                 hierarchy.solve(&mesh, b0, &group.name, &params.solve.stop, cancel, on_pass)?;
             solved.push(GroupSolution {
                 name: group.name.clone(),
-                direct_irradiance_rgb: direct,
-                radiosity_rgb: radiosity,
+                direct_irradiance_rgb: Arc::new(direct),
+                radiosity_rgb: Arc::new(radiosity),
                 convergence,
             });
         }

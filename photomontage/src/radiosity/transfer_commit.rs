@@ -56,7 +56,7 @@ impl Transfer {
             let direct = retraced[g].take().unwrap_or_default();
             let rows = self.relight_sun_by_axes(g, &source, counts);
             let group = &mut self.solution.groups[g];
-            group.direct_irradiance_rgb = direct;
+            group.direct_irradiance_rgb = Arc::new(direct);
             group.convergence = rows;
             actions[g] = Action::Keep;
         }
@@ -92,9 +92,9 @@ impl Transfer {
                 _ => None,
             };
             if let Some(direct) = retraced[g].take() {
-                group.direct_irradiance_rgb = direct;
+                group.direct_irradiance_rgb = Arc::new(direct);
             } else if let Some(k) = scale {
-                for d in &mut group.direct_irradiance_rgb {
+                for d in Arc::make_mut(&mut group.direct_irradiance_rgb) {
                     for c in 0..3 {
                         d[c] *= k[c];
                     }
@@ -105,7 +105,10 @@ impl Transfer {
             }
             if let (Some(k), true, false) = (scale, linear, material_changed) {
                 // The response is linear in the group's sources: scale it, exactly.
-                for (b, b0) in group.radiosity_rgb.iter_mut().zip(&mut self.b0s[g]) {
+                for (b, b0) in Arc::make_mut(&mut group.radiosity_rgb)
+                    .iter_mut()
+                    .zip(&mut self.b0s[g])
+                {
                     for c in 0..3 {
                         b[c] *= k[c];
                         b0[c] *= k[c];
@@ -139,9 +142,18 @@ impl Transfer {
                     > self.params.solve.stop.residual * power(&group.radiosity_rgb, areas);
             // The new initial exitance (as `initial_exitance_from`) in the same pass.
             let direct = &group.direct_irradiance_rgb;
-            let (b0_new, (start, unshot)): (Vec<Rgb>, (Vec<Rgb>, Vec<Rgb>)) = (0..new_rho.len())
-                .into_par_iter()
-                .map(|e| {
+            let n = new_rho.len();
+            let (mut b0_new, mut start, mut unshot) = (
+                self.scratch.take_rgb(n),
+                self.scratch.take_rgb(n),
+                self.scratch.take_rgb(n),
+            );
+            b0_new
+                .par_iter_mut()
+                .zip(start.par_iter_mut())
+                .zip(unshot.par_iter_mut())
+                .enumerate()
+                .for_each(|(e, ((b0_out, start_out), unshot_out))| {
                     let emitted = emitted.as_deref().map_or([0.0; 3], |m| m[e]);
                     let b0_new: Rgb =
                         std::array::from_fn(|c| new_rho[e][c] * direct[e][c] + emitted[c]);
@@ -161,14 +173,16 @@ impl Transfer {
                         };
                         unshot[c] = d + k * carry[c] * left[c];
                     }
-                    (b0_new, (start, unshot))
-                })
-                .unzip();
+                    (*b0_out, *start_out, *unshot_out) = (b0_new, start, unshot);
+                });
             if b0_new.iter().flatten().all(|&v| v == 0.0) {
                 // A dark group (sun down, sky off, light off): B = 0 exactly.
-                group.radiosity_rgb.clone_from(&b0_new);
+                group.radiosity_rgb = Arc::new(b0_new.clone());
                 group.convergence.clear();
-                self.b0s[g] = b0_new;
+                let old = std::mem::replace(&mut self.b0s[g], b0_new);
+                for v in [old, start, unshot] {
+                    self.scratch.give_rgb(v);
+                }
                 self.unshot[g].clear();
                 continue;
             }
@@ -236,18 +250,25 @@ impl Transfer {
             for (p, shot) in pending.into_iter().zip(results) {
                 let g = p.g;
                 let group = &mut self.solution.groups[g];
-                group.radiosity_rgb = shot.radiosity;
+                let old = std::mem::replace(&mut group.radiosity_rgb, Arc::new(shot.radiosity));
                 group.convergence = shot.rows;
-                self.b0s[g] = p.b0_new;
+                // The old buffers go back to the scratch (where no clone of the solution
+                // holds the radiosity).
+                if let Ok(old) = Arc::try_unwrap(old) {
+                    self.scratch.give_rgb(old);
+                }
+                let old = std::mem::replace(&mut self.b0s[g], p.b0_new);
+                self.scratch.give_rgb(old);
                 let remainder = shot.unshot.unwrap_or_default();
                 if p.pass_on || lit_from_zero || self.unshot[g].len() != remainder.len() {
-                    self.unshot[g] = remainder;
+                    let old = std::mem::replace(&mut self.unshot[g], remainder);
+                    self.scratch.give_rgb(old);
                 } else {
                     // Kept, not passed on: scaled as the gathered part, plus this remainder.
                     let old_rho = old_rho.as_deref();
                     self.unshot[g]
                         .par_iter_mut()
-                        .zip(remainder)
+                        .zip(remainder.par_iter())
                         .enumerate()
                         .for_each(|(e, (u, r))| {
                             let rho_old = old_rho.map_or(new_rho[e], |o| o[e]);
@@ -256,6 +277,7 @@ impl Transfer {
                                 u[c] = k * p.carry[c] * u[c] + r[c];
                             }
                         });
+                    self.scratch.give_rgb(remainder);
                 }
             }
         } else {
@@ -276,7 +298,7 @@ impl Transfer {
                     &self.params.solve.stop,
                     self.params.sweep,
                 );
-                group.radiosity_rgb = radiosity;
+                group.radiosity_rgb = Arc::new(radiosity);
                 group.convergence = rows;
                 self.b0s[g] = b0_new;
             }

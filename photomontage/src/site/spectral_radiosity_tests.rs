@@ -253,7 +253,7 @@ fn each_band_of_a_coloured_enclosure_meets_the_enclosure_identity() {
             passes.light(k, radiance_rgb),
             passes.reflectance(k, rho_rgb),
         );
-        for b in &solution.groups[0].radiosity_rgb {
+        for b in solution.groups[0].radiosity_rgb.iter() {
             for c in 0..3 {
                 let want = std::f64::consts::PI * l[c] / (1.0 - rho[c]);
                 assert!(
