@@ -401,7 +401,9 @@ impl Transfer {
     }
 
     /// Relights the transfer (module doc) and returns the new solution; on error nothing
-    /// changes.
+    /// changes. The returned solution shares its per-element values with the transfer's own
+    /// (copied on write): while the caller keeps it, the next relight copies the groups it
+    /// changes; dropped before, nothing is copied.
     ///
     /// # Errors
     /// [`RadiosityError::InvalidSource`] for a bad or unknown light,
@@ -411,8 +413,8 @@ impl Transfer {
         Ok(self.solution.clone())
     }
 
-    /// [`Self::relight`] without the copy of the solution it returns (read it with
-    /// [`Self::solution`]): the studio's live preview, which reads the transfer's own.
+    /// [`Self::relight`] without the solution it returns (read it with [`Self::solution`]): the
+    /// studio's live preview, which reads the transfer's own.
     ///
     /// # Errors
     /// As [`Self::relight`]; on error nothing changes.
