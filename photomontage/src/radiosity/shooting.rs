@@ -613,8 +613,8 @@ mod tests {
 
     proptest! {
         /// The keyed sort gives the order of the comparator it replaced: falling worth, ties by
-        /// rising index, patches of no worth left out (mutation checked: `u64::MAX −` dropped
-        /// or the index ignored fails it).
+        /// rising index, patches of no worth left out (mutation checked: the key without
+        /// `u64::MAX −` fails it).
         #[test]
         fn best_first_orders_as_the_comparator(
             worth in prop::collection::vec(
