@@ -463,23 +463,19 @@ pub(super) fn shoot(
             powers: [total[0], unshot[0]],
         }];
     }
-    // The results go into the groups' own buffers (no fresh pages).
-    let read = |v: &[f64], g: usize, out: &mut Vec<Rgb>| {
-        out.resize(n_el, [0.0; 3]);
-        out.par_iter_mut().enumerate().for_each(|(e, o)| {
-            *o = std::array::from_fn(|c| v[e * stride + 3 * g + c]);
-        });
-    };
-    groups
+    // The results go into the groups' own buffers (no fresh pages), in one parallel pass over
+    // fixed chunks of elements: a chunk of B and of the unshot part is read for every group
+    // while it is in cache, not once per group and buffer.
+    let mut shots: Vec<Shot> = groups
         .into_iter()
         .zip(out_rows)
         .enumerate()
         .map(|(g, (group, rows))| {
             let mut radiosity = group.start;
-            read(b, g, &mut radiosity);
+            radiosity.resize(n_el, [0.0; 3]);
             let kept = group.keep_unshot.then(|| {
                 let mut unshot = group.unshot.unwrap_or_default();
-                read(u, g, &mut unshot);
+                unshot.resize(n_el, [0.0; 3]);
                 unshot
             });
             Shot {
@@ -489,8 +485,38 @@ pub(super) fn shoot(
                 powers: [total[g], unshot[g]],
             }
         })
-        .collect()
+        .collect();
+    let (b, u): (&[f64], &[f64]) = (b, u);
+    // Per chunk, its part of every output: (group, read from the unshot part, the part).
+    let mut chunks: Vec<Vec<(usize, bool, &mut [Rgb])>> = (0..n_el.div_ceil(READ_CHUNK))
+        .map(|_| Vec::with_capacity(2 * k))
+        .collect();
+    for (g, shot) in shots.iter_mut().enumerate() {
+        for (c, part) in shot.radiosity.chunks_mut(READ_CHUNK).enumerate() {
+            chunks[c].push((g, false, part));
+        }
+        let kept = shot
+            .unshot
+            .iter_mut()
+            .flat_map(|v| v.chunks_mut(READ_CHUNK));
+        for (c, part) in kept.enumerate() {
+            chunks[c].push((g, true, part));
+        }
+    }
+    chunks.into_par_iter().enumerate().for_each(|(c, parts)| {
+        for (g, from_unshot, part) in parts {
+            let v = if from_unshot { u } else { b };
+            for (i, o) in part.iter_mut().enumerate() {
+                let at = (c * READ_CHUNK + i) * stride + 3 * g;
+                *o = [v[at], v[at + 1], v[at + 2]];
+            }
+        }
+    });
+    shots
 }
+
+/// Elements per chunk of [`shoot`]'s read-out.
+const READ_CHUNK: usize = 2048;
 
 /// Safety factor on a group's measured bounce when a round is planned as the last.
 const BOUNCE_MARGIN: f64 = 1.25;

@@ -206,13 +206,24 @@ impl PreparedRelight {
     }
 }
 
-/// Σ A_e·Y(|v_e|), the power the shooting weighs (in element order: the same on any number of
-/// threads).
+/// Elements per chunk of [`power`]'s parallel sum.
+const POWER_CHUNK: usize = 4096;
+
+/// Σ A_e·Y(|v_e|), the power the shooting weighs: fixed chunks of [`POWER_CHUNK`] elements
+/// summed in parallel (each in element order), then the chunk sums in chunk order, so the same
+/// on any number of threads. It runs on every relight of every group.
 fn power(v: &[Rgb], areas: &[f64]) -> f64 {
-    v.iter()
-        .zip(areas)
-        .map(|(v, a)| a * super::luminance(&v.map(f64::abs)))
-        .sum()
+    let chunks: Vec<f64> = v
+        .par_chunks(POWER_CHUNK)
+        .zip(areas.par_chunks(POWER_CHUNK))
+        .map(|(v, areas)| {
+            v.iter()
+                .zip(areas)
+                .map(|(v, a)| a * super::luminance(&v.map(f64::abs)))
+                .sum()
+        })
+        .collect();
+    chunks.iter().sum()
 }
 
 #[path = "transfer_build.rs"]

@@ -137,9 +137,11 @@ impl Transfer {
             // point however long the series.
             let kept = &self.unshot[g];
             let areas = &self.topology.areas;
-            let pass_on = !kept.is_empty()
-                && power(kept, areas)
-                    > self.params.solve.stop.residual * power(&group.radiosity_rgb, areas);
+            let pass_on = !kept.is_empty() && {
+                let (kept, all) =
+                    rayon::join(|| power(kept, areas), || power(&group.radiosity_rgb, areas));
+                kept > self.params.solve.stop.residual * all
+            };
             // The new initial exitance (as `initial_exitance_from`) in the same pass.
             let direct = &group.direct_irradiance_rgb;
             let n = new_rho.len();
