@@ -32,9 +32,9 @@ impl Token {
         is_x86_feature_detected!("avx2").then_some(Self(()))
     }
 
-    /// For each link `(receiver, factor)` of `links`: `acc[(receiver − base)·S ..][..S] +=
-    /// factor · src`, in link order. Panics when the first or the last receiver lies outside
-    /// `acc` (checked once per run, not per link).
+    /// For each link `(receiver, factor)`: `acc[receiver·S ..][..S] += factor · src`, in link
+    /// order (`receiver` is the offset from the first node of the range `acc` holds). Panics when
+    /// the last receiver lies outside `acc` (checked once per run, not per link).
     ///
     /// # Safety
     /// `receivers` must be sorted ascending (as every run of [`super::source_rows::SourceRows`]
@@ -43,14 +43,13 @@ impl Token {
     pub unsafe fn gather_run<const S: usize>(
         self,
         src: &[f32; S],
-        receivers: &[u32],
+        receivers: &[u16],
         factors: &[f32],
-        base: usize,
         acc: &mut [f32],
     ) {
         // SAFETY: a `Token` exists only if the CPU has AVX2 (`Token::new`); the receivers are
         // sorted (this function's contract).
-        unsafe { gather_run_impl::<S>(src, receivers, factors, base, acc) }
+        unsafe { gather_run_impl::<S>(src, receivers, factors, acc) }
     }
 
     /// The eight lane sums of `Σ_j hits[8b + j] · weights[b][j]` over blocks `b`
@@ -89,9 +88,8 @@ fn escaped_lanes_impl(hits: &[u8], weights: &[[f32; 8]]) -> [f32; 8] {
 #[target_feature(enable = "avx2")]
 unsafe fn gather_run_impl<const S: usize>(
     src: &[f32; S],
-    receivers: &[u32],
+    receivers: &[u16],
     factors: &[f32],
-    base: usize,
     acc: &mut [f32],
 ) {
     // Eight source values in one register where S ≥ 8, then four, then one at a time.
@@ -101,22 +99,22 @@ unsafe fn gather_run_impl<const S: usize>(
     let s4 = (quad_at + 4 <= S).then(|| unsafe { _mm_loadu_ps(src.as_ptr().add(quad_at)) });
     let single = quad_at + if s4.is_some() { 4 } else { 0 };
     // One check per run instead of one per link: a run's receivers are sorted (SourceRows), so
-    // the first and the last bound them all.
-    let (Some(&first), Some(&last)) = (receivers.first(), receivers.last()) else {
+    // the last bounds them all.
+    let Some(&last) = receivers.last() else {
         return;
     };
     assert!(
-        first as usize >= base && (last as usize - base + 1) * S <= acc.len(),
+        (usize::from(last) + 1) * S <= acc.len(),
         "a run's receivers lie in its range"
     );
     debug_assert!(receivers.is_sorted(), "a run's receivers are sorted");
     let n = receivers.len().min(factors.len());
     let acc = acc.as_mut_ptr();
     for i in 0..n {
-        // SAFETY: i < n ≤ both lengths; every receiver lies in first..=last (sorted, the
+        // SAFETY: i < n ≤ both lengths; every receiver is at most the last (sorted, the
         // caller's contract), so `at + S` ≤ `acc.len()` by the check above.
         let (rcv, f) = unsafe { (*receivers.get_unchecked(i), *factors.get_unchecked(i)) };
-        let at = (rcv as usize - base) * S;
+        let at = usize::from(rcv) * S;
         // SAFETY: `at + S` ≤ `acc.len()` (above): `p` points at S values of `acc`.
         let p = unsafe { acc.add(at) };
         if let Some(v) = s8 {

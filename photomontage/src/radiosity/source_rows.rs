@@ -14,6 +14,10 @@
 //! two ranges per thread of the pool that builds them, at least 4 and at most 16.
 
 use super::hierarchical::Link;
+
+/// The most nodes a receiver range holds: a receiver is stored as its `u16` offset from the
+/// range's first node (6 bytes a link with its factor, not 8), so a wider range is cut.
+pub(super) const MAX_RANGE_NODES: usize = 1 << 16;
 /// Receiver ranges of a shooting round for a pool of `threads` threads (module doc): the links
 /// of every source row are split at the same receiver-node boundaries, and each range is
 /// accumulated by one task. The sums do not depend on it.
@@ -40,7 +44,8 @@ pub(super) fn simd_token() -> Option<Simd> {
 
 /// The links as compressed rows per **source** node (receiver and factor), stored per receiver
 /// range: range r holds, source by source, the links whose receiver lies in
-/// `bounds[r]..bounds[r + 1]`, each source's run sorted by receiver. A range's task so reads its
+/// `bounds[r]..bounds[r + 1]`, each source's run sorted by receiver. A receiver is stored as
+/// its offset from `bounds[r]` (at most [`MAX_RANGE_NODES`] nodes a range). A range's task so reads its
 /// own contiguous arrays in source order, with no cut of a long row to look up per source.
 #[derive(Debug, Clone)]
 pub(super) struct SourceRows {
@@ -49,7 +54,8 @@ pub(super) struct SourceRows {
     ranges: usize,
     /// Run of source n in range r: `start[r·(nodes+1) + n]..start[r·(nodes+1) + n + 1]`.
     start: Vec<u32>,
-    receiver: Vec<u32>,
+    /// Receiver offset from its range's first node.
+    receiver: Vec<u16>,
     form_factor: Vec<f32>,
     /// Receiver node ranges: range r is `bounds[r]..bounds[r + 1]` (balanced by links).
     pub(super) bounds: Vec<u32>,
@@ -96,6 +102,16 @@ impl SourceRows {
         for b in &mut bounds[r..] {
             *b = nodes as u32;
         }
+        // Ranges wider than MAX_RANGE_NODES are cut into equal parts (the sums do not depend on
+        // the ranges).
+        let mut cut = vec![0u32];
+        for w in bounds.windows(2) {
+            let (lo, hi) = (w[0] as usize, w[1] as usize);
+            let parts = (hi - lo).div_ceil(MAX_RANGE_NODES).max(1);
+            cut.extend((1..=parts).map(|i| (lo + (hi - lo) * i / parts) as u32));
+        }
+        let bounds = cut;
+        let ranges = bounds.len() - 1;
         let range_of = |receiver: u32| bounds[1..].partition_point(|&b| b <= receiver);
         let width = nodes + 1;
         let mut start = vec![0u32; ranges * width];
@@ -113,12 +129,15 @@ impl SourceRows {
             }
         }
         let mut next: Vec<u32> = (0..ranges * width).map(|i| start[i]).collect();
-        let mut pairs = vec![(0u32, 0f32); links.len()];
+        let mut pairs = vec![(0u16, 0f32); links.len()];
         for l in links {
-            let at = range_of(l.receiver) * width + l.source as usize;
+            let range = range_of(l.receiver);
+            let at = range * width + l.source as usize;
             let i = next[at] as usize;
             next[at] += 1;
-            pairs[i] = (l.receiver, l.form_factor as f32);
+            let offset = u16::try_from(l.receiver - bounds[range])
+                .unwrap_or_else(|_| unreachable!("a range holds at most MAX_RANGE_NODES nodes"));
+            pairs[i] = (offset, l.form_factor as f32);
         }
         for r in 0..ranges {
             for n in 0..nodes {
@@ -167,7 +186,7 @@ impl SourceRows {
 }
 
 /// Receiver range `r` gathers the unshot values `un` (`S` per node) of the `active` nodes
-/// through their links into `acc` (the range's nodes, `S` per node): a receiver's sum runs over
+/// through their links into `acc` (the range's nodes from `bounds[r]` on, `S` per node): a receiver's sum runs over
 /// `active` in order and each row in receiver order. With an AVX2 `token` the same sums run in
 /// the vector kernel (bit for bit the same).
 pub(super) fn gather_range<const S: usize>(
@@ -178,7 +197,6 @@ pub(super) fn gather_range<const S: usize>(
     acc: &mut [f32],
     token: Option<Simd>,
 ) {
-    let base = rows.bounds[r] as usize;
     for &n in active {
         let src: &[f32; S] = un[n * S..(n + 1) * S]
             .try_into()
@@ -191,14 +209,14 @@ pub(super) fn gather_range<const S: usize>(
             // else writes the rows).
             #[allow(unsafe_code)] // the vector kernel's contract (gather_avx2.rs)
             unsafe {
-                token.gather_run::<S>(src, receivers, factors, base, acc)
+                token.gather_run::<S>(src, receivers, factors, acc)
             };
             continue;
         }
         #[cfg(not(target_arch = "x86_64"))]
         let _ = token;
         for (rcv, &f) in receivers.iter().zip(factors) {
-            let at = (*rcv as usize - base) * S;
+            let at = usize::from(*rcv) * S;
             let dst: &mut [f32; S] = (&mut acc[at..at + S])
                 .try_into()
                 .unwrap_or_else(|_| unreachable!("S values per node"));
@@ -218,7 +236,6 @@ pub(super) fn gather_range_dyn(
     acc: &mut [f32],
     stride: usize,
 ) {
-    let base = rows.bounds[r] as usize;
     for &n in active {
         let src = &un[n * stride..(n + 1) * stride];
         let links = rows.cut(n, r);
@@ -227,7 +244,7 @@ pub(super) fn gather_range_dyn(
             .zip(&rows.form_factor[links])
         {
             let f = *f;
-            let at = (*rcv as usize - base) * stride;
+            let at = usize::from(*rcv) * stride;
             for (d, s) in acc[at..at + stride].iter_mut().zip(src) {
                 *d += f * s;
             }
@@ -285,11 +302,14 @@ mod tests {
             expected.sort_unstable();
             let mut got = Vec::new();
             for r in 0..rows.ranges() {
-                let run = &rows.receiver[rows.cut(n, r)];
-                assert!(run.windows(2).all(|w| w[0] <= w[1]));
                 let (lo, hi) = (rows.bounds[r], rows.bounds[r + 1]);
+                let run: Vec<u32> = rows.receiver[rows.cut(n, r)]
+                    .iter()
+                    .map(|&o| lo + u32::from(o))
+                    .collect();
+                assert!(run.windows(2).all(|w| w[0] <= w[1]));
                 assert!(run.iter().all(|&x| lo <= x && x < hi));
-                got.extend_from_slice(run);
+                got.extend_from_slice(&run);
             }
             assert_eq!(got, expected, "row of node {n}");
             assert_eq!(rows.row_len(n), expected.len() as u64);
@@ -299,6 +319,61 @@ mod tests {
         for r in 0..rows.ranges() {
             let k: usize = (0..nodes as usize).map(|n| rows.cut(n, r).len()).sum();
             assert!(k <= 2 * share, "range {r} holds {k} links, share {share}");
+        }
+    }
+
+    /// A receiver range wider than [`MAX_RANGE_NODES`] is cut (a receiver is stored as a `u16`
+    /// offset in its range): 200 000 nodes asked for in one range make 4 ranges of at most
+    /// 65 536 nodes, and the gathered sums, with and without the vector kernel, equal a plain
+    /// loop over the active sources' links sorted by (source, receiver), bit for bit. Mutation
+    /// check: storing the receiver without taking its range's first node off breaks it.
+    #[test]
+    fn wide_ranges_are_cut_and_sum_as_the_links() {
+        const S: usize = 3;
+        let nodes = 200_000usize;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
+        let links: Vec<Link> = (0..30_000u64)
+            .map(|i| Link {
+                receiver: (i * 2_654_435_761 % nodes as u64) as u32,
+                source: (i * 40_503 % 997) as u32,
+                form_factor: 1e-3 * (1 + i % 89) as f64 / 7.0,
+            })
+            .collect();
+        #[allow(clippy::cast_precision_loss)]
+        let un: Vec<f32> = (0..nodes * S)
+            .map(|i| ((i * 6151 % 1000) as f32 - 400.0) * 2.9e-3)
+            .collect();
+        let active: Vec<usize> = (0..997).filter(|n| n % 3 != 1).collect();
+        let mut sorted: Vec<&Link> = links.iter().filter(|l| l.source % 3 != 1).collect();
+        sorted.sort_by_key(|l| (l.source, l.receiver));
+        let mut expected = vec![0.5_f32; nodes * S];
+        for l in sorted {
+            #[allow(clippy::cast_possible_truncation)]
+            let f = l.form_factor as f32;
+            for c in 0..S {
+                expected[l.receiver as usize * S + c] += f * un[l.source as usize * S + c];
+            }
+        }
+        let rows = SourceRows::with_ranges(nodes, &links, 1);
+        assert_eq!(rows.ranges(), 4);
+        assert!(
+            rows.bounds
+                .windows(2)
+                .all(|w| (w[1] - w[0]) as usize <= MAX_RANGE_NODES)
+        );
+        for token in [None, simd_token()] {
+            let mut acc = vec![0.5_f32; nodes * S];
+            for r in 0..rows.ranges() {
+                let (lo, hi) = (rows.bounds[r] as usize, rows.bounds[r + 1] as usize);
+                gather_range::<S>(&rows, r, &active, &un, &mut acc[lo * S..hi * S], token);
+            }
+            assert!(
+                acc.iter()
+                    .zip(&expected)
+                    .all(|(a, e)| a.to_bits() == e.to_bits()),
+                "vector kernel: {}",
+                token.is_some()
+            );
         }
     }
 
