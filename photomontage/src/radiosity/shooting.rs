@@ -74,6 +74,17 @@ impl<'a> ShotGroup<'a> {
     }
 }
 
+/// Where [`shoot`] finds the groups' start and unshot part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Leaves {
+    /// In the groups: [`ShotGroup`]'s `start`, and `old` or `unshot`.
+    InGroups,
+    /// Already in the scratch's leaves ([`ShootScratch::leaves`]), written by the caller in one
+    /// pass with its warm start: the groups' `start` and `unshot` are only the buffers the
+    /// results are read out into (`n` elements each, `unshot` for every group).
+    Filled,
+}
+
 /// One group's result of [`shoot`].
 pub(super) struct Shot {
     /// B per element.
@@ -120,6 +131,15 @@ impl ShootScratch {
             v.resize(n, [0.0; 3]);
         }
         v
+    }
+
+    /// B and the unshot part per element (`stride` values each, group-major within an
+    /// element, as [`shoot`] reads them with [`Leaves::Filled`]), sized for `n_el` elements;
+    /// their contents are unspecified until the caller writes every value.
+    pub(super) fn leaves(&mut self, n_el: usize, stride: usize) -> (&mut [f64], &mut [f64]) {
+        self.b.resize(n_el * stride, 0.0);
+        self.u.resize(n_el * stride, 0.0);
+        (&mut self.b, &mut self.u)
     }
 
     /// Keeps `v` for a later [`ShootScratch::take_rgb`] (up to [`SPARE_BUFFERS`]).
@@ -191,14 +211,16 @@ fn group_sums(per_patch: &[f64], k: usize) -> Vec<f64> {
 
 /// Shoots D = start − old (or the given unshot part) of every group (module doc) with
 /// reflectance `rho` (per element); `patch_links` are the links read when a patch is shot
-/// ([`SourceRows::patch_links`]). Returns each group's radiosity per element and its convergence
-/// rows (and what is left unshot, where asked).
-#[allow(clippy::too_many_lines)]
+/// ([`SourceRows::patch_links`]); `leaves` says whether the groups hold their start or the
+/// scratch does. Returns each group's radiosity per element and its convergence rows (and what
+/// is left unshot, where asked).
+#[allow(clippy::too_many_lines, clippy::too_many_arguments)]
 pub(super) fn shoot(
     topology: &Topology,
     rows: &SourceRows,
     rho: &[Rgb],
     groups: Vec<ShotGroup<'_>>,
+    leaves: Leaves,
     stop: &StopRule,
     patch_links: &[u64],
     scratch: &mut ShootScratch,
@@ -216,7 +238,9 @@ pub(super) fn shoot(
     // the unshot part (an `Rgb` per element is the layout of one group's values), so nothing is
     // copied in or out.
     let mut groups = groups;
-    let in_place = k == 1
+    let filled = leaves == Leaves::Filled;
+    let in_place = !filled
+        && k == 1
         && groups[0].keep_unshot
         && groups[0].start.len() == n_el
         && groups[0].unshot.as_ref().is_some_and(|v| v.len() == n_el);
@@ -232,14 +256,18 @@ pub(super) fn shoot(
     let (b, u): (&mut [f64], &mut [f64]) = if in_place {
         (own_b.as_flattened_mut(), own_u.as_flattened_mut())
     } else {
+        assert!(
+            !filled || (b.len() == n_el * stride && u.len() == n_el * stride),
+            "filled leaves hold every group's values for every element"
+        );
         b.resize(n_el * stride, 0.0);
         u.resize(n_el * stride, 0.0);
         (b, u)
     };
     un.resize(n_nodes * stride, 0.0);
     acc.resize(n_nodes * stride, 0.0);
-    // Leaves: B and the unshot part, `stride` values per element (group-major within), and the
-    // patches' powers; patch by patch in parallel.
+    // Leaves: B and the unshot part, `stride` values per element (group-major within), unless
+    // filled already, and the patches' powers; patch by patch in parallel.
     let mut powers = PatchPowers {
         total: vec![0.0; patches.len() * k],
         unshot: vec![0.0; patches.len() * k],
@@ -250,7 +278,7 @@ pub(super) fn shoot(
         .zip(block_leaves(&blocks, stride, k, b, u, &mut powers))
         .for_each(|(block, mut leaves)| {
             let BlockLeaves { b, u, .. } = &mut leaves;
-            let copied = if in_place {
+            let copied = if in_place || filled {
                 0..0
             } else {
                 block.elements.0..block.elements.1

@@ -36,7 +36,7 @@ use rayon::prelude::*;
 
 use super::{GroupKind, Transfer, initial_exitance_from, power};
 use crate::radiosity::convergence::ConvergenceRow;
-use crate::radiosity::shooting::{ShotGroup, shoot};
+use crate::radiosity::shooting::{Leaves, ShotGroup, shoot};
 use crate::radiosity::sources::DistantSource;
 use crate::radiosity::sun_rays::SunCounts;
 use crate::radiosity::{LightGroup, Rgb, luminance};
@@ -164,6 +164,7 @@ impl Transfer {
                 &self.source_rows,
                 &self.element_rho,
                 axes,
+                Leaves::InGroups,
                 &self.params.solve.stop,
                 &self.patch_links,
                 &mut self.scratch,

@@ -53,7 +53,7 @@ use super::convergence::ConvergenceRow;
 use super::form_factor::FormFactorEngine;
 use super::hierarchical::{Hierarchy, Link};
 use super::mesh::Mesh;
-use super::shooting::{ShootScratch, ShotGroup, shoot};
+use super::shooting::{Leaves, ShootScratch, ShotGroup, shoot};
 use super::sky_transfer::{SkyRays, SkyTransfer};
 use super::solve::{
     GroundTerm, group_direct, initial_exitance, initial_exitance_from, sun_directions,

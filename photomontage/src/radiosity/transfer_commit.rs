@@ -4,16 +4,106 @@
 
 use super::*;
 
-/// A group a relight iterates: its index, new initial exitance, warm start, the shooting's
-/// unshot part, the ratio its gathered part was carried with, and whether the kept remainder is
-/// in the unshot part.
+/// A group a relight iterates: its index, its emitting materials' exitance per element (if it
+/// has any), the ratio its gathered part is carried with, and whether the kept remainder goes
+/// into the unshot part.
 struct Pending {
     g: usize,
-    b0_new: Vec<Rgb>,
-    start: Vec<Rgb>,
-    unshot: Vec<Rgb>,
+    emitted: Option<Vec<Rgb>>,
     carry: Rgb,
     pass_on: bool,
+}
+
+/// What one group's warm start reads (the doc in [`Transfer::commit_relight`]).
+struct Warm<'a> {
+    rho_new: &'a [Rgb],
+    /// ρ before a material change (`None`: unchanged).
+    rho_old: Option<&'a [Rgb]>,
+    direct: &'a [Rgb],
+    emitted: Option<&'a [Rgb]>,
+    radiosity: &'a [Rgb],
+    b0_old: &'a [Rgb],
+    /// The kept remainder, where it is passed on.
+    left: Option<&'a [Rgb]>,
+    carry: Rgb,
+}
+
+impl Warm<'_> {
+    /// Element `e`'s new initial exitance (as `initial_exitance_from`), warm start and unshot
+    /// part: D = start − old (bit-equal values pass nothing on) plus the carried remainder.
+    #[inline]
+    fn at(&self, e: usize) -> (Rgb, Rgb, Rgb) {
+        let (rho, direct) = (self.rho_new[e], self.direct[e]);
+        let emitted = self.emitted.map_or([0.0; 3], |m| m[e]);
+        let b0_new: Rgb = std::array::from_fn(|c| rho[c] * direct[c] + emitted[c]);
+        let (b, b0_old) = (self.radiosity[e], self.b0_old[e]);
+        let rho_old = self.rho_old.map_or(rho, |r| r[e]);
+        let left = self.left.map_or([0.0; 3], |l| l[e]);
+        let mut start = [0.0; 3];
+        let mut unshot = [0.0; 3];
+        for c in 0..3 {
+            let gathered = b[c] - b0_old[c];
+            let k = rho_ratio(rho[c], rho_old[c]);
+            start[c] = b0_new[c] + k * self.carry[c] * gathered;
+            let d = if start[c].to_bits() == b[c].to_bits() {
+                0.0
+            } else {
+                start[c] - b[c]
+            };
+            unshot[c] = d + k * self.carry[c] * left[c];
+        }
+        (b0_new, start, unshot)
+    }
+
+    /// The new initial exitance and the warm start of every element, into `b0_new` and `start`.
+    fn fill(&self, b0_new: &mut [Rgb], start: &mut [Rgb]) {
+        b0_new
+            .par_iter_mut()
+            .zip(start.par_iter_mut())
+            .enumerate()
+            .for_each(|(e, (b0, s))| {
+                let (b0_e, s_e, _) = self.at(e);
+                (*b0, *s) = (b0_e, s_e);
+            });
+    }
+}
+
+/// Elements per chunk of the warm start written straight into the shooting's leaves.
+const WARM_CHUNK: usize = 2048;
+
+/// Every group's warm start in one pass over chunks of elements: the new initial exitance into
+/// `b0_new` (one buffer per group) and the warm start and unshot part into the shooting's leaves
+/// `b` and `u` (3 values per group and element, group-major within an element; [`Leaves::Filled`]).
+fn fill_leaves(warm: &[Warm<'_>], b0_new: &mut [Vec<Rgb>], b: &mut [f64], u: &mut [f64]) {
+    let stride = 3 * warm.len();
+    let n = b.len() / stride.max(1);
+    let mut parts: Vec<Vec<&mut [Rgb]>> = (0..n.div_ceil(WARM_CHUNK))
+        .map(|_| Vec::with_capacity(warm.len()))
+        .collect();
+    for buffer in b0_new.iter_mut() {
+        for (c, part) in buffer.chunks_mut(WARM_CHUNK).enumerate() {
+            parts[c].push(part);
+        }
+    }
+    b.par_chunks_mut(WARM_CHUNK * stride)
+        .zip(u.par_chunks_mut(WARM_CHUNK * stride))
+        .zip(parts)
+        .enumerate()
+        .for_each(|(c, ((b, u), mut b0_parts))| {
+            for (i, (b, u)) in b
+                .chunks_exact_mut(stride)
+                .zip(u.chunks_exact_mut(stride))
+                .enumerate()
+            {
+                let e = c * WARM_CHUNK + i;
+                for (g, (w, b0)) in warm.iter().zip(b0_parts.iter_mut()).enumerate() {
+                    let (b0_e, start, unshot) = w.at(e);
+                    b0[i] = b0_e;
+                    b[3 * g..3 * g + 3].copy_from_slice(&start);
+                    u[3 * g..3 * g + 3].copy_from_slice(&unshot);
+                }
+            }
+        });
 }
 
 /// ρ′/ρ, the factor an element's gathered light (and kept remainder) is carried over with; 0
@@ -128,13 +218,13 @@ impl Transfer {
             } else {
                 [1.0; 3]
             };
-            // Each element on its own, in parallel: the same values on any number of threads.
-            // With the warm start, the shooting's unshot part: D = start − old (bit-equal values
-            // pass nothing on), plus the group's kept remainder, carried over as the gathered
-            // part is, once that carries more than the stop rule's residual of the group's
-            // power. Until then it is only kept (scaled after the shooting), so a step shoots
-            // what it changed and the solution stays within twice the stop rule of its fixed
-            // point however long the series.
+            // The warm start ([`Warm`], each element on its own, in parallel: the same values
+            // on any number of threads) gives the shooting its unshot part: D = start − old
+            // (bit-equal values pass nothing on), plus the group's kept remainder, carried over
+            // as the gathered part is, once that carries more than the stop rule's residual of
+            // the group's power. Until then it is only kept (scaled after the shooting), so a
+            // step shoots what it changed and the solution stays within twice the stop rule of
+            // its fixed point however long the series.
             let kept = &self.unshot[g];
             let areas = &self.topology.areas;
             let pass_on = !kept.is_empty() && {
@@ -142,61 +232,51 @@ impl Transfer {
                     rayon::join(|| power(kept, areas), || power(&group.radiosity_rgb, areas));
                 kept > self.params.solve.stop.residual * all
             };
-            // The new initial exitance (as `initial_exitance_from`) in the same pass.
+            // A dark group (sun down, sky off, light off: the new initial exitance, as
+            // `Warm::at` computes it, is 0 everywhere): B = 0 exactly.
             let direct = &group.direct_irradiance_rgb;
-            let n = new_rho.len();
-            let (mut b0_new, mut start, mut unshot) = (
-                self.scratch.take_rgb(n),
-                self.scratch.take_rgb(n),
-                self.scratch.take_rgb(n),
-            );
-            b0_new
-                .par_iter_mut()
-                .zip(start.par_iter_mut())
-                .zip(unshot.par_iter_mut())
+            let lit = direct
+                .par_iter()
+                .zip(new_rho.par_iter())
                 .enumerate()
-                .for_each(|(e, ((b0_out, start_out), unshot_out))| {
-                    let emitted = emitted.as_deref().map_or([0.0; 3], |m| m[e]);
-                    let b0_new: Rgb =
-                        std::array::from_fn(|c| new_rho[e][c] * direct[e][c] + emitted[c]);
-                    let (b, b0_old) = (group.radiosity_rgb[e], self.b0s[g][e]);
-                    let rho_old = old_rho.as_ref().map_or(new_rho[e], |r| r[e]);
-                    let left = if pass_on { kept[e] } else { [0.0; 3] };
-                    let mut start = [0.0; 3];
-                    let mut unshot = [0.0; 3];
-                    for c in 0..3 {
-                        let gathered = b[c] - b0_old[c];
-                        let k = rho_ratio(new_rho[e][c], rho_old[c]);
-                        start[c] = b0_new[c] + k * carry[c] * gathered;
-                        let d = if start[c].to_bits() == b[c].to_bits() {
-                            0.0
-                        } else {
-                            start[c] - b[c]
-                        };
-                        unshot[c] = d + k * carry[c] * left[c];
-                    }
-                    (*b0_out, *start_out, *unshot_out) = (b0_new, start, unshot);
+                .any(|(e, (d, rho))| {
+                    let m = emitted.as_deref().map_or([0.0; 3], |m| m[e]);
+                    (0..3).any(|c| rho[c] * d[c] + m[c] != 0.0)
                 });
-            if b0_new.iter().flatten().all(|&v| v == 0.0) {
-                // A dark group (sun down, sky off, light off): B = 0 exactly.
-                group.radiosity_rgb = Arc::new(b0_new.clone());
+            if !lit {
+                let mut zeros = self.scratch.take_rgb(new_rho.len());
+                zeros.fill([0.0; 3]);
+                group.radiosity_rgb = Arc::new(zeros.clone());
                 group.convergence.clear();
-                let old = std::mem::replace(&mut self.b0s[g], b0_new);
-                for v in [old, start, unshot] {
-                    self.scratch.give_rgb(v);
-                }
+                let old = std::mem::replace(&mut self.b0s[g], zeros);
+                self.scratch.give_rgb(old);
                 self.unshot[g].clear();
                 continue;
             }
             pending.push(Pending {
                 g,
-                b0_new,
-                start,
-                unshot,
+                emitted,
                 carry,
                 pass_on,
             });
         }
+        let n = new_rho.len();
+        // Per pending group, what its warm start reads, and buffers for its new initial
+        // exitance.
+        let warm: Vec<Warm<'_>> = pending
+            .iter()
+            .map(|p| Warm {
+                rho_new: new_rho,
+                rho_old: old_rho.as_deref(),
+                direct: &self.solution.groups[p.g].direct_irradiance_rgb,
+                emitted: p.emitted.as_deref(),
+                radiosity: &self.solution.groups[p.g].radiosity_rgb,
+                b0_old: &self.b0s[p.g],
+                left: p.pass_on.then_some(self.unshot[p.g].as_slice()),
+                carry: p.carry,
+            })
+            .collect();
+        let mut b0_news: Vec<Vec<Rgb>> = warm.iter().map(|_| self.scratch.take_rgb(n)).collect();
         if self.params.sweep == Sweep::Shooting && !pending.is_empty() {
             // Shooting passes on D = start − old, which holds only if the old solution's
             // interreflected part scales with ρ. Where a channel's ρ was 0 and is not now, the
@@ -208,48 +288,58 @@ impl Transfer {
                     .any(|(o, n)| (0..3).any(|c| o[c] == 0.0 && n[c] != 0.0))
             });
             let zeros: Vec<Rgb> = if lit_from_zero {
-                vec![[0.0; 3]; new_rho.len()]
+                vec![[0.0; 3]; n]
             } else {
                 Vec::new()
             };
-            let shot: Vec<ShotGroup<'_>> = pending
-                .iter_mut()
-                .map(
-                    |Pending {
-                         g,
-                         b0_new,
-                         start,
-                         unshot,
-                         ..
-                     }| {
-                        let name = &self.solution.groups[*g].name;
-                        if lit_from_zero {
-                            ShotGroup {
-                                keep_unshot: true,
-                                ..ShotGroup::against(name, &zeros, b0_new.clone())
-                            }
-                        } else {
-                            ShotGroup {
-                                name,
-                                old: &[],
-                                start: std::mem::take(start),
-                                unshot: Some(std::mem::take(unshot)),
-                                keep_unshot: true,
-                            }
-                        }
-                    },
-                )
-                .collect();
+            let (shot, leaves): (Vec<ShotGroup<'_>>, Leaves) = if lit_from_zero {
+                for (w, b0_new) in warm.iter().zip(&mut b0_news) {
+                    let mut start = self.scratch.take_rgb(n);
+                    w.fill(b0_new, &mut start);
+                    self.scratch.give_rgb(start);
+                }
+                let shot = pending
+                    .iter()
+                    .zip(&b0_news)
+                    .map(|(p, b0_new)| ShotGroup {
+                        keep_unshot: true,
+                        ..ShotGroup::against(
+                            &self.solution.groups[p.g].name,
+                            &zeros,
+                            b0_new.clone(),
+                        )
+                    })
+                    .collect();
+                (shot, Leaves::InGroups)
+            } else {
+                // The warm start goes straight into the shooting's leaves, every group in one
+                // pass; the groups' buffers receive the results.
+                let shot = pending
+                    .iter()
+                    .map(|p| ShotGroup {
+                        name: &self.solution.groups[p.g].name,
+                        old: &[],
+                        start: self.scratch.take_rgb(n),
+                        unshot: Some(self.scratch.take_rgb(n)),
+                        keep_unshot: true,
+                    })
+                    .collect();
+                let (b, u) = self.scratch.leaves(n, 3 * warm.len());
+                fill_leaves(&warm, &mut b0_news, b, u);
+                (shot, Leaves::Filled)
+            };
             let results = shoot(
                 &self.topology,
                 &self.source_rows,
                 new_rho,
                 shot,
+                leaves,
                 &self.params.solve.stop,
                 &self.patch_links,
                 &mut self.scratch,
             );
-            for (p, shot) in pending.into_iter().zip(results) {
+            drop(warm);
+            for ((p, b0_new), shot) in pending.into_iter().zip(b0_news).zip(results) {
                 let g = p.g;
                 let group = &mut self.solution.groups[g];
                 let old = std::mem::replace(&mut group.radiosity_rgb, Arc::new(shot.radiosity));
@@ -259,7 +349,7 @@ impl Transfer {
                 if let Ok(old) = Arc::try_unwrap(old) {
                     self.scratch.give_rgb(old);
                 }
-                let old = std::mem::replace(&mut self.b0s[g], p.b0_new);
+                let old = std::mem::replace(&mut self.b0s[g], b0_new);
                 self.scratch.give_rgb(old);
                 let remainder = shot.unshot.unwrap_or_default();
                 if p.pass_on || lit_from_zero || self.unshot[g].len() != remainder.len() {
@@ -283,9 +373,17 @@ impl Transfer {
                 }
             }
         } else {
-            for Pending {
-                g, b0_new, start, ..
-            } in pending
+            let starts: Vec<Vec<Rgb>> = warm
+                .iter()
+                .zip(&mut b0_news)
+                .map(|(w, b0_new)| {
+                    let mut start = self.scratch.take_rgb(n);
+                    w.fill(b0_new, &mut start);
+                    start
+                })
+                .collect();
+            drop(warm);
+            for ((Pending { g, .. }, b0_new), start) in pending.into_iter().zip(b0_news).zip(starts)
             {
                 self.unshot[g].clear();
                 let group = &mut self.solution.groups[g];
@@ -302,7 +400,9 @@ impl Transfer {
                 );
                 group.radiosity_rgb = Arc::new(radiosity);
                 group.convergence = rows;
-                self.b0s[g] = b0_new;
+                let old = std::mem::replace(&mut self.b0s[g], b0_new);
+                self.scratch.give_rgb(old);
+                self.scratch.give_rgb(start);
             }
         }
         self.groups = new_groups;
