@@ -40,7 +40,10 @@
 //! remainder and passes it on with a later relight's D, so relights do not drift
 //! (`Transfer::commit_relight`).
 //! The shot node values and the gathers are `f32` (a round's increment needs ~1e-6 relative, the
-//! factors are `f32` already); B and the unshot leaves stay `f64`.
+//! factors are `f32` already), and so is the unshot part of the leaves, which is shot as `f32`
+//! anyway and whose kept remainder is below the stop rule's residual of B (its rounding, 6e-8 of
+//! itself, is far below what a relight resolves); it halves the bytes the per-round passes move
+//! for it, and those passes are bound by memory traffic. B stays `f64`.
 
 use super::convergence::{ConvergenceRow, StopRule, relative_change};
 use super::source_rows::{SourceRows, gather_range, gather_range_dyn, simd_token};
@@ -106,8 +109,8 @@ pub(super) struct Shot {
 pub(super) struct ShootScratch {
     /// Per element, B (`stride` values).
     b: Vec<f64>,
-    /// Per element, the unshot part.
-    u: Vec<f64>,
+    /// Per element, the unshot part (`f32`, as it is shot: module doc).
+    u: Vec<f32>,
     /// Per node, the unshot values of shot nodes.
     un: Vec<f32>,
     /// Per node, what it gathered in the round.
@@ -136,7 +139,7 @@ impl ShootScratch {
     /// B and the unshot part per element (`stride` values each, group-major within an
     /// element, as [`shoot`] reads them with [`Leaves::Filled`]), sized for `n_el` elements;
     /// their contents are unspecified until the caller writes every value.
-    pub(super) fn leaves(&mut self, n_el: usize, stride: usize) -> (&mut [f64], &mut [f64]) {
+    pub(super) fn leaves(&mut self, n_el: usize, stride: usize) -> (&mut [f64], &mut [f32]) {
         self.b.resize(n_el * stride, 0.0);
         self.u.resize(n_el * stride, 0.0);
         (&mut self.b, &mut self.u)
@@ -176,9 +179,16 @@ struct PatchPowers {
 
 /// Sums, into `total` and `unshot` (`k` each), the power of one patch's elements in `b` and `u`
 /// (the patch's own slices, `stride` = 3k values per element).
-fn patch_powers(areas: &[f64], b: &[f64], u: &[f64], total: &mut [f64], unshot: &mut [f64]) {
+fn patch_powers(areas: &[f64], b: &[f64], u: &[f32], total: &mut [f64], unshot: &mut [f64]) {
     let stride = 3 * total.len();
     let power = |v: &[f64]| luminance(&[v[0].abs(), v[1].abs(), v[2].abs()]);
+    let power_f32 = |v: &[f32]| {
+        luminance(&[
+            f64::from(v[0].abs()),
+            f64::from(v[1].abs()),
+            f64::from(v[2].abs()),
+        ])
+    };
     total.fill(0.0);
     unshot.fill(0.0);
     for ((&area, b), u) in areas
@@ -193,7 +203,7 @@ fn patch_powers(areas: &[f64], b: &[f64], u: &[f64], total: &mut [f64], unshot: 
             .zip(u.chunks_exact(3))
         {
             *t += power(b) * area;
-            *s += power(u) * area;
+            *s += power_f32(u) * area;
         }
     }
 }
@@ -234,36 +244,15 @@ pub(super) fn shoot(
     let areas = &topology.areas;
     let area_sum: f64 = areas.iter().sum();
     let patches = &topology.patch_ranges;
-    // One group that gives its unshot part and keeps what is left: its own buffers are B and
-    // the unshot part (an `Rgb` per element is the layout of one group's values), so nothing is
-    // copied in or out.
-    let mut groups = groups;
     let filled = leaves == Leaves::Filled;
-    let in_place = !filled
-        && k == 1
-        && groups[0].keep_unshot
-        && groups[0].start.len() == n_el
-        && groups[0].unshot.as_ref().is_some_and(|v| v.len() == n_el);
-    let (mut own_b, mut own_u) = if in_place {
-        (
-            std::mem::take(&mut groups[0].start),
-            groups[0].unshot.take().unwrap_or_default(),
-        )
-    } else {
-        (Vec::new(), Vec::new())
-    };
     let ShootScratch { b, u, un, acc, .. } = scratch;
-    let (b, u): (&mut [f64], &mut [f64]) = if in_place {
-        (own_b.as_flattened_mut(), own_u.as_flattened_mut())
-    } else {
-        assert!(
-            !filled || (b.len() == n_el * stride && u.len() == n_el * stride),
-            "filled leaves hold every group's values for every element"
-        );
-        b.resize(n_el * stride, 0.0);
-        u.resize(n_el * stride, 0.0);
-        (b, u)
-    };
+    assert!(
+        !filled || (b.len() == n_el * stride && u.len() == n_el * stride),
+        "filled leaves hold every group's values for every element"
+    );
+    b.resize(n_el * stride, 0.0);
+    u.resize(n_el * stride, 0.0);
+    let (b, u): (&mut [f64], &mut [f32]) = (b, u);
     un.resize(n_nodes * stride, 0.0);
     acc.resize(n_nodes * stride, 0.0);
     // Leaves: B and the unshot part, `stride` values per element (group-major within), unless
@@ -278,7 +267,7 @@ pub(super) fn shoot(
         .zip(block_leaves(&blocks, stride, k, b, u, &mut powers))
         .for_each(|(block, mut leaves)| {
             let BlockLeaves { b, u, .. } = &mut leaves;
-            let copied = if in_place || filled {
+            let copied = if filled {
                 0..0
             } else {
                 block.elements.0..block.elements.1
@@ -290,7 +279,10 @@ pub(super) fn shoot(
                         for c in 0..3 {
                             let j = i * stride + 3 * g + c;
                             b[j] = s[c];
-                            u[j] = given[e][c];
+                            #[allow(clippy::cast_possible_truncation)]
+                            {
+                                u[j] = given[e][c] as f32;
+                            }
                         }
                         continue;
                     }
@@ -300,11 +292,14 @@ pub(super) fn shoot(
                         b[j] = s[c];
                         // Bit-equal values have nothing to pass on (D = 0 exactly, not a
                         // rounding).
-                        u[j] = if s[c].to_bits() == o[c].to_bits() {
-                            0.0
-                        } else {
-                            s[c] - o[c]
-                        };
+                        #[allow(clippy::cast_possible_truncation)]
+                        {
+                            u[j] = if s[c].to_bits() == o[c].to_bits() {
+                                0.0
+                            } else {
+                                (s[c] - o[c]) as f32
+                            };
+                        }
                     }
                 }
             }
@@ -348,12 +343,7 @@ pub(super) fn shoot(
                         let own = &mut head[(n - n0) * stride..];
                         if let Some(e) = node_element(n) {
                             let e = e as usize - e0;
-                            for (o, v) in own.iter_mut().zip(&u[e * stride..(e + 1) * stride]) {
-                                #[allow(clippy::cast_possible_truncation)]
-                                {
-                                    *o = *v as f32;
-                                }
-                            }
+                            own.copy_from_slice(&u[e * stride..(e + 1) * stride]);
                             u[e * stride..(e + 1) * stride].fill(0.0);
                         } else {
                             own.fill(0.0);
@@ -433,7 +423,10 @@ pub(super) fn shoot(
                                 for j in 0..stride {
                                     let db = rho[e][j % 3] * f64::from(acc[(n - lo) * stride + j]);
                                     leaves.b[el * stride + j] += db;
-                                    leaves.u[el * stride + j] += db;
+                                    #[allow(clippy::cast_possible_truncation)]
+                                    {
+                                        leaves.u[el * stride + j] += db as f32;
+                                    }
                                 }
                             }
                         }
@@ -482,15 +475,6 @@ pub(super) fn shoot(
         }
     }
     let (total, unshot) = (group_sums(&powers.total, k), group_sums(&powers.unshot, k));
-    if in_place {
-        let rows = out_rows.pop().unwrap_or_default();
-        return vec![Shot {
-            radiosity: own_b,
-            rows,
-            unshot: Some(own_u),
-            powers: [total[0], unshot[0]],
-        }];
-    }
     // The results go into the groups' own buffers (no fresh pages), in one parallel pass over
     // fixed chunks of elements: a chunk of B and of the unshot part is read for every group
     // while it is in cache, not once per group and buffer.
@@ -514,7 +498,7 @@ pub(super) fn shoot(
             }
         })
         .collect();
-    let (b, u): (&[f64], &[f64]) = (b, u);
+    let (b, u): (&[f64], &[f32]) = (b, u);
     // Per chunk, its part of every output: (group, read from the unshot part, the part).
     let mut chunks: Vec<Vec<(usize, bool, &mut [Rgb])>> = (0..n_el.div_ceil(READ_CHUNK))
         .map(|_| Vec::with_capacity(2 * k))
@@ -533,10 +517,13 @@ pub(super) fn shoot(
     }
     chunks.into_par_iter().enumerate().for_each(|(c, parts)| {
         for (g, from_unshot, part) in parts {
-            let v = if from_unshot { u } else { b };
             for (i, o) in part.iter_mut().enumerate() {
                 let at = (c * READ_CHUNK + i) * stride + 3 * g;
-                *o = [v[at], v[at + 1], v[at + 2]];
+                *o = if from_unshot {
+                    [u[at], u[at + 1], u[at + 2]].map(f64::from)
+                } else {
+                    [b[at], b[at + 1], b[at + 2]]
+                };
             }
         }
     });

@@ -42,7 +42,7 @@ pub(super) fn patch_blocks(topology: &Topology) -> Vec<PatchBlock> {
 /// One block's leaves: B and the unshot part of its elements, and its patches' powers.
 pub(super) struct BlockLeaves<'a> {
     pub(super) b: &'a mut [f64],
-    pub(super) u: &'a mut [f64],
+    pub(super) u: &'a mut [f32],
     total: &'a mut [f64],
     unshot: &'a mut [f64],
 }
@@ -75,7 +75,7 @@ pub(super) fn block_leaves<'a>(
     stride: usize,
     k: usize,
     b: &'a mut [f64],
-    u: &'a mut [f64],
+    u: &'a mut [f32],
     powers: &'a mut PatchPowers,
 ) -> Vec<BlockLeaves<'a>> {
     let PatchPowers { total, unshot } = powers;

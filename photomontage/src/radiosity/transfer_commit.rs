@@ -74,7 +74,7 @@ const WARM_CHUNK: usize = 2048;
 /// Every group's warm start in one pass over chunks of elements: the new initial exitance into
 /// `b0_new` (one buffer per group) and the warm start and unshot part into the shooting's leaves
 /// `b` and `u` (3 values per group and element, group-major within an element; [`Leaves::Filled`]).
-fn fill_leaves(warm: &[Warm<'_>], b0_new: &mut [Vec<Rgb>], b: &mut [f64], u: &mut [f64]) {
+fn fill_leaves(warm: &[Warm<'_>], b0_new: &mut [Vec<Rgb>], b: &mut [f64], u: &mut [f32]) {
     let stride = 3 * warm.len();
     let n = b.len() / stride.max(1);
     let mut parts: Vec<Vec<&mut [Rgb]>> = (0..n.div_ceil(WARM_CHUNK))
@@ -100,7 +100,8 @@ fn fill_leaves(warm: &[Warm<'_>], b0_new: &mut [Vec<Rgb>], b: &mut [f64], u: &mu
                     let (b0_e, start, unshot) = w.at(e);
                     b0[i] = b0_e;
                     b[3 * g..3 * g + 3].copy_from_slice(&start);
-                    u[3 * g..3 * g + 3].copy_from_slice(&unshot);
+                    #[allow(clippy::cast_possible_truncation)] // shot as `f32` (shooting.rs)
+                    u[3 * g..3 * g + 3].copy_from_slice(&unshot.map(|v| v as f32));
                 }
             }
         });
