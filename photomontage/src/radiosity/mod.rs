@@ -100,7 +100,7 @@ mod twin_tests;
 pub use convergence::{ConvergenceRow, StopRule};
 pub use form_factor::FormFactorParams;
 pub use mesh::{Mesh, MeshParams, MeshWarning, Refinement};
-pub use query::{IrradianceSample, QueryParams, QueryPoint, parse_query_points};
+pub use query::{IrradianceSample, PointOnElement, QueryParams, QueryPoint, parse_query_points};
 pub use sky_transfer::SkyRays;
 pub use solve::{
     GroupSolution, LightGroup, RadiosityDifference, Refit, SkyLight, Solution, SolveParams, Solver,

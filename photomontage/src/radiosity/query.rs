@@ -112,7 +112,35 @@ impl Solution {
     }
 }
 
+/// Where a point lies on a solution's mesh: its element and barycentric weights of the element's
+/// three vertices. It stays valid across relights of the same geometry (a relight changes
+/// reflectances and light, not the mesh), so a caller can locate once and read the relit
+/// solutions' values there ([`Solution::irradiance_gathered_on`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointOnElement {
+    /// The element.
+    pub element: u32,
+    /// Barycentric weights of its three vertices.
+    pub weights: [f64; 3],
+}
+
 impl Solution {
+    /// Locates a point on this solution's elements as [`Solution::irradiance_gathered_at`] does;
+    /// `None` when it lies on none.
+    #[must_use]
+    pub fn locate_point(
+        &self,
+        point_in_world_m: &Point3<f64>,
+        normal_in_world: &Vector3<f64>,
+    ) -> Option<PointOnElement> {
+        let (e, weights) = self.locator().locate(point_in_world_m, normal_in_world)?;
+        #[allow(clippy::cast_possible_truncation)]
+        Some(PointOnElement {
+            element: e as u32,
+            weights,
+        })
+    }
+
     /// Irradiance at a point as [`Solution::irradiance_at`], with the interreflected part taken
     /// from vertex gathers of this solution's mesh summing the exitances `gathered` holds
     /// instead of the elements' own values
@@ -128,10 +156,26 @@ impl Solution {
         if gathered.gather().mesh().geometry_hash != self.mesh.geometry_hash {
             return None;
         }
-        let locator = self.locator();
-        let (e, w) = locator.locate(point_in_world_m, normal_in_world)?;
+        let at = self.locate_point(point_in_world_m, normal_in_world)?;
+        self.irradiance_gathered_on(&at, gathered)
+    }
+
+    /// [`Solution::irradiance_gathered_at`] at a point located before
+    /// ([`Solution::locate_point`], on this solution or on another of the same geometry). `None`
+    /// when the gathers or the point's element belong to another geometry.
+    #[must_use]
+    pub fn irradiance_gathered_on(
+        &self,
+        at: &PointOnElement,
+        gathered: &GatheredExitance,
+    ) -> Option<IrradianceSample> {
+        if gathered.gather().mesh().geometry_hash != self.mesh.geometry_hash {
+            return None;
+        }
+        let e = at.element as usize;
+        let w = at.weights;
         let mut direct = [0.0; 3];
-        for (k, (_, d)) in locator.vertex_values[e].iter().enumerate() {
+        for (k, (_, d)) in self.locator().vertex_values.get(e)?.iter().enumerate() {
             for c in 0..3 {
                 direct[c] += w[k] * d[c];
             }

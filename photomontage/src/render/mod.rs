@@ -41,6 +41,7 @@ pub mod irradiance_cache;
 pub mod luminaire_light;
 pub mod output;
 pub mod partial;
+pub mod preview;
 pub mod spectral;
 
 pub mod tiling;

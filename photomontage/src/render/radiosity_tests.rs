@@ -320,3 +320,86 @@ fn radiosity_mode_known_answers_untouched_pixels_and_threads() {
     }
     assert!(shadow > 200, "{shadow} shadow points in view");
 }
+
+/// The instant preview's records ([`preview`]) are the renderer's own samples: each equals
+/// `trace_primary` through its block's middle pixel, bit for bit, and a replay under the same
+/// light returns them. Replayed under a sun twice as strong (no ray traced), the box top is
+/// eq. 6 with the doubled sun.
+#[test]
+#[allow(clippy::float_cmp)] // the same function of the same inputs: compared bit for bit
+fn preview_records_are_the_renderers_samples_and_replay_a_stronger_sun() {
+    const STRIDE_PX: u32 = 2;
+    let fx = fixture();
+    let tracer =
+        DifferentialTracer::new(&fx.scene, &fx.lighting, &fx.camera, &fx.photo, 2).unwrap();
+    let records =
+        preview::PreviewRecords::record(&tracer, STRIDE_PX, &AtomicBool::new(false)).unwrap();
+    let cols = SIZE_PX[0] / STRIDE_PX;
+    assert_eq!(
+        records.samples().len(),
+        (cols * SIZE_PX[1] / STRIDE_PX) as usize
+    );
+    let c = fx.camera.pose.camera_center_in_world;
+    let mut top = Vec::new();
+    for (i, s) in records.samples().iter().enumerate() {
+        #[allow(clippy::cast_possible_truncation)]
+        let i = i as u32;
+        // The middle pixel of a 2-pixel block is its first.
+        let (x, y) = (i % cols * STRIDE_PX, i / cols * STRIDE_PX);
+        let dir = fx
+            .camera
+            .ray_dir_in_world(nalgebra::Point2::new(f64::from(x), f64::from(y)));
+        let photo_rgb = fx.photo.get_pixel(x, y).0.map(f64::from);
+        let traced = tracer.trace_primary(&dir, photo_rgb);
+        assert_eq!(traced.radiance_rgb, s.radiance_rgb, "sample ({x}, {y})");
+        assert_eq!(traced.changed, s.changed);
+        if let Some(hit) = s.first_hit.filter(|_| s.hit_artificial) {
+            let p = c + dir * hit.distance_m;
+            if (p.z - BOX_HEIGHT_M).abs() < 1e-4 {
+                top.push(i as usize);
+            }
+        }
+    }
+    assert!(top.len() >= 4, "{} box-top samples", top.len());
+    let same = records.replay(&fx.scene, &fx.lighting, &fx.camera).unwrap();
+    for (s, p) in records.samples().iter().zip(&same.rgba) {
+        #[allow(clippy::cast_possible_truncation)]
+        let recorded = s.radiance_rgb.map(|v| v as f32);
+        assert_eq!([p[0], p[1], p[2]], recorded);
+    }
+
+    let mut stronger = fx.lighting.clone();
+    if let Some(sun) = stronger.daylight.sun.as_mut() {
+        sun.normal_irradiance_rgb = E_SUN.map(|e| 2.0 * e);
+    }
+    let replayed = records.replay(&fx.scene, &stronger, &fx.camera).unwrap();
+    let sky = sky_horizontal();
+    for i in top {
+        for k in 0..3 {
+            let expected = RHO_BOX[k] / PI * (2.0 * E_SUN[k] * sun_dir().z + sky[k]);
+            let got = f64::from(replayed.rgba[i][k]);
+            assert!(
+                (got - expected).abs() <= TOP_REL_TOL * expected,
+                "box top sample {i} channel {k}: {got} vs {expected}"
+            );
+        }
+        assert_eq!(replayed.rgba[i][3], 1.0);
+    }
+}
+
+/// The preview's stride keeps it under the sample budget with the smallest stride, and a
+/// block's sample goes through its middle pixel (the last, smaller block's own middle).
+#[test]
+fn preview_stride_and_sample_pixels() {
+    assert_eq!(preview::stride_for([1280, 960], 200_000), 3);
+    assert_eq!(preview::stride_for([1280, 960], 1_228_800), 1);
+    assert_eq!(preview::stride_for([64, 48], 0), 64);
+    for (photo, budget) in [([1280_u32, 960_u32], 200_000_u64), ([6000, 4000], 150_000)] {
+        let s = preview::stride_for(photo, budget);
+        let n = |s: u32| u64::from(photo[0].div_ceil(s)) * u64::from(photo[1].div_ceil(s));
+        assert!(
+            n(s) <= budget && (s == 1 || n(s - 1) > budget),
+            "{photo:?}: {s}"
+        );
+    }
+}

@@ -428,3 +428,106 @@ fn a_photo_taken_at_another_time_is_read_under_its_sun_by_the_render_and_the_stu
 /// ρ_d read against the studio's relit transfer and the render's solve: both solves' fixed
 /// points agree within the relight tolerances (≈ 1 %), which reach ρ_d through E_rad.
 const STUDIO_RHO_REL_TOL: f64 = 0.02;
+
+/// The instant preview ([`crate::render::preview`]) on the studio's path: recorded once with the
+/// kept transfers' light, then replayed after a relight (sky type and a material colour) without
+/// a ray: the same values, bit for bit, as a new recording under the edited site; and under the
+/// recording's own light, the recorded values.
+#[test]
+fn the_preview_replays_a_sky_and_colour_edit_as_a_new_recording_would() {
+    use crate::render::differential::DifferentialTracer;
+    use crate::render::differential::replay::SampleReplay;
+    use crate::render::preview::PreviewRecords;
+    const STRIDE_PX: u32 = 1;
+
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = fixture(dir.path());
+    doc.site.render.radiosity = true;
+    let cancel = AtomicBool::new(false);
+    let mut slot = None;
+    let view = |doc: &SiteDocument, slot: &mut Option<SiteTransfers>| {
+        let mut job = crate::site::render::prepare_view(doc, "p1").unwrap();
+        let (light, report) =
+            SiteTransfers::update(slot, doc, &job.scene.scene, "p1", None, &cancel).unwrap();
+        job.lighting.radiosity = Some(light);
+        (job, report.update)
+    };
+    let (job0, update) = view(&doc, &mut slot);
+    assert_eq!(update, TransferUpdate::Built);
+    let tracer0 = DifferentialTracer::new(
+        &job0.scene.scene,
+        &job0.lighting,
+        &job0.camera,
+        &job0.photo_linear,
+        2,
+    )
+    .unwrap();
+    let records = PreviewRecords::record(&tracer0, STRIDE_PX, &cancel).unwrap();
+    let count = |f: &dyn Fn(&SampleReplay) -> bool| {
+        records.samples().iter().filter(|s| f(&s.replay)).count()
+    };
+    let artificial = count(&|r| matches!(r, SampleReplay::Artificial { at: Some(_), .. }));
+    let natural = count(&|r| matches!(r, SampleReplay::Natural { .. }));
+    let total = records.samples().len();
+    assert!(
+        artificial > 20 && natural > 100,
+        "{artificial} {natural} of {total}"
+    );
+    // Under the recording's light: the recorded values.
+    let same = records
+        .replay(&job0.scene.scene, &job0.lighting, &job0.camera)
+        .unwrap();
+    for (s, p) in records.samples().iter().zip(&same.rgba) {
+        #[allow(clippy::cast_possible_truncation)]
+        let recorded = s.radiance_rgb.map(|x| x as f32);
+        assert_eq!([p[0], p[1], p[2]], recorded);
+    }
+
+    doc.site.lighting.sky_model = SkyModelName::CieGeneral(12);
+    doc.site.materials.push(SiteMaterial {
+        material: crate::scene::Material::diffuse("brick", [0.7, 0.35, 0.2]),
+        colour: None,
+    });
+    let (job1, update) = view(&doc, &mut slot);
+    assert_eq!(update, TransferUpdate::Relit);
+    let (scene1, lighting1, camera1) = (&job1.scene.scene, &job1.lighting, &job1.camera);
+    // The replay needs no tracer: the edited site's scene, lighting and camera.
+    assert!(records.fits(scene1, lighting1, camera1));
+    let replayed = records.replay(scene1, lighting1, camera1).unwrap();
+    let tracer1 =
+        DifferentialTracer::new(scene1, lighting1, camera1, &job1.photo_linear, 2).unwrap();
+    let fresh = PreviewRecords::record(&tracer1, STRIDE_PX, &cancel)
+        .unwrap()
+        .replay(scene1, lighting1, camera1)
+        .unwrap();
+    let bits = |img: &crate::render::preview::PreviewImage| -> Vec<u32> {
+        img.rgba.iter().flat_map(|p| p.map(f32::to_bits)).collect()
+    };
+    let (a, b) = (bits(&replayed), bits(&fresh));
+    let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert!(
+        a.len() == b.len() && differ == 0,
+        "{differ} of {} values differ",
+        a.len()
+    );
+    // The edit shows: the planned object's colour and the light around it changed.
+    let changed = replayed
+        .rgba
+        .iter()
+        .zip(&same.rgba)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(changed > artificial, "{changed} of {}", same.rgba.len());
+
+    // Moving the model: the records no longer fit, and say so.
+    doc.site.models[0].placement.translation[0] += 2.0;
+    let (job2, update) = view(&doc, &mut slot);
+    assert_eq!(update, TransferUpdate::Built);
+    let (scene2, lighting2, camera2) = (&job2.scene.scene, &job2.lighting, &job2.camera);
+    assert!(!records.fits(scene2, lighting2, camera2));
+    let err = records
+        .replay(scene2, lighting2, camera2)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("geometry changed"), "{err}");
+}

@@ -10,7 +10,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::glass::PhotoBehind;
-use super::radiosity_light::RadiosityLight;
+use super::replay::{ArtificialParts, NaturalParts, SampleReplay};
 use super::specular::{SurfaceFrame, reflect_above};
 use super::{DifferentialTracer, NaturalRatio, PrimaryHit, RaySample, SURFACE_OFFSET_M};
 use crate::render::illumination::{
@@ -33,6 +33,17 @@ impl DifferentialTracer<'_> {
     /// (the reconstructed image function at the sample, box reconstruction).
     #[must_use]
     pub fn trace_primary(&self, dir_in_world: &Vector3<f64>, photo_pixel_rgb: Rgb) -> RaySample {
+        self.trace_primary_with(dir_in_world, photo_pixel_rgb, None)
+    }
+
+    /// [`Self::trace_primary`], filling `record` with what a replay needs in the radiosity mode
+    /// ([`super::replay`]; left as it is elsewhere).
+    pub(super) fn trace_primary_with(
+        &self,
+        dir_in_world: &Vector3<f64>,
+        photo_pixel_rgb: Rgb,
+        record: Option<&mut SampleReplay>,
+    ) -> RaySample {
         let origin = self.camera.pose.camera_center_in_world;
         let ray = self
             .all
@@ -55,6 +66,7 @@ impl DifferentialTracer<'_> {
                             d,
                             0,
                             Some(PhotoBehind::at_camera(photo_pixel_rgb)),
+                            record,
                         ),
                         changed: true,
                         hit_artificial: true,
@@ -62,8 +74,12 @@ impl DifferentialTracer<'_> {
                         natural_ratio: None,
                     },
                     ObjectKind::Natural => {
+                        let photo = PhotoSeen {
+                            rgb: photo_pixel_rgb,
+                            distance_m: d,
+                        };
                         let (radiance_rgb, changed, natural_ratio) =
-                            self.case_d_parts(&hit, &point, dir_in_world, photo_pixel_rgb, d, d);
+                            self.case_d_parts(&hit, &point, dir_in_world, photo, d, record);
                         RaySample {
                             radiance_rgb,
                             changed,
@@ -110,11 +126,13 @@ impl DifferentialTracer<'_> {
         distance_m: f64,
         depth: u32,
     ) -> Rgb {
-        self.case_c_shade(hit, point, dir_in_world, distance_m, depth, None)
+        self.case_c_shade(hit, point, dir_in_world, distance_m, depth, None, None)
     }
 
     /// Case C with, for a ray still on the camera's line of sight (`behind` given), the photo's
-    /// value at that pixel as what a glass pane lets through from behind.
+    /// value at that pixel as what a glass pane lets through from behind; `record` (a primary
+    /// ray's) receives the parts a replay evaluates again ([`super::replay`]).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn case_c_shade(
         &self,
         hit: &SceneHit,
@@ -123,6 +141,7 @@ impl DifferentialTracer<'_> {
         distance_m: f64,
         depth: u32,
         behind: Option<PhotoBehind>,
+        record: Option<&mut SampleReplay>,
     ) -> Rgb {
         let normal = self.normal_facing(hit, dir_in_world);
         let origin = point + normal * SURFACE_OFFSET_M;
@@ -132,46 +151,45 @@ impl DifferentialTracer<'_> {
             .get(hit.material.0 as usize)
             .and_then(Option::as_ref);
         let shading_normal = shading_normal(material, noise, point, &normal, dir_in_world);
-        let rho = material.map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb);
         let daylight = &self.lighting.daylight;
         let sun_passed = self.sun_transmittance(&origin, &normal);
         // Radiosity mode: sky and every bounce from the solution with the artificial objects.
-        let e_radiosity = self
-            .lighting
-            .radiosity
-            .as_ref()
-            .and_then(|r| r.with_at(point, &normal));
-        let e_natural = match e_radiosity {
-            Some(e_rad) => add(
-                natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |_| {
-                    [0.0; 3]
-                }),
-                e_rad,
-            ),
-            None => natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |i| {
-                self.light_transmittance(&origin, &daylight.sky[i].dir_in_world, f64::INFINITY)
-            }),
-        };
+        let radiosity = self.lighting.radiosity.as_deref();
+        let at = radiosity.and_then(|r| r.with_artificial.locate_point(point, &normal));
+        let e_radiosity = radiosity.zip(at.as_ref()).and_then(|(r, at)| r.with_on(at));
         let lights = self.visible_artificial_lights(point, &origin, &normal);
-        let mut e = add(
-            e_natural,
-            Self::artificial_light_irradiance(&lights, &shading_normal).0,
-        );
-        if depth < self.max_depth && e_radiosity.is_none() {
-            e = add(
-                e,
-                self.cached_photo_bounce(GatherKind::ArtificialPoint, &origin, &shading_normal),
-            );
-        }
-        let mut l0 = diffuse_radiance_rgb(rho, e);
-        if let Some(m) = material {
-            if let Some(emission) = m.emission_rgb_w_m2_sr {
-                l0 = add(l0, emission);
+        let e_lights_rgb = Self::artificial_light_irradiance(&lights, &shading_normal).0;
+        // The facet path where the point has no radiosity value.
+        let e_traced_rgb = e_radiosity.is_none().then(|| {
+            let e_natural =
+                natural_irradiance_weighted_rgb(daylight, &shading_normal, sun_passed, |i| {
+                    self.light_transmittance(&origin, &daylight.sky[i].dir_in_world, f64::INFINITY)
+                });
+            let mut e = add(e_natural, e_lights_rgb);
+            if depth < self.max_depth {
+                e = add(
+                    e,
+                    self.cached_photo_bounce(GatherKind::ArtificialPoint, &origin, &shading_normal),
+                );
             }
-            if let (Some(mirror), true) = (m.mirror_rgb, depth < self.max_depth) {
+            e
+        });
+        let mut parts = ArtificialParts {
+            material: hit.material.0,
+            distance_m,
+            shading_normal,
+            sun_passed,
+            e_lights_rgb,
+            e_traced_rgb,
+            mirror_incoming_rgb: None,
+            specular_rgb: None,
+            glass_rgb: None,
+        };
+        if let Some(m) = material {
+            if let (Some(_), true) = (m.mirror_rgb, depth < self.max_depth) {
                 let reflected = reflect_above(dir_in_world, &shading_normal, &normal);
-                let incoming = self.trace_secondary(&origin, &reflected, depth + 1);
-                l0 = add(l0, mul(mirror, incoming));
+                parts.mirror_incoming_rgb =
+                    Some(self.trace_secondary(&origin, &reflected, depth + 1));
             }
             if let Some(spec) = &m.specular {
                 let frame = SurfaceFrame {
@@ -187,38 +205,39 @@ impl DifferentialTracer<'_> {
                         normal_irradiance_rgb: mul(s.normal_irradiance_rgb, sun_passed),
                         ..s
                     });
-                l0 = add(
-                    l0,
-                    self.specular_radiance(
-                        spec,
-                        &frame,
-                        dir_in_world,
-                        sun.as_ref(),
-                        &lights,
-                        depth,
-                    ),
-                );
+                parts.specular_rgb = Some(self.specular_radiance(
+                    spec,
+                    &frame,
+                    dir_in_world,
+                    sun.as_ref(),
+                    &lights,
+                    depth,
+                ));
             }
             if let (Some(glass), true) = (&m.glass, depth < self.max_depth) {
                 let behind = behind.map(|b| PhotoBehind {
                     camera_distance_m: b.camera_distance_m + distance_m,
                     ..b
                 });
-                l0 = add(
-                    l0,
-                    self.glass_radiance(
-                        glass,
-                        point,
-                        &normal,
-                        &shading_normal,
-                        dir_in_world,
-                        depth,
-                        behind,
-                    ),
-                );
+                parts.glass_rgb = Some(self.glass_radiance(
+                    glass,
+                    point,
+                    &normal,
+                    &shading_normal,
+                    dir_in_world,
+                    depth,
+                    behind,
+                ));
             }
         }
-        self.apparent(l0, distance_m)
+        let radiance = self.shade().artificial_radiance(&parts, e_radiosity);
+        if let Some(record) = record {
+            *record = SampleReplay::Artificial {
+                parts: Box::new(parts),
+                at: at.filter(|_| e_radiosity.is_some()),
+            };
+        }
+        radiance
     }
 
     /// Case D: a natural object at `point`, hit along `dir_in_world` at `distance_m` from the ray
@@ -234,50 +253,52 @@ impl DifferentialTracer<'_> {
         photo_distance_m: f64,
         distance_m: f64,
     ) -> (Rgb, bool) {
-        let (rgb, changed, _) = self.case_d_parts(
-            hit,
-            point,
-            dir_in_world,
-            photo_rgb,
-            photo_distance_m,
-            distance_m,
-        );
+        let photo = PhotoSeen {
+            rgb: photo_rgb,
+            distance_m: photo_distance_m,
+        };
+        let (rgb, changed, _) =
+            self.case_d_parts(hit, point, dir_in_world, photo, distance_m, None);
         (rgb, changed)
     }
 
     /// [`Self::case_d_natural_hit`] with the parts of a changed point's radiance on the photo's
-    /// line of sight ([`NaturalRatio`]; `None` elsewhere and in the radiosity mode).
+    /// line of sight ([`NaturalRatio`]; `None` elsewhere and in the radiosity mode); `record` (a
+    /// primary ray's) receives the parts a replay evaluates again in the radiosity mode
+    /// ([`super::replay`]).
     fn case_d_parts(
         &self,
         hit: &SceneHit,
         point: &Point3<f64>,
         dir_in_world: &Vector3<f64>,
-        photo_rgb: Rgb,
-        photo_distance_m: f64,
+        photo: PhotoSeen,
         distance_m: f64,
+        record: Option<&mut SampleReplay>,
     ) -> (Rgb, bool, Option<NaturalRatio>) {
         let normal = self.normal_facing(hit, dir_in_world);
-        if let Some(radiosity) = &self.lighting.radiosity
+        if let Some(radiosity) = self.lighting.radiosity.as_deref()
+            && let [Some(at_with), Some(at_without)] = radiosity.locate(point, &normal)
             && let (Some(e_with), Some(e_without)) = (
-                radiosity.with_at(point, &normal),
-                radiosity.without_at(point, &normal),
+                radiosity.with_on(&at_with),
+                radiosity.without_on(&at_without),
             )
         {
-            let photo = PhotoSeen {
-                rgb: photo_rgb,
-                distance_m: photo_distance_m,
-            };
-            let (rgb, changed) = self.case_d_radiosity(
-                hit,
-                point,
-                &normal,
-                photo,
-                distance_m,
-                [e_with, e_without],
-                radiosity.as_ref(),
-            );
+            let parts = self.natural_parts(hit, point, &normal, photo, distance_m);
+            let (rgb, changed) =
+                self.shade()
+                    .natural_radiance(&parts, [e_with, e_without], radiosity);
+            if let Some(record) = record {
+                *record = SampleReplay::Natural {
+                    parts: Box::new(parts),
+                    at: [at_with, at_without],
+                };
+            }
             return (rgb, changed, None);
         }
+        let PhotoSeen {
+            rgb: photo_rgb,
+            distance_m: photo_distance_m,
+        } = photo;
         let origin = point + normal * SURFACE_OFFSET_M;
         let daylight = &self.lighting.daylight;
         let inf = f64::INFINITY;
@@ -413,20 +434,16 @@ impl DifferentialTracer<'_> {
         })
     }
 
-    /// Case D in the radiosity mode ([`super::radiosity_light`]): `e_rad` holds the sky and
-    /// interreflected irradiance at the point with and without the artificial objects.
-    #[allow(clippy::too_many_arguments)]
-    fn case_d_radiosity(
+    /// Case D in the radiosity mode ([`super::radiosity_light`]): what the shadow and light rays
+    /// at a natural point find, for [`Self::natural_radiance`].
+    fn natural_parts(
         &self,
         hit: &SceneHit,
         point: &Point3<f64>,
         normal: &Vector3<f64>,
         photo: PhotoSeen,
         distance_m: f64,
-        e_rad: [Rgb; 2],
-        radiosity: &RadiosityLight,
-    ) -> (Rgb, bool) {
-        let [e_with, e_without] = e_rad;
+    ) -> NaturalParts {
         let origin = point + normal * SURFACE_OFFSET_M;
         let daylight = &self.lighting.daylight;
         let inf = f64::INFINITY;
@@ -439,41 +456,27 @@ impl DifferentialTracer<'_> {
             (passed.iter().any(|&x| x < 1.0) && !self.natural_blocks(&origin, &s.dir_in_world, inf))
                 .then(|| passed.map(|x| 1.0 - x))
         });
-        let (e_d1, lit_d1) = Self::artificial_light_irradiance(
+        let (e_d1_rgb, lit_d1) = Self::artificial_light_irradiance(
             &self.visible_artificial_lights(point, &origin, normal),
             normal,
         );
         let sun_natural = daylight.sun.as_ref().is_some_and(|s| {
             s.dir_in_world.dot(normal) > 0.0 && !self.natural_blocks(&origin, &s.dir_in_world, inf)
         });
-        let e_natural = add(
-            natural_irradiance_rgb(daylight, normal, sun_natural, |_| false),
-            e_without,
-        );
-        let e_change = add(e_with, scale(e_without, -1.0));
-        let unchanged = sun_d3.is_none() && !lit_d1 && !radiosity.is_change(&e_change, &e_natural);
-        if unchanged {
-            if photo.distance_m.to_bits() == distance_m.to_bits() {
-                return (photo.rgb, false);
-            }
-            let l0 = self.true_colour(photo.rgb, photo.distance_m);
-            return (self.apparent(l0, distance_m), false);
+        NaturalParts {
+            material: hit.material.0,
+            photo_rgb: photo.rgb,
+            photo_distance_m: photo.distance_m,
+            distance_m,
+            normal: *normal,
+            sun_natural,
+            sun_d3,
+            e_d1_rgb,
+            lit_d1,
         }
-        let l0 = self.true_colour(photo.rgb, photo.distance_m);
-        let rho = diffuse_reflectance_from_true_colour(l0, e_natural).unwrap_or_else(|| {
-            self.material_of(hit)
-                .map_or([0.5; 3], crate::scene::Material::diffuse_reflectance_rgb)
-        });
-        let mut e_d3 = [0.0; 3];
-        if let (Some(blocked), Some(s)) = (sun_d3, &daylight.sun) {
-            e_d3 = mul(s.irradiance_rgb(normal), blocked);
-        }
-        let delta = diffuse_radiance_rgb(rho, add(add(e_d1, e_change), scale(e_d3, -1.0)));
-        self.changed_apparent(photo.rgb, l0, delta, photo.distance_m, distance_m)
     }
 
-    /// The apparent colour after adding `delta` to the true colour `l0`: along the photo's own
-    /// line of sight `L_photo + τ(d)·ΔL₀` (eq. 2 is affine), otherwise eq. 2 at `distance_m`.
+    /// [`Shade::changed_apparent`] with this tracer's atmosphere.
     fn changed_apparent(
         &self,
         photo_rgb: Rgb,
@@ -482,12 +485,8 @@ impl DifferentialTracer<'_> {
         photo_distance_m: f64,
         distance_m: f64,
     ) -> (Rgb, bool) {
-        if photo_distance_m.to_bits() == distance_m.to_bits() {
-            let t = self.transmission(distance_m);
-            (add(photo_rgb, mul(t, delta)), true)
-        } else {
-            (self.apparent(add(l0, delta), distance_m), true)
-        }
+        self.shade()
+            .changed_apparent(photo_rgb, l0, delta, photo_distance_m, distance_m)
     }
 
     /// A secondary ray (reflection) from `origin` along `dir`, at recursion depth `depth`.

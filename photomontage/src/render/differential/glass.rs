@@ -241,7 +241,9 @@ impl DifferentialTracer<'_> {
             return behind.photo_rgb;
         };
         match hit.kind {
-            ObjectKind::Artificial => self.case_c_shade(&hit, &point, dir, t, depth, Some(behind)),
+            ObjectKind::Artificial => {
+                self.case_c_shade(&hit, &point, dir, t, depth, Some(behind), None)
+            }
             ObjectKind::Natural => {
                 self.case_d_natural_hit(
                     &hit,

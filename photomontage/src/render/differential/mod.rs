@@ -61,6 +61,7 @@ mod cases;
 pub mod glass;
 mod interreflection;
 pub mod radiosity_light;
+pub mod replay;
 mod shading;
 pub use shading::true_colour_rgb;
 pub mod specular;
@@ -352,6 +353,12 @@ impl<'a> DifferentialTracer<'a> {
     /// The material of a hit (`None` for an unknown id).
     pub(super) fn material_of(&self, hit: &SceneHit) -> Option<&'a Material> {
         self.materials.get(hit.material.0 as usize)
+    }
+
+    /// The scene this tracer traces.
+    #[must_use]
+    pub fn scene(&self) -> &'a Scene {
+        self.scene
     }
 
     /// The lighting of this tracer.

@@ -42,7 +42,7 @@ use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use crate::radiosity::vertex_gather::DEFAULT_RAYS_PER_AXIS;
-use crate::radiosity::{GatheredExitance, RadiosityError, Solution, VertexGather};
+use crate::radiosity::{GatheredExitance, PointOnElement, RadiosityError, Solution, VertexGather};
 use crate::render::illumination::Rgb;
 
 /// A radiosity change below this fraction of the natural irradiance, in every channel, leaves a
@@ -216,6 +216,47 @@ impl RadiosityLight {
         self.without_artificial
             .irradiance_gathered_at(point, normal, &self.gathered[1])
             .map(|s| s.total_rgb)
+    }
+
+    /// Where a surface point lies on the two solutions' meshes (with, without the artificial
+    /// objects), for reading relit solutions of the same geometry there later
+    /// ([`Self::with_on`], [`Self::without_on`]).
+    #[must_use]
+    pub fn locate(
+        &self,
+        point: &Point3<f64>,
+        normal: &Vector3<f64>,
+    ) -> [Option<PointOnElement>; 2] {
+        [
+            self.with_artificial.locate_point(point, normal),
+            self.without_artificial.locate_point(point, normal),
+        ]
+    }
+
+    /// [`Self::with_at`] at a point located by [`Self::locate`] on a light of the same geometry
+    /// ([`Self::same_geometry`]).
+    #[must_use]
+    pub fn with_on(&self, at: &PointOnElement) -> Option<Rgb> {
+        self.with_artificial
+            .irradiance_gathered_on(at, &self.gathered[0])
+            .map(|s| s.total_rgb)
+    }
+
+    /// [`Self::without_at`] at a point located by [`Self::locate`].
+    #[must_use]
+    pub fn without_on(&self, at: &PointOnElement) -> Option<Rgb> {
+        self.without_artificial
+            .irradiance_gathered_on(at, &self.gathered[1])
+            .map(|s| s.total_rgb)
+    }
+
+    /// Whether `other`'s two meshes have this light's geometry (a relight of it), so that points
+    /// located on one are read on the other.
+    #[must_use]
+    pub fn same_geometry(&self, other: &Self) -> bool {
+        self.with_artificial.mesh.geometry_hash == other.with_artificial.mesh.geometry_hash
+            && self.without_artificial.mesh.geometry_hash
+                == other.without_artificial.mesh.geometry_hash
     }
 
     /// The vertex gathers of the two meshes (with, without the artificial objects).

@@ -9,6 +9,7 @@
 
 use nalgebra::{Point3, Vector3};
 
+use super::replay::Shade;
 use super::{DifferentialTracer, SURFACE_OFFSET_M};
 use crate::colour::Colour;
 use crate::render::illumination::{Rgb, add, mul, scale};
@@ -72,6 +73,32 @@ impl DifferentialTracer<'_> {
     }
 
     pub(super) fn transmission(&self, distance_m: f64) -> Rgb {
+        self.shade().transmission(distance_m)
+    }
+
+    /// Eq. 2 forward: apparent colour of a true colour seen over `distance_m`.
+    pub(super) fn apparent(&self, true_rgb: Rgb, distance_m: f64) -> Rgb {
+        self.shade().apparent(true_rgb, distance_m)
+    }
+
+    /// Eq. 8: true colour from an apparent colour seen over `distance_m` (unchanged when there
+    /// is no atmosphere or the inversion is refused).
+    pub(super) fn true_colour(&self, apparent_rgb: Rgb, distance_m: f64) -> Rgb {
+        true_colour_rgb(self.lighting, apparent_rgb, distance_m)
+    }
+
+    /// The light and materials this tracer shades with ([`Shade`]).
+    pub(super) fn shade(&self) -> Shade<'_> {
+        Shade {
+            lighting: self.lighting,
+            materials: self.materials,
+        }
+    }
+}
+
+impl Shade<'_> {
+    /// τ(d) of the atmosphere per channel (1 without one).
+    pub(super) fn transmission(&self, distance_m: f64) -> Rgb {
         self.lighting.atmosphere.as_ref().map_or([1.0; 3], |a| {
             let t = a.transmission(distance_m);
             [0, 1, 2].map(|k| f64::from(t.channels[k]))
@@ -87,10 +114,22 @@ impl DifferentialTracer<'_> {
         [0, 1, 2].map(|k| true_rgb[k] * t[k] + horizon[k] * (1.0 - t[k]))
     }
 
-    /// Eq. 8: true colour from an apparent colour seen over `distance_m` (unchanged when there
-    /// is no atmosphere or the inversion is refused).
-    pub(super) fn true_colour(&self, apparent_rgb: Rgb, distance_m: f64) -> Rgb {
-        true_colour_rgb(self.lighting, apparent_rgb, distance_m)
+    /// The apparent colour after adding `delta` to the true colour `l0`: along the photo's own
+    /// line of sight `L_photo + τ(d)·ΔL₀` (eq. 2 is affine), otherwise eq. 2 at `distance_m`.
+    pub(super) fn changed_apparent(
+        &self,
+        photo_rgb: Rgb,
+        l0: Rgb,
+        delta: Rgb,
+        photo_distance_m: f64,
+        distance_m: f64,
+    ) -> (Rgb, bool) {
+        if photo_distance_m.to_bits() == distance_m.to_bits() {
+            let t = self.transmission(distance_m);
+            (add(photo_rgb, mul(t, delta)), true)
+        } else {
+            (self.apparent(add(l0, delta), distance_m), true)
+        }
     }
 }
 
