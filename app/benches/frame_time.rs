@@ -212,10 +212,17 @@ fn live_preview_frames() {
     let (mut step_t, mut render_t, mut total_t) = (Vec::new(), Vec::new(), Vec::new());
     let mut relights = Vec::new();
     let mut last = h.state().render_panel().live.last_relight().cloned();
+    // The instant images (radiosity mode): their cost, and the time from the edit to the frame
+    // that has one.
+    let (mut instants, mut edit_to_instant, mut job_to_instant) =
+        (Vec::new(), Vec::new(), Vec::new());
+    let mut last_instant = h.state().render_panel().live.last_instant().cloned();
+    let mut edit_at = Instant::now();
     for i in 0..LIVE_FRAMES {
         if i % LIVE_STEP_EVERY == 0 {
             azimuth_deg += 1.0;
             set_sun(&mut h, azimuth_deg, elevation_deg);
+            edit_at = Instant::now();
         }
         let a = Instant::now();
         h.step();
@@ -225,6 +232,15 @@ fn live_preview_frames() {
         step_t.push(b - a);
         render_t.push(c - b);
         total_t.push(c - a);
+        let instant = h.state().render_panel().live.last_instant().cloned();
+        if instant != last_instant {
+            if let Some(r) = &instant {
+                instants.push(Duration::from_secs_f64(r.seconds));
+                job_to_instant.push(Duration::from_secs_f64(r.job_seconds));
+                edit_to_instant.push(edit_at.elapsed());
+            }
+            last_instant = instant;
+        }
         let now = h.state().render_panel().live.last_relight().cloned();
         if now != last {
             if let Some(r) = &now {
@@ -255,6 +271,20 @@ fn live_preview_frames() {
                 .into_iter()
                 .map(|(_, s)| Duration::from_secs_f64(s))
                 .collect(),
+        );
+    }
+    if instants.is_empty() {
+        println!("no instant image during the timed frames");
+    } else {
+        let n = instants.len();
+        stats(&format!("live: instant image ({n} seen)"), instants);
+        stats(
+            &format!("live: render job start to its instant image ({n})"),
+            job_to_instant,
+        );
+        stats(
+            &format!("live: edit to the frame showing its instant image ({n})"),
+            edit_to_instant,
         );
     }
     println!(

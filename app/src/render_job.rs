@@ -12,7 +12,7 @@ use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::ToneCurve;
 use photomontage::render::{RenderError, RenderSettings, RenderedImage, TileProgress};
 use photomontage::site::SiteDocument;
-use photomontage::site::render::SiteRenderError;
+use photomontage::site::render::{KeptPhoto, SiteRenderError};
 use photomontage::site::render_photo::{PreparedView, RenderPlan, RenderRequest, SPP_RANGE};
 use photomontage::verified::{AvrLevel, apply_massing, avr_overlay};
 use std::sync::atomic::AtomicBool;
@@ -120,6 +120,21 @@ pub fn prepare_photo(
     photo_id: &str,
     quality: Quality,
 ) -> Result<PhotoJob, RenderPanelError> {
+    prepare_photo_kept(doc, photo_id, quality, None)
+}
+
+/// [`prepare_photo`], taking the decoded photo from `kept` where it holds the view's file
+/// unchanged and keeping the one it loads there otherwise (the live preview's renders: an edit
+/// does not decode the photo again).
+///
+/// # Errors
+/// As [`prepare_photo`].
+pub fn prepare_photo_kept(
+    doc: &SiteDocument,
+    photo_id: &str,
+    quality: Quality,
+    kept: Option<&mut Option<KeptPhoto>>,
+) -> Result<PhotoJob, RenderPanelError> {
     let photo = photo_id.to_owned();
     let Quality {
         spp_min,
@@ -152,12 +167,16 @@ pub fn prepare_photo(
     let plan = RenderPlan::new(doc, &request).map_err(|e| prepare_error(&e))?;
     let massing = avr == AvrLevel::Avr2;
     let prepared = plan
-        .prepare(doc, &|scene| {
-            if massing {
-                apply_massing(scene)?;
-            }
-            Ok(())
-        })
+        .prepare_kept(
+            doc,
+            &|scene| {
+                if massing {
+                    apply_massing(scene)?;
+                }
+                Ok(())
+            },
+            kept,
+        )
         .map_err(|e| prepare_error(&e))?;
     Ok(PhotoJob { plan, prepared })
 }

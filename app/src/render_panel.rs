@@ -47,6 +47,7 @@ use crate::viewport::ViewTransform;
 use crate::widgets::name_widget;
 use crate::worker::{Poll, Progress, Worker};
 
+pub mod instant;
 pub mod live;
 use live::{JobOptions, LivePreview};
 
@@ -63,6 +64,13 @@ pub enum RenderUpdate {
     Pass { index: u32, count: u32 },
     /// The radiosity mode's transfers were updated ([`live`]).
     Relit(photomontage::site::live_relight::RelightReport),
+    /// The radiosity mode's instant image ([`instant`]): for display, the replayed preview, and
+    /// its cost.
+    Instant {
+        display: egui::ColorImage,
+        image: Box<photomontage::render::preview::PreviewImage>,
+        report: instant::InstantReport,
+    },
 }
 
 /// The render's worker: the montage (with the geometry of a re-projected view), or why not, with
@@ -150,6 +158,7 @@ fn render_job(
     options: &JobOptions,
     progress: &Progress<RenderUpdate>,
 ) -> Result<(RenderedImage, Option<ViewGeometry>), RenderPanelError> {
+    let job_start = std::time::Instant::now();
     if let Some((view, paper)) = view {
         let (image, geometry) =
             make_reprojected(doc, id, &view, quality.avr, paper, progress.cancel_flag())?;
@@ -158,11 +167,24 @@ fn render_job(
     if matches!(quality.avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
         return overlay_photo(doc, id, quality.avr).map(|image| (image, None));
     }
-    let mut job = prepare_photo(doc, id, quality)?;
+    let mut job = match &options.photo {
+        Some(shared) => {
+            // A job that panicked while holding the lock leaves nothing to reuse.
+            let mut kept = shared.lock().unwrap_or_else(|poisoned| {
+                let mut kept = poisoned.into_inner();
+                *kept = None;
+                kept
+            });
+            shared.clear_poison();
+            crate::render_job::prepare_photo_kept(doc, id, quality, Some(&mut kept))?
+        }
+        None => prepare_photo(doc, id, quality)?,
+    };
     let photo = &job.prepared.job.photo_linear;
+    let photo_display = display_photo(photo, &tone_map);
     progress.send(RenderUpdate::Photo {
         size_px: [photo.width(), photo.height()],
-        image: display_photo(photo, &tone_map),
+        image: photo_display.clone(),
     });
     if job.plan.radiosity && !job.prepared.photo_only {
         if job.plan.spectral {
@@ -176,6 +198,7 @@ fn render_job(
                 })?;
         } else {
             options.prepare_radiosity(doc, id, &mut job.prepared.job, progress)?;
+            options.instant_preview(id, &job, &photo_display, &tone_map, job_start, progress)?;
         }
     }
     let tiles = progress.clone();
@@ -280,8 +303,14 @@ impl RenderPanel {
             .view_choice
             .standard_view(photo_id)
             .map(|v| (v, self.view_choice.paper));
+        if options.coarse_first {
+            options.photo = Some(self.live.kept_photo());
+        }
         if doc.site.render.radiosity {
             options.transfers = Some(self.live.transfers());
+            if options.coarse_first {
+                options.records = Some(self.live.records());
+            }
         }
         let started = self.worker.spawn(ctx, move |progress| {
             render_job(&doc, &id, quality, tone_map, view, &options, progress)
@@ -314,6 +343,16 @@ impl RenderPanel {
                 tiles_done.clear();
             }
             RenderUpdate::Relit(report) => live.relit(report),
+            RenderUpdate::Instant {
+                display,
+                image,
+                report,
+            } => {
+                if let Some(size_px) = preview.as_ref().map(|p| p.size_px) {
+                    *preview = Some(Preview::new(&photo_id, size_px, display));
+                }
+                live.instant(report, *image);
+            }
             RenderUpdate::Photo { size_px, image } => {
                 *preview = Some(Preview::new(&photo_id, size_px, image));
             }

@@ -4,8 +4,9 @@
 //! caught up, its montage equals the library's `render_view` of the same site bit for bit (same
 //! rays per pixel and seed) and the preview shows exactly the montage (no tile of a cancelled
 //! render left). In the radiosity mode the studio's relit transfers match a fresh solve of the
-//! edited site within the transfer tests' tolerance, and the montage equals the library's render
-//! on those solutions bit for bit.
+//! edited site within the transfer tests' tolerance, the montage equals the library's render on
+//! those solutions bit for bit, and each edit's instant image (replayed from records traced by
+//! the first live render) equals the library's preview recorded under the edited site.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -16,6 +17,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use photomontage::radiosity::{RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, Solution};
 use photomontage::render::differential::radiosity_light::RadiosityLight;
+use photomontage::render::preview::{PreviewImage, PreviewRecords};
 use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::TransferUpdate;
@@ -218,6 +220,17 @@ fn radiosity_mode_relights_the_kept_transfers() {
         .clone();
     assert_eq!(built.update, TransferUpdate::Built);
     assert!(built.build.is_some(), "a build hands its report on");
+    let first = h
+        .state()
+        .render_panel()
+        .live
+        .last_instant()
+        .unwrap()
+        .clone();
+    assert!(
+        first.recorded,
+        "the first live render traces the instant image's records"
+    );
 
     set_sky(&mut h, "cie_overcast");
     wait(&mut h, "live render after the sky", caught_up);
@@ -232,9 +245,15 @@ fn radiosity_mode_relights_the_kept_transfers() {
         .clone();
     assert_eq!(relit.update, TransferUpdate::Relit);
     assert!(relit.build.is_none());
+    // The colour edit's instant image: replayed from the first render's records, no ray.
+    let live = &h.state().render_panel().live;
+    let report = live.last_instant().unwrap().clone();
+    assert!(!report.recorded && report.samples > 1000, "{report:?}");
+    let instant = live.instant_image().unwrap().clone();
     h.get_by_label("Render").click();
     steps(&mut h);
     assert!(h.query_by_label_contains("radiosity update").is_some());
+    assert!(h.query_by_label_contains("instant image").is_some());
     // The build's report stays shown after the relights (folded).
     let b = h.state().render_panel().live.last_build().unwrap().clone();
     assert_eq!(Some(&b), built.build.as_ref());
@@ -258,7 +277,40 @@ fn radiosity_mode_relights_the_kept_transfers() {
         &light.without_artificial,
         &fresh.without_artificial,
     );
+    assert_instant_is_the_librarys(&doc, &light, &instant);
     assert_montage_is(&h, &library_render(&doc, Some(light)), "radiosity");
+}
+
+/// The studio's instant image after a sky and a colour edit, replayed from records traced
+/// before both, equals the library's preview recorded now under the edited site and the same
+/// relit solutions, bit for bit (`photomontage::render::preview`).
+fn assert_instant_is_the_librarys(
+    doc: &SiteDocument,
+    light: &Arc<RadiosityLight>,
+    instant: &PreviewImage,
+) {
+    let mut job = prepare_view(doc, "P1").unwrap();
+    job.lighting.radiosity = Some(Arc::clone(light));
+    let tracer = DifferentialTracer::new(
+        &job.scene.scene,
+        &job.lighting,
+        &job.camera,
+        &job.photo_linear,
+        job.settings.max_depth,
+    )
+    .unwrap();
+    let library =
+        PreviewRecords::record(&tracer, instant.stride_px, &AtomicBool::new(false)).unwrap();
+    let library = library
+        .replay(&job.scene.scene, &job.lighting, &job.camera)
+        .unwrap();
+    let bits =
+        |p: &PreviewImage| -> Vec<u32> { p.rgba.iter().flatten().map(|v| v.to_bits()).collect() };
+    assert!(library.changed.iter().filter(|&&c| c).count() > 100);
+    assert!(
+        bits(&library) == bits(instant) && library.changed == instant.changed,
+        "the instant image differs from the library's preview"
+    );
 }
 
 /// In spectral mode the Render panel solves the radiosity once per spectral pass (the kept

@@ -12,24 +12,32 @@
 //! edit, built again only when the geometry changes; the renderer reads the relit solutions
 //! through `Lighting::radiosity`.
 //!
+//! In that mode a live render also shows an instant image right after the relight, replayed
+//! from records of the view without a ray ([`super::instant`]), before its first tile.
+//!
 //! The tab shows the last egui frame's time (the studio's whole `ui` call), the last radiosity
-//! update's time and kind, the last build's report (folded: element counts, where the natural
+//! update's time and kind, the instant image's time, the last build's report (folded: element counts, where the natural
 //! surfaces' reflectances came from, its notes), and the refinement's pass and tiles.
 //!
+//! A live render takes the photo decoded by the last one while its file is unchanged
+//! ([`photomontage::site::render::KeptPhoto`]).
+//!
 //! # Known limitations
-//! Every new render decodes the photo again; the re-projected views (planar, cylindrical) are
-//! not rendered live (Start renders them).
+//! The re-projected views (planar, cylindrical) are not rendered live (Start renders them).
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use eframe::egui;
+use photomontage::render::preview::PreviewImage;
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::{RelightReport, SiteTransfers, TransferUpdate};
 use photomontage::site::photo_reflectance::PhotoView;
+use photomontage::site::render::KeptPhoto;
 use photomontage::site::render::ViewJob;
 use photomontage::site::render_radiosity::RadiosityReport;
 
+use super::instant::{InstantReport, SharedRecords};
 use super::{Quality, RenderPanelError, RenderUpdate};
 use crate::widgets::name_widget;
 use crate::worker::Progress;
@@ -37,8 +45,16 @@ use crate::worker::Progress;
 /// Rays per pixel of the coarse pass.
 pub const COARSE_SPP: u32 = 4;
 
+/// Samples of the radiosity mode's instant image at most ([`super::instant`]): one per block of
+/// the smallest stride that keeps under this (3 × 3 pixels for 1280 × 960).
+pub const INSTANT_SAMPLES: u64 = 150_000;
+
 /// The site's transfers, shared with the render worker.
 pub type SharedTransfers = Arc<Mutex<Option<SiteTransfers>>>;
+
+/// The last decoded photo, shared with the render worker (an edit's render reuses it while its
+/// file is unchanged).
+pub type SharedPhoto = Arc<Mutex<Option<KeptPhoto>>>;
 
 /// What the live preview rendered last: the site, photo and quality.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,6 +82,12 @@ pub struct LivePreview {
     /// Pass of the running render: (index from 1, count).
     pub(super) pass: Option<(u32, u32)>,
     cancelled: usize,
+    /// The instant image's records (radiosity mode, [`super::instant`]).
+    records: SharedRecords,
+    /// The last decoded photo.
+    photo: SharedPhoto,
+    last_instant: Option<InstantReport>,
+    instant_image: Option<PreviewImage>,
 }
 
 /// What a render job does beyond the panel's quality.
@@ -75,6 +97,10 @@ pub struct JobOptions {
     pub coarse_first: bool,
     /// The site's transfers, in the radiosity mode.
     pub transfers: Option<SharedTransfers>,
+    /// The instant image's records, in a live render of the radiosity mode.
+    pub records: Option<SharedRecords>,
+    /// The last decoded photo, reused by a live render while its file is unchanged.
+    pub photo: Option<SharedPhoto>,
 }
 
 impl JobOptions {
@@ -157,6 +183,35 @@ impl LivePreview {
         Arc::clone(&self.transfers)
     }
 
+    /// The last decoded photo, shared with the render worker.
+    #[must_use]
+    pub fn kept_photo(&self) -> SharedPhoto {
+        Arc::clone(&self.photo)
+    }
+
+    /// The instant image's records, shared with the render worker.
+    #[must_use]
+    pub fn records(&self) -> SharedRecords {
+        Arc::clone(&self.records)
+    }
+
+    /// What the last instant image cost (radiosity mode).
+    #[must_use]
+    pub fn last_instant(&self) -> Option<&InstantReport> {
+        self.last_instant.as_ref()
+    }
+
+    /// The last instant image (tests compare it with the library's replay).
+    #[must_use]
+    pub fn instant_image(&self) -> Option<&PreviewImage> {
+        self.instant_image.as_ref()
+    }
+
+    pub(super) fn instant(&mut self, report: InstantReport, image: PreviewImage) {
+        self.last_instant = Some(report);
+        self.instant_image = Some(image);
+    }
+
     /// Records the time of the studio's last frame.
     pub fn frame_done(&mut self, elapsed: Duration) {
         self.last_frame = Some(elapsed);
@@ -206,6 +261,17 @@ impl LivePreview {
             ui.label(format!(
                 "radiosity update {:.1} ms ({what})",
                 r.seconds * 1e3
+            ));
+        }
+        if let Some(r) = &self.last_instant {
+            let how = if r.recorded { "traced" } else { "replayed" };
+            ui.label(format!(
+                "instant image {:.1} ms ({how}: {} samples, 1 per {s}×{s} px), {:.0} ms after \
+                 the render started",
+                r.seconds * 1e3,
+                r.samples,
+                r.job_seconds * 1e3,
+                s = r.stride_px
             ));
         }
         if let Some(b) = &self.last_build {
@@ -287,7 +353,7 @@ impl crate::Studio {
         };
         let options = JobOptions {
             coarse_first: true,
-            transfers: None,
+            ..JobOptions::default()
         };
         let id = id.to_owned();
         let result = self.render.start_with(doc, &id, ctx, options);

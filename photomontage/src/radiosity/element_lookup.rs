@@ -162,8 +162,9 @@ impl LookupGeometry {
 #[derive(Debug, Clone)]
 pub(crate) struct ElementLocator {
     pub(super) geometry: Arc<LookupGeometry>,
-    /// Per element and corner: (total, direct) irradiance averaged at the shared vertex.
-    pub(super) vertex_values: Vec<[(Rgb, Rgb); 3]>,
+    /// Per shared vertex: (total, direct) irradiance averaged over its corners
+    /// ([`Self::vertex_values`] reads an element's three).
+    vertex_means: Vec<(Rgb, Rgb)>,
     /// Per element, total radiosity B (for gathers).
     pub(super) radiosity: Vec<Rgb>,
     /// Per element: reflects (ρ > 0 in some channel).
@@ -215,18 +216,24 @@ impl ElementLocator {
             }
             (t.map(|x| x / k), d.map(|x| x / k))
         });
-        let vertex_values = map_indices(parallel, n, |e| {
-            geometry.corner_vertex[e].map(|v| vertex_means[v as usize])
-        });
         let reflects = map_indices(parallel, n, |e| {
             mesh.element_reflectance_rgb(e).iter().any(|&r| r > 0.0)
         });
         Self {
             geometry,
-            vertex_values,
+            vertex_means,
             radiosity: per_element.into_iter().map(|(_, _, b)| b).collect(),
             reflects,
         }
+    }
+
+    /// Element `e`'s (total, direct) irradiance at its three corners, averaged at the shared
+    /// vertices (module doc); `None` for an element the mesh does not have.
+    pub(super) fn vertex_values(&self, e: usize) -> Option<[(Rgb, Rgb); 3]> {
+        self.geometry
+            .corner_vertex
+            .get(e)
+            .map(|corners| corners.map(|v| self.vertex_means[v as usize]))
     }
 
     /// The element `point` lies on and its barycentric weights ([`LookupGeometry::locate`]).
@@ -323,10 +330,15 @@ mod tests {
             .unwrap();
         let locator = pool.install(|| ElementLocator::new(solution, true));
         let alone = ElementLocator::new(solution, false);
-        assert_eq!(bits(&locator.vertex_values), bits(&alone.vertex_values));
-        assert!(locator.vertex_values.len() > 100);
+        let values = |l: &ElementLocator| -> Vec<[(Rgb, Rgb); 3]> {
+            (0..solution.mesh.elements.len())
+                .map(|e| l.vertex_values(e).unwrap())
+                .collect()
+        };
+        assert_eq!(bits(&values(&locator)), bits(&values(&alone)));
+        assert!(values(&locator).len() > 100);
         assert_eq!(
-            bits(&locator.vertex_values),
+            bits(&values(&locator)),
             bits(&one_pass_vertex_values(solution))
         );
         let b: Vec<u64> = solution

@@ -93,7 +93,7 @@ impl Solution {
     ) -> Option<IrradianceSample> {
         let locator = self.locator();
         let (e, w) = locator.locate(point_in_world_m, normal_in_world)?;
-        let values = &locator.vertex_values[e];
+        let values = locator.vertex_values(e)?;
         let mut total = [0.0; 3];
         let mut direct = [0.0; 3];
         for (k, (t, d)) in values.iter().enumerate() {
@@ -175,7 +175,7 @@ impl Solution {
         let e = at.element as usize;
         let w = at.weights;
         let mut direct = [0.0; 3];
-        for (k, (_, d)) in self.locator().vertex_values.get(e)?.iter().enumerate() {
+        for (k, (_, d)) in self.locator().vertex_values(e)?.iter().enumerate() {
             for c in 0..3 {
                 direct[c] += w[k] * d[c];
             }

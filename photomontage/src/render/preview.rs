@@ -18,6 +18,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use image::Rgb32FImage;
 use nalgebra::Point2;
 use rayon::prelude::*;
 
@@ -71,17 +72,58 @@ pub struct PreviewImage {
     pub size_px: [u32; 2],
     /// The pixels.
     pub rgba: Vec<[f32; 4]>,
+    /// Whether each pixel's sample differs from the photo.
+    pub changed: Vec<bool>,
 }
 
+/// Photo values below this (linear) are not divided by in [`PreviewImage::linear_at`].
+const PHOTO_FLOOR: f32 = 1e-3;
+
 impl PreviewImage {
-    /// The preview pixel showing photo pixel `[x, y]`.
-    #[must_use]
-    pub fn at_photo_px(&self, x: u32, y: u32) -> [f32; 4] {
+    /// The index of the preview pixel showing photo pixel `[x, y]`.
+    fn index_at(&self, x: u32, y: u32) -> usize {
         let (px, py) = (
             (x / self.stride_px).min(self.size_px[0] - 1),
             (y / self.stride_px).min(self.size_px[1] - 1),
         );
-        self.rgba[(py * self.size_px[0] + px) as usize]
+        (py * self.size_px[0] + px) as usize
+    }
+
+    /// The preview pixel showing photo pixel `[x, y]`.
+    #[must_use]
+    pub fn at_photo_px(&self, x: u32, y: u32) -> [f32; 4] {
+        self.rgba[self.index_at(x, y)]
+    }
+
+    /// The preview's linear RGB at photo pixel `[x, y]` of `photo` (the photo the records were
+    /// traced over), for display at full resolution: the photo's own value where the block's
+    /// sample did not change; the sample where it hit an artificial object; on a changed natural
+    /// point the sample's change factor (its value over the photo's at the sample) times the
+    /// photo's own value, so that a new shadow keeps the photo's texture.
+    #[must_use]
+    pub fn linear_at(&self, x: u32, y: u32, photo: &Rgb32FImage) -> [f32; 3] {
+        let own = photo.get_pixel(x, y).0;
+        let i = self.index_at(x, y);
+        if !self.changed[i] {
+            return own;
+        }
+        let p = self.rgba[i];
+        if p[3] > 0.0 {
+            return [p[0], p[1], p[2]];
+        }
+        let s = self.stride_px;
+        let (sx, sy) = (
+            sample_px((x / s).min(self.size_px[0] - 1), s, photo.width()),
+            sample_px((y / s).min(self.size_px[1] - 1), s, photo.height()),
+        );
+        let at_sample = photo.get_pixel(sx, sy).0;
+        std::array::from_fn(|k| {
+            if at_sample[k] > PHOTO_FLOOR {
+                own[k] * (p[k] / at_sample[k])
+            } else {
+                p[k]
+            }
+        })
     }
 }
 
@@ -208,12 +250,15 @@ impl PreviewRecords {
                          recorded",
             });
         }
+        if let Some(radiosity) = &lighting.radiosity {
+            radiosity.prepare_queries();
+        }
         let shade = Shade {
             lighting,
             materials: scene.materials(),
         };
         #[allow(clippy::cast_possible_truncation)]
-        let rgba = self
+        let (rgba, changed) = self
             .samples
             .par_iter()
             .with_min_len(1024)
@@ -224,13 +269,17 @@ impl PreviewRecords {
                 } else {
                     0.0
                 };
-                [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, alpha]
+                (
+                    [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, alpha],
+                    changed,
+                )
             })
-            .collect();
+            .unzip();
         Ok(PreviewImage {
             stride_px: self.stride_px,
             size_px: self.size_px,
             rgba,
+            changed,
         })
     }
 }

@@ -368,6 +368,27 @@ fn preview_records_are_the_renderers_samples_and_replay_a_stronger_sun() {
         assert_eq!([p[0], p[1], p[2]], recorded);
     }
 
+    // At full resolution: a pixel whose block did not change is the photo's own value; a
+    // sample's own pixel is its value (the change factor times the photo there).
+    let (mut unchanged, mut own) = (0, 0);
+    for y in 0..SIZE_PX[1] {
+        for x in 0..SIZE_PX[0] {
+            let i = ((y / STRIDE_PX) * cols + x / STRIDE_PX) as usize;
+            let v = same.linear_at(x, y, &fx.photo);
+            if !same.changed[i] {
+                unchanged += 1;
+                assert_eq!(v, fx.photo.get_pixel(x, y).0);
+            } else if x % STRIDE_PX == 0 && y % STRIDE_PX == 0 {
+                own += 1;
+                let p = same.rgba[i];
+                for k in 0..3 {
+                    assert!((v[k] - p[k]).abs() <= 1e-6 * p[k].abs(), "({x}, {y})");
+                }
+            }
+        }
+    }
+    assert!(unchanged > 1000 && own > 50, "{unchanged} {own}");
+
     let mut stronger = fx.lighting.clone();
     if let Some(sun) = stronger.daylight.sun.as_mut() {
         sun.normal_irradiance_rgb = E_SUN.map(|e| 2.0 * e);

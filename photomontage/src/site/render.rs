@@ -403,6 +403,38 @@ pub fn site_photo_linear(
     photo_id: &str,
     camera: &Camera,
 ) -> Result<Rgb32FImage, SiteRenderError> {
+    site_photo_linear_kept(doc, photo_id, camera, None)
+}
+
+/// A photo decoded and linearised, kept to be handed out again while its file is unchanged
+/// (same path, length and modification time): the studio's live renders of one view, which
+/// would otherwise decode the photo again for every edit.
+#[derive(Debug, Clone)]
+pub struct KeptPhoto {
+    file: std::path::PathBuf,
+    len: u64,
+    modified: Option<std::time::SystemTime>,
+    photo_linear: Rgb32FImage,
+}
+
+impl KeptPhoto {
+    /// Whether `file` is the one kept, unchanged since it was read.
+    fn holds(&self, file: &std::path::Path, meta: &std::fs::Metadata) -> bool {
+        self.file == file && self.len == meta.len() && self.modified == meta.modified().ok()
+    }
+}
+
+/// [`site_photo_linear`], reusing the photo `kept` holds when it is this view's file unchanged
+/// and keeping the one it loads there otherwise (`None`: nothing kept).
+///
+/// # Errors
+/// As [`site_photo_linear`].
+pub fn site_photo_linear_kept(
+    doc: &SiteDocument,
+    photo_id: &str,
+    camera: &Camera,
+    kept: Option<&mut Option<KeptPhoto>>,
+) -> Result<Rgb32FImage, SiteRenderError> {
     let photo = doc
         .site
         .photos
@@ -412,8 +444,29 @@ pub fn site_photo_linear(
             id: photo_id.to_owned(),
             valid: Vec::new(),
         })?;
-    let loaded = crate::photo::load(&doc.resolve(&photo.file))?;
-    let photo_linear = crate::render::linear_photo(&loaded);
+    let file = doc.resolve(&photo.file);
+    let meta = std::fs::metadata(&file).ok();
+    let reused = kept.as_deref().and_then(Option::as_ref).and_then(|k| {
+        meta.as_ref()
+            .filter(|m| k.holds(&file, m))
+            .map(|_| k.photo_linear.clone())
+    });
+    let photo_linear = match reused {
+        Some(photo_linear) => photo_linear,
+        None => {
+            let loaded = crate::photo::load(&file)?;
+            let photo_linear = crate::render::linear_photo(&loaded);
+            if let (Some(slot), Some(meta)) = (kept, &meta) {
+                *slot = Some(KeptPhoto {
+                    file: file.clone(),
+                    len: meta.len(),
+                    modified: meta.modified().ok(),
+                    photo_linear: photo_linear.clone(),
+                });
+            }
+            photo_linear
+        }
+    };
     let photo_px = [photo_linear.width(), photo_linear.height()];
     if photo_px != camera.intrinsics.image_size_px {
         return Err(SiteRenderError::SizeMismatch {
@@ -444,6 +497,20 @@ pub fn prepare_view_with(
     photo_id: &str,
     options: &SiteLightingOptions,
 ) -> Result<ViewJob, SiteRenderError> {
+    prepare_view_kept(doc, photo_id, options, None)
+}
+
+/// [`prepare_view_with`], taking the photo from `kept` where it holds this view's file unchanged
+/// ([`site_photo_linear_kept`]).
+///
+/// # Errors
+/// As [`prepare_view`].
+pub fn prepare_view_kept(
+    doc: &SiteDocument,
+    photo_id: &str,
+    options: &SiteLightingOptions,
+    kept: Option<&mut Option<KeptPhoto>>,
+) -> Result<ViewJob, SiteRenderError> {
     let camera = site_camera(doc, photo_id)?;
     // A design variant may show no model (the existing situation, for comparison).
     let variant_applied = doc.site.variants.iter().any(|v| v.applied);
@@ -452,7 +519,7 @@ pub fn prepare_view_with(
     }
     let scene = site_scene(doc)?;
     let (lighting, sun_dir_in_world) = site_lighting(doc, photo_id, options)?;
-    let photo_linear = site_photo_linear(doc, photo_id, &camera)?;
+    let photo_linear = site_photo_linear_kept(doc, photo_id, &camera, kept)?;
     let (settings, setting_warnings) = site_render_settings(&doc.site.render);
     let mut warnings = scene.warnings.clone();
     warnings.extend(setting_warnings);

@@ -19,7 +19,10 @@ use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
 
 use super::SiteDocument;
-use super::render::{ObjectSource, SiteRenderError, SiteWarning, prepare_view, site_camera};
+use super::render::{
+    KeptPhoto, ObjectSource, SiteLightingOptions, SiteRenderError, SiteWarning, prepare_view_kept,
+    site_camera,
+};
 use crate::colour::{SampleSet, ToneMap};
 use crate::render::output::{LayerSet, OutputLayers};
 use crate::render::partial::{PART_FORMAT, PartInfo, to_hex};
@@ -309,7 +312,27 @@ impl RenderPlan {
         doc: &SiteDocument,
         edit: &dyn Fn(&mut Scene) -> Result<(), SceneError>,
     ) -> Result<PreparedView, SiteRenderError> {
-        let mut job = prepare_view(doc, &self.request.view)?;
+        self.prepare_kept(doc, edit, None)
+    }
+
+    /// [`Self::prepare`], taking the photo from `kept` where it holds the view's file unchanged
+    /// and keeping the one it loads there otherwise
+    /// ([`super::render::site_photo_linear_kept`]: the studio's live renders).
+    ///
+    /// # Errors
+    /// As [`Self::prepare`].
+    pub fn prepare_kept(
+        &self,
+        doc: &SiteDocument,
+        edit: &dyn Fn(&mut Scene) -> Result<(), SceneError>,
+        kept: Option<&mut Option<KeptPhoto>>,
+    ) -> Result<PreparedView, SiteRenderError> {
+        let mut job = prepare_view_kept(
+            doc,
+            &self.request.view,
+            &SiteLightingOptions::default(),
+            kept,
+        )?;
         edit(&mut job.scene.scene)?;
         // Only a design variant gets here without a model (prepare_view refuses the site
         // itself): nothing is added, the band is the photo.

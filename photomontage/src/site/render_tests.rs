@@ -399,3 +399,32 @@ fn render_settings_round_to_multiples_of_four() {
     assert_eq!((s.min_rays_per_pixel, s.max_rays_per_pixel), (4, 16));
     assert!(w.is_empty());
 }
+
+/// A kept photo ([`KeptPhoto`]) is handed out again while its file is unchanged (the kept
+/// pixels, not a new decode), and read again once the file changed.
+#[test]
+fn a_kept_photo_is_reused_until_its_file_changes() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = fixture(dir.path());
+    let camera = site_camera(&doc, "p1").unwrap();
+    let fresh = site_photo_linear(&doc, "p1", &camera).unwrap();
+    let mut kept = None;
+    let first = site_photo_linear_kept(&doc, "p1", &camera, Some(&mut kept)).unwrap();
+    assert!(first == fresh);
+    // Mark the kept pixels: a reuse hands out the mark.
+    let mark = image::Rgb([9.0_f32; 3]);
+    kept.as_mut().unwrap().photo_linear.put_pixel(0, 0, mark);
+    let again = site_photo_linear_kept(&doc, "p1", &camera, Some(&mut kept)).unwrap();
+    assert_eq!(*again.get_pixel(0, 0), mark);
+    // Another photo in the same file (other pixels, so another length): read again.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    image::RgbImage::from_fn(64, 48, |x, y| {
+        #[allow(clippy::cast_possible_truncation)]
+        image::Rgb([(x * 4) as u8, (y * 5) as u8, 100])
+    })
+    .save(dir.path().join("p1.png"))
+    .unwrap();
+    let changed = site_photo_linear_kept(&doc, "p1", &camera, Some(&mut kept)).unwrap();
+    assert!(changed == site_photo_linear(&doc, "p1", &camera).unwrap());
+    assert!(changed != fresh && *changed.get_pixel(0, 0) != mark);
+}

@@ -109,12 +109,7 @@ impl RadiosityLight {
             [None, None],
             None,
         )?;
-        // Both element lookups side by side, before the render's first query would build them
-        // one after the other.
-        rayon::join(
-            || light.with_artificial.prepare_queries(),
-            || light.without_artificial.prepare_queries(),
-        );
+        light.prepare_queries();
         Ok(light)
     }
 
@@ -194,6 +189,16 @@ impl RadiosityLight {
             change_fraction: DEFAULT_CHANGE_FRACTION,
             gathered: [with_gathered, without_gathered],
         })
+    }
+
+    /// Builds both solutions' point lookups side by side over rayon's pool, before a first query
+    /// would build them one after the other, each on one thread (a relit light's are built by
+    /// its first query, or here).
+    pub fn prepare_queries(&self) {
+        rayon::join(
+            || self.with_artificial.prepare_queries(),
+            || self.without_artificial.prepare_queries(),
+        );
     }
 
     /// The groups the renderer traces exactly: the sun and every luminaire.
