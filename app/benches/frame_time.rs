@@ -12,7 +12,9 @@
 //! `[render] radiosity = true`, solved, Live on, a manual sun stepped 1° in azimuth every
 //! [`LIVE_STEP_EVERY`] frames (each step one undoable edit, as a slider drag gives), so that the
 //! studio relights its transfers and re-renders on its worker while the frames are timed. It
-//! prints the same statistics for those frames and the relight times the studio reported.
+//! prints the same statistics for those frames, the relight times the studio reported, and its
+//! instant images' times (the replay, from the render job's start, and from the edit to the
+//! frame that shows it).
 //!
 //! `cargo bench -p photomontage-studio --bench frame_time` (release profile; `live` as the only
 //! argument runs the live part alone). On a machine without a GPU wgpu runs on lavapipe (CPU),

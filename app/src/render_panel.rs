@@ -198,7 +198,13 @@ fn render_job(
                 })?;
         } else {
             options.prepare_radiosity(doc, id, &mut job.prepared.job, progress)?;
-            options.instant_preview(id, &job, &photo_display, &tone_map, job_start, progress)?;
+            let instant = instant::InstantJob {
+                records: options.records.as_ref(),
+                photo_display: &photo_display,
+                tone_map: &tone_map,
+                job_start,
+            };
+            instant.run(id, &job, progress)?;
         }
     }
     let tiles = progress.clone();

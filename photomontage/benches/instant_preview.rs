@@ -29,7 +29,7 @@ use photomontage::site::solve::{apply_solution, solve_site};
 
 /// Threads of every measurement.
 const THREADS: usize = 2;
-/// The studio's sample budget of the instant image (`app/src/render_panel/live.rs`).
+/// The studio's sample budget of the instant image (`app/src/render_panel/instant.rs`).
 const INSTANT_SAMPLES: u64 = 150_000;
 /// The two colours a step alternates the planned building's material between.
 const COLOURS: [[f64; 3]; 2] = [[0.7, 0.35, 0.2], [0.35, 0.45, 0.6]];

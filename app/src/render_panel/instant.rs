@@ -7,7 +7,7 @@
 //! photo or the geometry changed (a model moved, hidden or added).
 //!
 //! # Known limitations
-//! One sample per block of [`super::live::INSTANT_SAMPLES`]' stride (about a third of the
+//! One sample per block of [`INSTANT_SAMPLES`]' stride (about a third of the
 //! photo's resolution on each axis for 1280 × 960): the instant image is coarse where it changed,
 //! until the tiles come. A sun move keeps the recorded shadows until the passes re-trace them
 //! (the replay module's limitations).
@@ -21,7 +21,6 @@ use photomontage::colour::tonemap::encode_srgb8;
 use photomontage::render::preview::{PreviewImage, PreviewRecords, stride_for};
 use photomontage::render::{DifferentialTracer, RenderError};
 
-use super::live::{INSTANT_SAMPLES, JobOptions};
 use super::{RenderPanelError, RenderUpdate, display_step};
 use crate::render_job::PhotoJob;
 use crate::worker::Progress;
@@ -53,27 +52,41 @@ pub struct InstantReport {
     pub job_seconds: f64,
 }
 
-impl JobOptions {
+/// Samples of the radiosity mode's instant image at most: one per block of the smallest stride
+/// that keeps under this (3 × 3 pixels for 1280 × 960).
+pub const INSTANT_SAMPLES: u64 = 150_000;
+
+/// The render job's part (module doc).
+pub(super) struct InstantJob<'a> {
+    /// The kept records (a live render of the radiosity mode); `None`: no instant image.
+    pub records: Option<&'a SharedRecords>,
+    /// The photo's display image, which the instant image is drawn over.
+    pub photo_display: &'a egui::ColorImage,
+    /// The panel's tone map.
+    pub tone_map: &'a ToneMap,
+    /// When the render job started.
+    pub job_start: Instant,
+}
+
+impl InstantJob<'_> {
     /// In a live render of the radiosity mode: the instant image of `job` (its lighting holds
     /// the relit transfers' light), from the kept records or from records traced now, drawn
-    /// over `photo_display` (the photo's display image) and sent to the panel as
-    /// [`RenderUpdate::Instant`].
+    /// over the photo's display image and sent to the panel as [`RenderUpdate::Instant`].
     ///
     /// # Errors
     /// [`RenderPanelError::Cancelled`] when cancelled while tracing the records,
     /// [`RenderPanelError::Prepare`] with the library's message otherwise.
-    pub(super) fn instant_preview(
+    pub(super) fn run(
         &self,
         photo_id: &str,
         job: &PhotoJob,
-        photo_display: &egui::ColorImage,
-        tone_map: &ToneMap,
-        job_start: Instant,
         progress: &Progress<RenderUpdate>,
     ) -> Result<(), RenderPanelError> {
-        let Some(shared) = &self.records else {
+        let Some(shared) = self.records else {
             return Ok(());
         };
+        let (photo_display, tone_map, job_start) =
+            (self.photo_display, self.tone_map, self.job_start);
         let start = Instant::now();
         let view = &job.prepared.job;
         let (scene, lighting, camera) = (&view.scene.scene, &view.lighting, &view.camera);

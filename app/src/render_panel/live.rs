@@ -45,10 +45,6 @@ use crate::worker::Progress;
 /// Rays per pixel of the coarse pass.
 pub const COARSE_SPP: u32 = 4;
 
-/// Samples of the radiosity mode's instant image at most ([`super::instant`]): one per block of
-/// the smallest stride that keeps under this (3 × 3 pixels for 1280 × 960).
-pub const INSTANT_SAMPLES: u64 = 150_000;
-
 /// The site's transfers, shared with the render worker.
 pub type SharedTransfers = Arc<Mutex<Option<SiteTransfers>>>;
 

@@ -22,8 +22,8 @@ use image::Rgb32FImage;
 use nalgebra::Point2;
 use rayon::prelude::*;
 
-use super::differential::replay::{RecordedSample, Shade};
-use super::differential::{DifferentialTracer, Lighting};
+use super::differential::replay::RecordedSample;
+use super::differential::{DifferentialTracer, Lighting, Shade};
 use super::{RenderError, Rgb};
 use crate::camera::Camera;
 use crate::scene::Scene;

@@ -476,7 +476,7 @@ impl DifferentialTracer<'_> {
         }
     }
 
-    /// [`Shade::changed_apparent`] with this tracer's atmosphere.
+    /// [`super::Shade::changed_apparent`] with this tracer's atmosphere.
     fn changed_apparent(
         &self,
         photo_rgb: Rgb,

@@ -63,7 +63,7 @@ mod interreflection;
 pub mod radiosity_light;
 pub mod replay;
 mod shading;
-pub use shading::true_colour_rgb;
+pub use shading::{Shade, true_colour_rgb};
 pub mod specular;
 mod visibility;
 

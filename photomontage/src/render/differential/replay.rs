@@ -30,14 +30,13 @@
 use nalgebra::Vector3;
 
 use super::radiosity_light::RadiosityLight;
-use super::shading::true_colour_rgb;
-use super::{DifferentialTracer, Lighting, PrimaryHit};
+use super::shading::{Shade, true_colour_rgb};
+use super::{DifferentialTracer, PrimaryHit};
 use crate::radiosity::PointOnElement;
 use crate::render::illumination::{
     Rgb, add, diffuse_radiance_rgb, diffuse_reflectance_from_true_colour, mul,
     natural_irradiance_rgb, natural_irradiance_weighted_rgb, scale,
 };
-use crate::scene::Material;
 
 /// What a case C shading depends on besides the material and the light a studio edit changes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -122,16 +121,6 @@ pub struct RecordedSample {
     pub first_hit: Option<PrimaryHit>,
     /// What the replay evaluates.
     pub replay: SampleReplay,
-}
-
-/// The light and materials a sample is shaded under: a tracer's own ([`DifferentialTracer`]
-/// shades with them), or those of a studio edit for a replay. Needs no geometry.
-#[derive(Debug, Clone, Copy)]
-pub struct Shade<'a> {
-    /// Lights, atmosphere and radiosity solutions.
-    pub lighting: &'a Lighting,
-    /// The materials, indexed by material id.
-    pub materials: &'a [Material],
 }
 
 impl Shade<'_> {

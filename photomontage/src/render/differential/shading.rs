@@ -9,10 +9,10 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::replay::Shade;
-use super::{DifferentialTracer, SURFACE_OFFSET_M};
+use super::{DifferentialTracer, Lighting, SURFACE_OFFSET_M};
 use crate::colour::Colour;
 use crate::render::illumination::{Rgb, add, mul, scale};
+use crate::scene::Material;
 
 impl DifferentialTracer<'_> {
     /// Fraction of the sun reaching the offset point `origin` of a surface with geometric
@@ -94,6 +94,16 @@ impl DifferentialTracer<'_> {
             materials: self.materials,
         }
     }
+}
+
+/// The light and materials a sample is shaded under: a tracer's own ([`DifferentialTracer`]
+/// shades with them), or those of a studio edit for a replay ([`super::replay`]). Needs no geometry.
+#[derive(Debug, Clone, Copy)]
+pub struct Shade<'a> {
+    /// Lights, atmosphere and radiosity solutions.
+    pub lighting: &'a Lighting,
+    /// The materials, indexed by material id.
+    pub materials: &'a [Material],
 }
 
 impl Shade<'_> {
