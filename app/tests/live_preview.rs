@@ -18,7 +18,7 @@ use egui_kittest::kittest::Queryable;
 use photomontage::radiosity::{RELIGHT_L1_REL_TOL, RELIGHT_MEAN_REL_TOL, Solution};
 use photomontage::render::differential::radiosity_light::RadiosityLight;
 use photomontage::render::preview::{PreviewImage, PreviewRecords};
-use photomontage::render::{DifferentialTracer, RenderedImage, render_view};
+use photomontage::render::{RenderedImage, render_view};
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::TransferUpdate;
 use photomontage::site::render::{prepare_view, site_scene};
@@ -110,14 +110,7 @@ fn library_render(doc: &SiteDocument, radiosity: Option<Arc<RadiosityLight>>) ->
     job.settings.max_rays_per_pixel = SPP.1;
     job.settings.seed = SEED;
     job.lighting.radiosity = radiosity;
-    let tracer = DifferentialTracer::new(
-        &job.scene.scene,
-        &job.lighting,
-        &job.camera,
-        &job.photo_linear,
-        job.settings.max_depth,
-    )
-    .unwrap();
+    let tracer = job.tracer().unwrap();
     render_view(&tracer, &job.settings, &|_| {}, &AtomicBool::new(false)).unwrap()
 }
 
@@ -291,14 +284,7 @@ fn assert_instant_is_the_librarys(
 ) {
     let mut job = prepare_view(doc, "P1").unwrap();
     job.lighting.radiosity = Some(Arc::clone(light));
-    let tracer = DifferentialTracer::new(
-        &job.scene.scene,
-        &job.lighting,
-        &job.camera,
-        &job.photo_linear,
-        job.settings.max_depth,
-    )
-    .unwrap();
+    let tracer = job.tracer().unwrap();
     let library =
         PreviewRecords::record(&tracer, instant.stride_px, &AtomicBool::new(false)).unwrap();
     let library = library

@@ -20,7 +20,6 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
-use photomontage::render::DifferentialTracer;
 use photomontage::render::preview::{PreviewRecords, stride_for};
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::SiteTransfers;
@@ -101,14 +100,7 @@ fn bench_instant_preview(c: &mut Criterion) {
     let (job, _) = pool.install(|| relit_view(&docs[0], &mut slot));
     let photo = &job.photo_linear;
     let stride = stride_for([photo.width(), photo.height()], INSTANT_SAMPLES);
-    let tracer = DifferentialTracer::new(
-        &job.scene.scene,
-        &job.lighting,
-        &job.camera,
-        &job.photo_linear,
-        job.settings.max_depth,
-    )
-    .unwrap();
+    let tracer = job.tracer().unwrap();
     let mut record_ms = Vec::new();
     let mut records = None;
     for _ in 0..3 {

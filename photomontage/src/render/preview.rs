@@ -89,12 +89,6 @@ impl PreviewImage {
         (py * self.size_px[0] + px) as usize
     }
 
-    /// The preview pixel showing photo pixel `[x, y]`.
-    #[must_use]
-    pub fn at_photo_px(&self, x: u32, y: u32) -> [f32; 4] {
-        self.rgba[self.index_at(x, y)]
-    }
-
     /// The preview's linear RGB at photo pixel `[x, y]` of `photo` (the photo the records were
     /// traced over), for display at full resolution: the photo's own value where the block's
     /// sample did not change; the sample where it hit an artificial object; on a changed natural
@@ -218,12 +212,6 @@ impl PreviewRecords {
     #[must_use]
     pub fn fits(&self, scene: &Scene, lighting: &Lighting, camera: &Camera) -> bool {
         key_of(scene, lighting, camera).is_some_and(|k| k == self.key)
-    }
-
-    /// Photo pixels per preview pixel along each axis.
-    #[must_use]
-    pub fn stride_px(&self) -> u32 {
-        self.stride_px
     }
 
     /// The samples, row-major over the preview.

@@ -435,7 +435,6 @@ const STUDIO_RHO_REL_TOL: f64 = 0.02;
 /// recording's own light, the recorded values.
 #[test]
 fn the_preview_replays_a_sky_and_colour_edit_as_a_new_recording_would() {
-    use crate::render::differential::DifferentialTracer;
     use crate::render::differential::replay::SampleReplay;
     use crate::render::preview::PreviewRecords;
     const STRIDE_PX: u32 = 1;
@@ -454,14 +453,7 @@ fn the_preview_replays_a_sky_and_colour_edit_as_a_new_recording_would() {
     };
     let (job0, update) = view(&doc, &mut slot);
     assert_eq!(update, TransferUpdate::Built);
-    let tracer0 = DifferentialTracer::new(
-        &job0.scene.scene,
-        &job0.lighting,
-        &job0.camera,
-        &job0.photo_linear,
-        2,
-    )
-    .unwrap();
+    let tracer0 = job0.tracer().unwrap();
     let records = PreviewRecords::record(&tracer0, STRIDE_PX, &cancel).unwrap();
     let count = |f: &dyn Fn(&SampleReplay) -> bool| {
         records.samples().iter().filter(|s| f(&s.replay)).count()
@@ -494,8 +486,7 @@ fn the_preview_replays_a_sky_and_colour_edit_as_a_new_recording_would() {
     // The replay needs no tracer: the edited site's scene, lighting and camera.
     assert!(records.fits(scene1, lighting1, camera1));
     let replayed = records.replay(scene1, lighting1, camera1).unwrap();
-    let tracer1 =
-        DifferentialTracer::new(scene1, lighting1, camera1, &job1.photo_linear, 2).unwrap();
+    let tracer1 = job1.tracer().unwrap();
     let fresh = PreviewRecords::record(&tracer1, STRIDE_PX, &cancel)
         .unwrap()
         .replay(scene1, lighting1, camera1)

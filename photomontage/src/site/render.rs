@@ -33,7 +33,9 @@ use super::{PerezForm, SiteDocument, SkyModelName};
 use crate::atmosphere::schachter::SchachterAtmosphere;
 use crate::camera::Camera;
 use crate::colour::Colour;
-use crate::render::{Daylight, DistantLight, Lighting, RenderSettings};
+use crate::render::{
+    Daylight, DifferentialError, DifferentialTracer, DistantLight, Lighting, RenderSettings,
+};
 use crate::sky::{PerezSky, SkyModel};
 use crate::sky_dome::durisch_facets::durisch_dome;
 
@@ -86,6 +88,23 @@ pub struct ViewJob {
     pub sun_dir_in_world: Option<Vector3<f64>>,
     /// Scene warnings and setting adjustments.
     pub warnings: Vec<SiteWarning>,
+}
+
+impl ViewJob {
+    /// The differential tracer of this view (its scene, lighting, camera and photo, the
+    /// settings' recursion depth).
+    ///
+    /// # Errors
+    /// As [`DifferentialTracer::new`].
+    pub fn tracer(&self) -> Result<DifferentialTracer<'_>, DifferentialError> {
+        DifferentialTracer::new(
+            &self.scene.scene,
+            &self.lighting,
+            &self.camera,
+            &self.photo_linear,
+            self.settings.max_depth,
+        )
+    }
 }
 
 /// The solved camera of photo `photo_id`.

@@ -239,7 +239,7 @@ impl RadiosityLight {
     }
 
     /// [`Self::with_at`] at a point located by [`Self::locate`] on a light of the same geometry
-    /// ([`Self::same_geometry`]).
+    /// (a relight of the one it was located on).
     #[must_use]
     pub fn with_on(&self, at: &PointOnElement) -> Option<Rgb> {
         self.with_artificial
@@ -253,15 +253,6 @@ impl RadiosityLight {
         self.without_artificial
             .irradiance_gathered_on(at, &self.gathered[1])
             .map(|s| s.total_rgb)
-    }
-
-    /// Whether `other`'s two meshes have this light's geometry (a relight of it), so that points
-    /// located on one are read on the other.
-    #[must_use]
-    pub fn same_geometry(&self, other: &Self) -> bool {
-        self.with_artificial.mesh.geometry_hash == other.with_artificial.mesh.geometry_hash
-            && self.without_artificial.mesh.geometry_hash
-                == other.without_artificial.mesh.geometry_hash
     }
 
     /// The vertex gathers of the two meshes (with, without the artificial objects).
