@@ -178,9 +178,17 @@ struct PatchPowers {
 }
 
 /// Sums, into `total` and `unshot` (`k` each), the power of one patch's elements in `b` and `u`
-/// (the patch's own slices, `stride` = 3k values per element).
-fn patch_powers(areas: &[f64], b: &[f64], u: &[f32], total: &mut [f64], unshot: &mut [f64]) {
-    let stride = 3 * total.len();
+/// (the patch's own slices, `stride` = 3k values per element), compiled for `K` groups (0: any).
+fn patch_powers<const K: usize>(
+    areas: &[f64],
+    b: &[f64],
+    u: &[f32],
+    total: &mut [f64],
+    unshot: &mut [f64],
+) {
+    let k = groups_of::<K>(total.len());
+    let (total, unshot) = (&mut total[..k], &mut unshot[..k]);
+    let stride = 3 * k;
     let power = |v: &[f64]| luminance(&[v[0].abs(), v[1].abs(), v[2].abs()]);
     let power_f32 = |v: &[f32]| {
         luminance(&[
@@ -224,7 +232,7 @@ fn group_sums(per_patch: &[f64], k: usize) -> Vec<f64> {
 /// ([`SourceRows::patch_links`]); `leaves` says whether the groups hold their start or the
 /// scratch does. Returns each group's radiosity per element and its convergence rows (and what
 /// is left unshot, where asked).
-#[allow(clippy::too_many_lines, clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn shoot(
     topology: &Topology,
     rows: &SourceRows,
@@ -235,7 +243,49 @@ pub(super) fn shoot(
     patch_links: &[u64],
     scratch: &mut ShootScratch,
 ) -> Vec<Shot> {
-    let k = groups.len();
+    // The per-patch passes run with the number of groups known at compile time (their loops
+    // over a node's or an element's values then unroll); more than four groups take the loops
+    // with the number read at run time.
+    let run = match groups.len() {
+        1 => shoot_k::<1>,
+        2 => shoot_k::<2>,
+        3 => shoot_k::<3>,
+        4 => shoot_k::<4>,
+        _ => shoot_k::<0>,
+    };
+    run(
+        topology,
+        rows,
+        rho,
+        groups,
+        leaves,
+        stop,
+        patch_links,
+        scratch,
+    )
+}
+
+/// The number of light groups of a shooting compiled for `K` groups (`K` = 0: `k`, read at run
+/// time).
+#[inline(always)]
+fn groups_of<const K: usize>(k: usize) -> usize {
+    if K == 0 { k } else { K }
+}
+
+/// [`shoot`] for `K` groups (0: any number).
+#[allow(clippy::too_many_lines, clippy::too_many_arguments)]
+fn shoot_k<const K: usize>(
+    topology: &Topology,
+    rows: &SourceRows,
+    rho: &[Rgb],
+    groups: Vec<ShotGroup<'_>>,
+    leaves: Leaves,
+    stop: &StopRule,
+    patch_links: &[u64],
+    scratch: &mut ShootScratch,
+) -> Vec<Shot> {
+    let k = groups_of::<K>(groups.len());
+    debug_assert_eq!(k, groups.len(), "shoot_k runs for its number of groups");
     let stride = 3 * k;
     let simd = simd_token();
     let n_el = topology.areas.len();
@@ -266,6 +316,7 @@ pub(super) fn shoot(
         .par_iter()
         .zip(block_leaves(&blocks, stride, k, b, u, &mut powers))
         .for_each(|(block, mut leaves)| {
+            let stride = 3 * groups_of::<K>(k);
             let BlockLeaves { b, u, .. } = &mut leaves;
             let copied = if filled {
                 0..0
@@ -304,7 +355,7 @@ pub(super) fn shoot(
                 }
             }
             for p in block.patches.0..block.patches.1 {
-                leaves.sum_powers(topology, block, p);
+                leaves.sum_powers::<K>(topology, block, p);
             }
         });
     let mut out_rows: Vec<Vec<ConvergenceRow>> = vec![Vec::new(); k];
@@ -331,6 +382,7 @@ pub(super) fn shoot(
             .zip(un_parts)
             .zip(u_parts)
             .map(|((block, un), u)| {
+                let stride = 3 * groups_of::<K>(k);
                 let (n0, e0) = (block.nodes.0, block.elements.0);
                 let mut active = Vec::new();
                 for p in block.patches.0..block.patches.1 {
@@ -399,6 +451,7 @@ pub(super) fn shoot(
             .zip(split_blocks(&blocks, |b| b.nodes, stride, acc))
             .zip(block_leaves(&blocks, stride, k, b, u, &mut powers))
             .for_each(|((block, acc), mut leaves)| {
+                let stride = 3 * groups_of::<K>(k);
                 let (n0, e0) = (block.nodes.0, block.elements.0);
                 for p in block.patches.0..block.patches.1 {
                     let (lo, hi) = patches[p];
@@ -433,7 +486,7 @@ pub(super) fn shoot(
                         acc.fill(0.0);
                     }
                     if gathered || shot_now[p] {
-                        leaves.sum_powers(topology, block, p);
+                        leaves.sum_powers::<K>(topology, block, p);
                     }
                 }
             });

@@ -3,7 +3,7 @@
 //! values on any number of threads.
 
 use super::super::topology::Topology;
-use super::{PatchPowers, patch_powers};
+use super::{PatchPowers, groups_of, patch_powers};
 
 /// Elements per [`PatchBlock`] (at least; a block ends at a patch's end): enough to amortise a
 /// task, few enough to balance two to dozens of threads on 50 000 elements.
@@ -48,9 +48,15 @@ pub(super) struct BlockLeaves<'a> {
 }
 
 impl BlockLeaves<'_> {
-    /// Sums the powers of patch `p` of `block` from its elements' B and unshot part.
-    pub(super) fn sum_powers(&mut self, topology: &Topology, block: &PatchBlock, p: usize) {
-        let k = self.total.len() / (block.patches.1 - block.patches.0);
+    /// Sums the powers of patch `p` of `block` from its elements' B and unshot part (`K` groups,
+    /// 0: any number).
+    pub(super) fn sum_powers<const K: usize>(
+        &mut self,
+        topology: &Topology,
+        block: &PatchBlock,
+        p: usize,
+    ) {
+        let k = groups_of::<K>(self.total.len() / (block.patches.1 - block.patches.0));
         let stride = 3 * k;
         let (elo, ehi) = topology.patch_elements[p];
         let (x, y) = (
@@ -58,7 +64,7 @@ impl BlockLeaves<'_> {
             (ehi - block.elements.0) * stride,
         );
         let i = p - block.patches.0;
-        patch_powers(
+        patch_powers::<K>(
             &topology.areas[elo..ehi],
             &self.b[x..y],
             &self.u[x..y],
