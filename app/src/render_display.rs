@@ -10,6 +10,7 @@ use eframe::egui::{self, Color32};
 use photomontage::colour::ToneMap;
 use photomontage::colour::tonemap::encode_srgb8;
 use photomontage::render::{RenderedImage, TileProgress};
+use rayon::prelude::*;
 
 /// Longest side of the preview texture; larger montages are subsampled for display only.
 pub const MAX_DISPLAY_SIDE_PX: u32 = 2048;
@@ -120,19 +121,23 @@ pub fn display_step(size_px: [u32; 2]) -> u32 {
 #[must_use]
 pub fn display_rgb(
     size_px: [u32; 2],
-    rgb_at: impl Fn(u32, u32) -> [f32; 3],
+    rgb_at: impl Fn(u32, u32) -> [f32; 3] + Sync,
     tone_map: &ToneMap,
 ) -> egui::ColorImage {
     let [w, h] = size_px;
     let step = display_step(size_px);
     let (dw, dh) = (w.div_ceil(step), h.div_ceil(step));
-    let mut pixels = Vec::with_capacity((dw * dh) as usize);
-    for y in 0..dh {
-        for x in 0..dw {
-            let [r, g, b] = encode_srgb8(rgb_at(x * step, y * step), tone_map);
-            pixels.push(Color32::from_rgb(r, g, b));
-        }
-    }
+    let mut pixels = vec![Color32::BLACK; (dw * dh) as usize];
+    // Rows in parallel (each pixel on its own: the same image on any number of threads).
+    pixels
+        .par_chunks_mut(dw.max(1) as usize)
+        .zip(0..dh)
+        .for_each(|(row, y)| {
+            for (p, x) in row.iter_mut().zip(0..dw) {
+                let [r, g, b] = encode_srgb8(rgb_at(x * step, y * step), tone_map);
+                *p = Color32::from_rgb(r, g, b);
+            }
+        });
     egui::ColorImage::new([dw as usize, dh as usize], pixels)
 }
 

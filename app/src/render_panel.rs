@@ -167,21 +167,27 @@ fn render_job(
     if matches!(quality.avr, AvrLevel::Avr0 | AvrLevel::Avr1) {
         return overlay_photo(doc, id, quality.avr).map(|image| (image, None));
     }
-    let mut job = match &options.photo {
+    let (mut job, photo_display) = match &options.photo {
         Some(shared) => {
             // A job that panicked while holding the lock leaves nothing to reuse.
             let mut kept = shared.lock().unwrap_or_else(|poisoned| {
                 let mut kept = poisoned.into_inner();
-                *kept = None;
+                *kept = live::KeptView::default();
                 kept
             });
             shared.clear_poison();
-            crate::render_job::prepare_photo_kept(doc, id, quality, Some(&mut kept))?
+            let job =
+                crate::render_job::prepare_photo_kept(doc, id, quality, Some(&mut kept.photo))?;
+            let display = kept.display(&job.prepared.job.photo_linear, &tone_map);
+            (job, display)
         }
-        None => prepare_photo(doc, id, quality)?,
+        None => {
+            let job = prepare_photo(doc, id, quality)?;
+            let display = display_photo(&job.prepared.job.photo_linear, &tone_map);
+            (job, display)
+        }
     };
     let photo = &job.prepared.job.photo_linear;
-    let photo_display = display_photo(photo, &tone_map);
     progress.send(RenderUpdate::Photo {
         size_px: [photo.width(), photo.height()],
         image: photo_display.clone(),

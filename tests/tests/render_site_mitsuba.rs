@@ -176,7 +176,7 @@ fn site_file_montage_matches_mitsuba_1024spp() {
     let doc = SiteDocument::load(&site).unwrap();
     let job = prepare_view(&doc, "view").unwrap();
     // The photo went through the site file and the EXR reader unchanged.
-    assert_eq!(job.photo_linear, photo);
+    assert_eq!(*job.photo_linear, photo);
     let tracer = DifferentialTracer::new(
         &job.scene.scene,
         &job.lighting,

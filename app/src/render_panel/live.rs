@@ -20,7 +20,8 @@
 //! surfaces' reflectances came from, its notes), and the refinement's pass and tiles.
 //!
 //! A live render takes the photo decoded by the last one while its file is unchanged
-//! ([`photomontage::site::render::KeptPhoto`]).
+//! ([`photomontage::site::render::KeptPhoto`], shared, not copied) and its display image while
+//! the tone map is unchanged too ([`KeptView`]).
 //!
 //! # Known limitations
 //! The re-projected views (planar, cylindrical) are not rendered live (Start renders them).
@@ -29,6 +30,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use eframe::egui;
+use photomontage::colour::ToneMap;
 use photomontage::render::preview::PreviewImage;
 use photomontage::site::SiteDocument;
 use photomontage::site::live_relight::{RelightReport, SiteTransfers, TransferUpdate};
@@ -48,9 +50,40 @@ pub const COARSE_SPP: u32 = 4;
 /// The site's transfers, shared with the render worker.
 pub type SharedTransfers = Arc<Mutex<Option<SiteTransfers>>>;
 
-/// The last decoded photo, shared with the render worker (an edit's render reuses it while its
-/// file is unchanged).
-pub type SharedPhoto = Arc<Mutex<Option<KeptPhoto>>>;
+/// The last decoded photo and its display image, shared with the render worker (an edit's render
+/// reuses them while the file and the tone map are unchanged).
+pub type SharedPhoto = Arc<Mutex<KeptView>>;
+
+/// What a live render keeps of its view's photo between edits: the decoded photo (while its
+/// file is unchanged) and the display image made from it (while the tone map is unchanged).
+#[derive(Default)]
+pub struct KeptView {
+    /// The decoded photo.
+    pub photo: Option<KeptPhoto>,
+    /// The photo the display image was made from (held, so that no other photo can take its
+    /// address), its tone map and the image.
+    display: Option<(Arc<image::Rgb32FImage>, ToneMap, egui::ColorImage)>,
+}
+
+impl KeptView {
+    /// The display image of `photo` through `tone_map` ([`super::display_photo`]): the kept one
+    /// when it was made from this very photo (the same allocation) with the same tone map.
+    pub fn display(
+        &mut self,
+        photo: &Arc<image::Rgb32FImage>,
+        tone_map: &ToneMap,
+    ) -> egui::ColorImage {
+        if let Some((from, map, image)) = &self.display
+            && Arc::ptr_eq(from, photo)
+            && map == tone_map
+        {
+            return image.clone();
+        }
+        let image = super::display_photo(photo, tone_map);
+        self.display = Some((Arc::clone(photo), *tone_map, image.clone()));
+        image
+    }
+}
 
 /// What the live preview rendered last: the site, photo and quality.
 #[derive(Debug, Clone, PartialEq)]
@@ -367,5 +400,39 @@ pub(super) fn passes(options: &JobOptions, quality: Quality) -> Vec<(u32, u32)> 
         vec![(COARSE_SPP, COARSE_SPP), (quality.spp_min, quality.spp_max)]
     } else {
         vec![(quality.spp_min, quality.spp_max)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kept display image is handed out again only for the very photo (the same allocation)
+    /// and tone map it was made from; otherwise it is made again (mutation checked: without
+    /// the pointer test, the equal copy gets the marked image).
+    #[test]
+    fn the_display_image_is_kept_for_the_same_photo_and_tone_map() {
+        let photo = Arc::new(image::Rgb32FImage::from_fn(8, 6, |x, y| {
+            #[allow(clippy::cast_precision_loss)]
+            image::Rgb([0.01 * x as f32, 0.02 * y as f32, 0.3])
+        }));
+        let clamp = ToneMap::clamp();
+        let mut kept = KeptView::default();
+        let first = kept.display(&photo, &clamp);
+        assert!(first.pixels == super::super::display_photo(&photo, &clamp).pixels);
+        let mark = |kept: &mut KeptView| {
+            kept.display.as_mut().expect("a kept image").2.pixels[0] = egui::Color32::RED;
+        };
+        // The same photo and tone map: the kept image (marked), not a new one.
+        mark(&mut kept);
+        assert_eq!(kept.display(&photo, &clamp).pixels[0], egui::Color32::RED);
+        // Another tone map: made again.
+        let reinhard = ToneMap::reinhard(0.5);
+        let other = kept.display(&photo, &reinhard);
+        assert!(other.pixels == super::super::display_photo(&photo, &reinhard).pixels);
+        // An equal photo in another allocation (a file read again): made again.
+        mark(&mut kept);
+        let copy = Arc::new((*photo).clone());
+        assert_ne!(kept.display(&copy, &reinhard).pixels[0], egui::Color32::RED);
     }
 }

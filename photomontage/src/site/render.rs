@@ -79,8 +79,9 @@ pub struct ViewJob {
     pub lighting: Lighting,
     /// The solved camera of the photo.
     pub camera: Camera,
-    /// The photo, linear RGB, the camera's size.
-    pub photo_linear: Rgb32FImage,
+    /// The photo, linear RGB, the camera's size (shared with a [`KeptPhoto`]: the studio's live
+    /// renders do not copy it for every edit).
+    pub photo_linear: std::sync::Arc<Rgb32FImage>,
     /// Render settings from the site's `[render]` table.
     pub settings: RenderSettings,
     /// The sun direction used (survey frame), `None` when none was needed or it is below the
@@ -422,7 +423,8 @@ pub fn site_photo_linear(
     photo_id: &str,
     camera: &Camera,
 ) -> Result<Rgb32FImage, SiteRenderError> {
-    site_photo_linear_kept(doc, photo_id, camera, None)
+    // Nothing kept: the only handle, so no copy.
+    site_photo_linear_kept(doc, photo_id, camera, None).map(std::sync::Arc::unwrap_or_clone)
 }
 
 /// A photo decoded and linearised, kept to be handed out again while its file is unchanged
@@ -433,7 +435,7 @@ pub struct KeptPhoto {
     file: std::path::PathBuf,
     len: u64,
     modified: Option<std::time::SystemTime>,
-    photo_linear: Rgb32FImage,
+    photo_linear: std::sync::Arc<Rgb32FImage>,
 }
 
 impl KeptPhoto {
@@ -444,7 +446,8 @@ impl KeptPhoto {
 }
 
 /// [`site_photo_linear`], reusing the photo `kept` holds when it is this view's file unchanged
-/// and keeping the one it loads there otherwise (`None`: nothing kept).
+/// and keeping the one it loads there otherwise (`None`: nothing kept). The kept photo is
+/// shared, not copied.
 ///
 /// # Errors
 /// As [`site_photo_linear`].
@@ -453,7 +456,7 @@ pub fn site_photo_linear_kept(
     photo_id: &str,
     camera: &Camera,
     kept: Option<&mut Option<KeptPhoto>>,
-) -> Result<Rgb32FImage, SiteRenderError> {
+) -> Result<std::sync::Arc<Rgb32FImage>, SiteRenderError> {
     let photo = doc
         .site
         .photos
@@ -474,7 +477,7 @@ pub fn site_photo_linear_kept(
         Some(photo_linear) => photo_linear,
         None => {
             let loaded = crate::photo::load(&file)?;
-            let photo_linear = crate::render::linear_photo(&loaded);
+            let photo_linear = std::sync::Arc::new(crate::render::linear_photo(&loaded));
             if let (Some(slot), Some(meta)) = (kept, &meta) {
                 *slot = Some(KeptPhoto {
                     file: file.clone(),

@@ -410,10 +410,10 @@ fn a_kept_photo_is_reused_until_its_file_changes() {
     let fresh = site_photo_linear(&doc, "p1", &camera).unwrap();
     let mut kept = None;
     let first = site_photo_linear_kept(&doc, "p1", &camera, Some(&mut kept)).unwrap();
-    assert!(first == fresh);
+    assert!(*first == fresh);
     // Mark the kept pixels: a reuse hands out the mark.
     let mark = image::Rgb([9.0_f32; 3]);
-    kept.as_mut().unwrap().photo_linear.put_pixel(0, 0, mark);
+    std::sync::Arc::make_mut(&mut kept.as_mut().unwrap().photo_linear).put_pixel(0, 0, mark);
     let again = site_photo_linear_kept(&doc, "p1", &camera, Some(&mut kept)).unwrap();
     assert_eq!(*again.get_pixel(0, 0), mark);
     // Another photo in the same file (other pixels, so another length): read again.
@@ -425,6 +425,6 @@ fn a_kept_photo_is_reused_until_its_file_changes() {
     .save(dir.path().join("p1.png"))
     .unwrap();
     let changed = site_photo_linear_kept(&doc, "p1", &camera, Some(&mut kept)).unwrap();
-    assert!(changed == site_photo_linear(&doc, "p1", &camera).unwrap());
-    assert!(changed != fresh && *changed.get_pixel(0, 0) != mark);
+    assert!(*changed == site_photo_linear(&doc, "p1", &camera).unwrap());
+    assert!(*changed != fresh && *changed.get_pixel(0, 0) != mark);
 }

@@ -196,10 +196,10 @@ pub fn planar_view_job(
     let mut job = prepare_view(doc, photo_id)?;
     let [w, h] = view.image.size_px;
     let rgba = &view.image.rgba;
-    job.photo_linear = Rgb32FImage::from_fn(w, h, |x, y| {
+    job.photo_linear = std::sync::Arc::new(Rgb32FImage::from_fn(w, h, |x, y| {
         let p = rgba[(y * w + x) as usize];
         image::Rgb([p[0], p[1], p[2]])
-    });
+    }));
     job.camera = view.camera;
     Ok((view, job))
 }
